@@ -1,0 +1,13 @@
+"""Benchmarks: speed against error, reported by ``palpate bench``.
+
+Each section is a module exposing ``run(ctx: BenchContext) -> BenchSection``; the registry below
+lists them in the order they print. Benchmarks measure; tests never assert timings.
+"""
+
+from __future__ import annotations
+
+SECTIONS: dict[str, str] = {
+    "mechanics": "bench.mechanics",
+    "sensor": "bench.sensor",
+    "robot": "bench.robot",
+}

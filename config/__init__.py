@@ -1,0 +1,27 @@
+"""Configuration: YAML files shipped here and the one loader that validates them.
+
+``load_stack("robot.yaml")`` returns a :class:`config.schema.StackConfig` in SI-ready form.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from config.loader import CONFIG_DIR, ConfigError, from_mapping, load, read_yaml, resolve
+from config.schema import StackConfig
+
+__all__ = [
+    "CONFIG_DIR",
+    "ConfigError",
+    "StackConfig",
+    "from_mapping",
+    "load",
+    "load_stack",
+    "read_yaml",
+    "resolve",
+]
+
+
+def load_stack(path: str | Path = "robot.yaml") -> StackConfig:
+    """Load the robot/sensor configuration (default: the shipped simulated robot)."""
+    return load(StackConfig, resolve(path))

@@ -1,0 +1,203 @@
+"""One loader for every YAML file: mapping -> typed, validated dataclasses.
+
+The schema is plain dataclasses (see :mod:`config.schema`). A field's YAML key is its name, so a
+key carries its unit when the unit is not SI (``length_mm``); the dataclass exposes SI properties.
+Range limits live in the field metadata (``ge``, ``gt``, ``le``, ``lt``), so the schema is data and
+this module is the only code that checks it.
+
+Every failure raises :class:`ConfigError` with the file and the dotted key path, e.g.
+``config/robot.yaml: sensor.wire_count: expected an integer, got 'four'``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Literal, TypeVar, get_args, get_origin
+
+import yaml
+
+T = TypeVar("T")
+
+CONFIG_DIR = Path(__file__).resolve().parent
+
+
+class ConfigError(ValueError):
+    """A configuration file or value is wrong; the message names the file and the key."""
+
+    def __init__(self, source: str, key: str, problem: str) -> None:
+        self.source = source
+        self.key = key
+        self.problem = problem
+        where = f"{source}: {key}" if key else source
+        super().__init__(f"{where}: {problem}")
+
+
+def limits(
+    *,
+    ge: float | None = None,
+    gt: float | None = None,
+    le: float | None = None,
+    lt: float | None = None,
+    doc: str = "",
+) -> dict[str, Any]:
+    """Field metadata for a numeric range check: ``field(default=1.0, metadata=limits(gt=0))``."""
+    return {"ge": ge, "gt": gt, "le": le, "lt": lt, "doc": doc}
+
+
+def _join(path: str, key: str | int) -> str:
+    if isinstance(key, int):
+        return f"{path}[{key}]"
+    return f"{path}.{key}" if path else key
+
+
+def _check_range(value: float, meta: Mapping[str, Any], source: str, path: str) -> None:
+    bounds = (
+        ("ge", lambda v, b: v >= b, ">="),
+        ("gt", lambda v, b: v > b, ">"),
+        ("le", lambda v, b: v <= b, "<="),
+        ("lt", lambda v, b: v < b, "<"),
+    )
+    for name, ok, sign in bounds:
+        bound = meta.get(name)
+        if bound is not None and not ok(value, bound):
+            raise ConfigError(source, path, f"must be {sign} {bound}, got {value}")
+
+
+def _convert(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any]) -> Any:
+    origin = get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        options = get_args(tp)
+        if value is None and type(None) in options:
+            return None
+        errors = []
+        for option in options:
+            if option is type(None):
+                continue
+            try:
+                return _convert(option, value, source, path, meta)
+            except ConfigError as exc:
+                errors.append(exc.problem)
+        raise ConfigError(source, path, " / ".join(errors))
+    if origin is Literal:
+        allowed = get_args(tp)
+        if value not in allowed:
+            raise ConfigError(source, path, f"must be one of {list(allowed)}, got {value!r}")
+        return value
+    if origin in (tuple, list):
+        args = get_args(tp)
+        if not isinstance(value, list | tuple):
+            raise ConfigError(source, path, f"expected a list, got {value!r}")
+        item_tp = args[0] if args else Any
+        items = [_convert(item_tp, v, source, _join(path, i), meta) for i, v in enumerate(value)]
+        if origin is tuple and args and args[-1] is not Ellipsis and len(args) != len(items):
+            raise ConfigError(source, path, f"expected {len(args)} items, got {len(items)}")
+        return tuple(items) if origin is tuple else items
+    if origin is dict:
+        if not isinstance(value, Mapping):
+            raise ConfigError(source, path, f"expected a mapping, got {value!r}")
+        _, val_tp = get_args(tp)
+        return {str(k): _convert(val_tp, v, source, _join(path, str(k)), meta) for k, v in value.items()}
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        return from_mapping(tp, value, source, path)
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(source, path, f"expected true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(source, path, f"expected an integer, got {value!r}")
+        _check_range(value, meta, source, path)
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(source, path, f"expected a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ConfigError(source, path, f"must be finite, got {value!r}")
+        _check_range(float(value), meta, source, path)
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(source, path, f"expected a string, got {value!r}")
+        return value
+    if tp is Any:
+        return value
+    raise TypeError(f"config schema uses an unsupported type {tp!r} at {path}")
+
+
+def from_mapping(cls: type[T], data: Any, source: str = "<config>", path: str = "") -> T:
+    """Build dataclass ``cls`` from a YAML mapping, rejecting unknown keys by name.
+
+    Missing keys take the dataclass default; a key without a default is required.
+    After construction, a ``validate()`` method on the dataclass (if any) checks cross-field rules
+    and may raise ``ValueError``; that message is re-raised as a :class:`ConfigError` at ``path``.
+    """
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise ConfigError(source, path, f"expected a mapping, got {data!r}")
+    if not (dataclasses.is_dataclass(cls) and isinstance(cls, type)):
+        raise TypeError(f"{cls!r} is not a dataclass")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    unknown = sorted(str(k) for k in data if k not in fields)
+    if unknown:
+        raise ConfigError(
+            source,
+            _join(path, unknown[0]),
+            f"unknown key (expected one of: {', '.join(sorted(fields))})",
+        )
+    kwargs: dict[str, Any] = {}
+    for name, f in fields.items():
+        key_path = _join(path, name)
+        if name in data:
+            kwargs[name] = _convert(hints[name], data[name], source, key_path, f.metadata)
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            raise ConfigError(source, key_path, "missing required key")
+    try:
+        obj = cls(**kwargs)
+        validate = getattr(obj, "validate", None)
+        if callable(validate):
+            validate()
+    except ConfigError:
+        raise
+    except ValueError as exc:
+        raise ConfigError(source, path or "<top>", str(exc)) from exc
+    return obj
+
+
+def read_yaml(path: str | Path) -> Any:
+    """Parse a YAML file; a syntax error or a missing file becomes a :class:`ConfigError`."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(str(p), "", "file not found") from None
+    except OSError as exc:
+        raise ConfigError(str(p), "", f"cannot read: {exc.strerror}") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        raise ConfigError(str(p), "", f"malformed YAML: {where}{getattr(exc, 'problem', exc)}") from None
+
+
+def load(cls: type[T], path: str | Path) -> T:
+    """Load one YAML file into dataclass ``cls``."""
+    return from_mapping(cls, read_yaml(path), str(path))
+
+
+def resolve(name: str | Path) -> Path:
+    """A path as given if it exists, else a file shipped in ``config/`` (``"robot.yaml"``)."""
+    p = Path(name)
+    if p.exists():
+        return p
+    shipped = CONFIG_DIR / p
+    if shipped.exists():
+        return shipped
+    raise ConfigError(str(name), "", "file not found (neither as given nor in the shipped config/)")

@@ -1,0 +1,1 @@
+"""Pure physics and statistics: composite section, elastica, contact, detection, stiffness fits."""

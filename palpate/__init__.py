@@ -1,0 +1,1 @@
+"""The ``palpate`` application: command-line entry point and the wiring of hardware or emulators."""

@@ -1,0 +1,1 @@
+"""Subcommands of ``palpate``; each module has ``register(parser)`` and ``run(args) -> int``."""

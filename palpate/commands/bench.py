@@ -1,0 +1,52 @@
+"""Speed against error of the mechanics, the signal chain and the servo bus."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+from pathlib import Path
+
+from bench import SECTIONS
+from bench.report import BenchContext, BenchSection
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--only", action="append", choices=sorted(SECTIONS), help="run only these sections"
+    )
+    parser.add_argument("--quick", action="store_true", help="fewer repeats and a coarser grid")
+    parser.add_argument("--out", type=Path, default=Path("out/bench"), help="folder for plots")
+    parser.add_argument("--seed", type=int, default=0)
+
+
+def run(args: argparse.Namespace) -> int:
+    ctx = BenchContext(out_dir=args.out, quick=args.quick, seed=args.seed, repeats=3 if args.quick else 7)
+    ctx.out_dir.mkdir(parents=True, exist_ok=True)
+    names = args.only or list(SECTIONS)
+    results: list[BenchSection] = []
+    for name in names:
+        module = importlib.import_module(SECTIONS[name])
+        print(f"[bench] {name} ...", file=sys.stderr, flush=True)
+        section: BenchSection = module.run(ctx)
+        results.append(section)
+        if not args.json:
+            for table in section.tables:
+                print(table.render())
+                print()
+            for fig in section.figures:
+                print(f"plot: {fig}")
+            if section.figures:
+                print()
+    if args.json:
+        payload = {
+            s.name: {
+                "tables": [t.as_dict() for t in s.tables],
+                "figures": [str(f) for f in s.figures],
+                "summary": s.summary,
+            }
+            for s in results
+        }
+        print(json.dumps(payload, indent=2, default=float))
+    return 0

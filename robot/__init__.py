@@ -1,0 +1,1 @@
+"""Robot stack: tube kinematics, roller-gear drive, Dynamixel driver, indentation state machine."""

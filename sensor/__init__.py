@@ -1,0 +1,1 @@
+"""FBG signal chain: board frames over pyserial, wavelength -> strain, grating averages, detection."""
