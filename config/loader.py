@@ -101,7 +101,9 @@ def _convert(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any
         if not isinstance(value, Mapping):
             raise ConfigError(source, path, f"expected a mapping, got {value!r}")
         _, val_tp = get_args(tp)
-        return {str(k): _convert(val_tp, v, source, _join(path, str(k)), meta) for k, v in value.items()}
+        return {
+            str(k): _convert(val_tp, v, source, _join(path, str(k)), meta) for k, v in value.items()
+        }
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):
         return from_mapping(tp, value, source, path)
     if tp is bool:
@@ -184,7 +186,8 @@ def read_yaml(path: str | Path) -> Any:
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
-        raise ConfigError(str(p), "", f"malformed YAML: {where}{getattr(exc, 'problem', exc)}") from None
+        problem = getattr(exc, "problem", exc)
+        raise ConfigError(str(p), "", f"malformed YAML: {where}{problem}") from None
 
 
 def load(cls: type[T], path: str | Path) -> T:

@@ -1,0 +1,114 @@
+"""Scenes: what the simulator builds (samples, fidelity switches) and the campaign it runs.
+
+A scene file (``config/scenes/*.yaml``) names the robot configuration it uses, the tissue
+samples, the fidelity switches (each effect costs nothing when off) and the campaign. The
+defaults reproduce the paper: Table I's 11 phantoms for the bench-top campaign, Table II's two
+samples for the robot campaign.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from config.loader import limits
+from config.schema import MM
+
+KPA = 1e3
+
+Orientation = Literal["downward", "sideways", "upward"]
+ORIENTATION_ROLL_DEG: dict[str, float] = {"downward": 0.0, "sideways": 90.0, "upward": 180.0}
+
+
+@dataclass(frozen=True)
+class SampleConfig:
+    """A tissue phantom: modulus, Poisson's ratio, layer thickness (null = half-space)."""
+
+    name: str
+    modulus_kpa: float = field(metadata=limits(gt=0, le=1e6))
+    poisson: float = field(default=0.45, metadata=limits(ge=0, le=0.5))
+    thickness_mm: float | None = field(default=10.0, metadata=limits(gt=0, le=1000))
+    bonded: bool = True
+
+    @property
+    def modulus(self) -> float:
+        return self.modulus_kpa * KPA
+
+    @property
+    def thickness(self) -> float | None:
+        return None if self.thickness_mm is None else self.thickness_mm * MM
+
+
+# Paper Table I: actual moduli (kPa) of the 11 PDMS / PA-gel phantoms.
+TABLE_I_KPA: tuple[float, ...] = (
+    1023.67, 706.30, 504.03, 823.77, 529.33, 908.88, 1122.86, 314.53, 716.74, 499.56, 323.78,
+)  # fmt: skip
+PAPER_SAMPLES: tuple[SampleConfig, ...] = tuple(
+    SampleConfig(name=f"S{i}", modulus_kpa=e) for i, e in enumerate(TABLE_I_KPA, start=1)
+)
+
+
+@dataclass(frozen=True)
+class FidelityConfig:
+    """Effects the simulated world models. Off means not computed at all."""
+
+    fbg_noise_pm: float = field(default=1.0, metadata=limits(ge=0, le=1000))
+    encoder_quantisation: bool = True
+    contact_uncertainty_mm: float = field(default=0.0, metadata=limits(ge=0, le=10))
+    imperfection_w0_over_l: float = field(default=0.0, metadata=limits(ge=0, le=0.1))
+    finite_thickness: bool = True
+    large_indentation: bool = True
+    tube_tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
+    temperature_drift_degc_per_s: float = field(default=0.0, metadata=limits(ge=-10, le=10))
+    servo_tracking_lag: bool = True
+
+
+@dataclass(frozen=True)
+class CampaignConfig:
+    """Which trials to run and how each one indents."""
+
+    kind: Literal["bench", "robot"] = "robot"
+    samples: tuple[str, ...] = ()  # empty: every sample of the scene
+    exposed_lengths_mm: tuple[float, ...] = (42.0, 44.0, 46.0, 48.0, 50.0)  # bench-top
+    exposed_length_mm: float = field(default=42.0, metadata=limits(gt=0, le=500))  # robot
+    tubes: tuple[str, ...] = ("straight", "bent15", "bent30", "bent50")
+    orientations: tuple[Orientation, ...] = ("downward", "sideways", "upward")
+    repeats: int = field(default=1, metadata=limits(ge=1, le=1000))
+    standoff_mm: float = field(default=1.0, metadata=limits(gt=0, le=50))
+    approach_speed_mm_per_s: float = field(default=2.0, metadata=limits(gt=0, le=100))
+    indent_speed_mm_per_s: float = field(default=0.5, metadata=limits(gt=0, le=100))
+    post_buckling_mm: float = field(default=0.3, metadata=limits(ge=0, le=20))
+    max_travel_past_contact_mm: float = field(default=2.5, metadata=limits(gt=0, le=50))
+    contact: Literal["event", "fbg"] = "event"
+    detector: Literal["paper", "cusum"] = "paper"
+    detector_threshold_ue: float = field(default=30.0, metadata=limits(gt=0, le=10000))
+    outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))
+
+    @property
+    def orientation_rolls_deg(self) -> tuple[float, ...]:
+        return tuple(ORIENTATION_ROLL_DEG[o] for o in self.orientations)
+
+
+@dataclass(frozen=True)
+class SceneConfig:
+    """A simulated world and the campaign to run in it: ``config/scenes/*.yaml``."""
+
+    name: str = "scene"
+    robot: str = "robot.yaml"
+    transport: Literal["fast", "wire"] = "fast"
+    control_rate_hz: float = field(default=500.0, metadata=limits(gt=0, le=10000))
+    samples: tuple[SampleConfig, ...] = PAPER_SAMPLES
+    fidelity: FidelityConfig = FidelityConfig()
+    campaign: CampaignConfig = CampaignConfig()
+
+    def validate(self) -> None:
+        names = [s.name for s in self.samples]
+        if len(set(names)) != len(names):
+            raise ValueError(f"samples: names must be unique, got {names}")
+        for wanted in self.campaign.samples:
+            if wanted not in names:
+                raise ValueError(f"campaign.samples: no sample named {wanted!r}; known: {names}")
+
+    def campaign_samples(self) -> tuple[SampleConfig, ...]:
+        wanted = self.campaign.samples
+        return tuple(s for s in self.samples if not wanted or s.name in wanted)

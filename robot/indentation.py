@@ -1,0 +1,318 @@
+"""The indentation state machine: explicit states, guards, and a log line for every transition.
+
+It is pure logic: each control tick the trial loop hands it an :class:`Observation` (stage
+position from the servo encoder, the grating strains, the contact event, health of the streams)
+and gets back a :class:`Command` (goal advance and roll, and the speed to get there). It never
+touches hardware, so the same machine runs on the bench, on the emulators and in tests.
+
+States and the normal path::
+
+    IDLE -> HOMING -> POSITIONING -> APPROACH -> CONTACT -> INDENTING -> BUCKLED
+         -> RETRACTING -> DONE
+
+FAULT (a guard tripped: retract, then stop) and ABORTED (operator stop) are reachable from every
+state. A fault always ends with the stage retracted to the home advance when the drive still
+answers; the trial record is closed with the reason.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+
+class State(enum.Enum):
+    IDLE = "idle"
+    HOMING = "homing"
+    POSITIONING = "positioning"
+    APPROACH = "approach"
+    CONTACT = "contact"
+    INDENTING = "indenting"
+    BUCKLED = "buckled"
+    RETRACTING = "retracting"
+    DONE = "done"
+    FAULT = "fault"
+    ABORTED = "aborted"
+
+
+TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED})
+
+
+@dataclass(frozen=True)
+class TrialPlan:
+    """Where to go: from inverse kinematics and the campaign (SI: m, rad, m/s)."""
+
+    roll: float
+    contact_advance: float  # advance where the tip sphere is expected to touch (m)
+    home_advance: float = 0.0
+    standoff: float = 2e-3  # stop this far before the expected contact, then approach slowly
+    approach_window: float = 3e-3  # no contact this far past the expected contact -> fault
+    post_buckling_travel: float = 0.3e-3  # keep indenting after detection, for the record
+    fast_speed: float = 5e-3
+    approach_speed: float = 1e-3
+    indent_speed: float = 0.5e-3
+    roll_tolerance: float = 2e-3
+    position_tolerance: float = 5e-6
+
+
+@dataclass(frozen=True)
+class Guards:
+    """Limits that stop a trial. Exceeding any of them is a FAULT with the guard named."""
+
+    max_travel_past_contact: float = 2.5e-3  # m; the beam or the tissue is at risk beyond
+    strain_limit: float = 5e-3  # fiber strain (dimensionless); protects the fiber
+    stream_timeout: float = 0.1  # s without a fresh FBG frame
+    state_timeout: float = 60.0  # s in any one state
+    early_contact_margin: float = 0.5e-3  # contact this much before the plan is "unexpected"
+
+
+@dataclass(frozen=True)
+class Observation:
+    t: float  # s
+    advance: float  # m, stage position from the translation servo's encoder
+    roll: float  # rad, outer roll from its encoder
+    strains: tuple[float, ...]  # grating-average strains of the used gratings
+    contact: bool  # the contact event (force scale / camera / FBG), as the rig reports it
+    stream_age: float = 0.0  # s since the last good FBG frame
+    servo_fault: str | None = None  # a fault the servo bus reported, if any
+    abort: bool = False  # the operator pressed stop
+
+
+@dataclass(frozen=True)
+class Command:
+    advance: float  # goal, m
+    roll: float  # goal, rad
+    speed: float  # m/s for the advance
+    torque: bool = True
+
+
+@dataclass(frozen=True)
+class Transition:
+    t: float
+    source: State
+    target: State
+    reason: str
+    advance: float
+    strains: tuple[float, ...]
+
+
+class BucklingDetector(Protocol):
+    """Anything that decides from strains (and stage advance) that the beam has buckled."""
+
+    def reset(self) -> None: ...
+
+    def update(self, advance: float, strains: tuple[float, ...]) -> bool: ...
+
+
+@dataclass
+class TrialMarks:
+    """What the estimator needs: encoder values at contact and at detected buckling."""
+
+    x_contact: float | None = None
+    x_buckling: float | None = None
+    t_contact: float | None = None
+    t_buckling: float | None = None
+    strains_at_buckling: tuple[float, ...] = ()
+    reason: str = ""
+
+
+@dataclass
+class IndentationMachine:
+    """One trial's controller. Call :meth:`step` once per control tick."""
+
+    plan: TrialPlan
+    guards: Guards
+    detector: BucklingDetector
+    on_transition: Callable[[Transition], None] = lambda tr: None
+    state: State = State.IDLE
+    marks: TrialMarks = field(default_factory=TrialMarks)
+    _entered: float = 0.0
+    _last_command: Command | None = None
+
+    # -- public -------------------------------------------------------------------------------
+    @property
+    def finished(self) -> bool:
+        return self.state in TERMINAL
+
+    def start(self, t: float) -> None:
+        if self.state is not State.IDLE:
+            raise RuntimeError(f"start() in state {self.state.value}; a machine runs one trial")
+        self.detector.reset()
+        self._go(State.HOMING, t, "start", math.nan, ())
+
+    def step(self, obs: Observation) -> Command:
+        """Advance the machine by one tick and return the goal to send to the drive."""
+        if self.state is State.IDLE:
+            self.start(obs.t)
+        if not self.finished:
+            self._check_guards(obs)
+        handler = _HANDLERS[self.state]
+        cmd = handler(self, obs)
+        self._last_command = cmd
+        return cmd
+
+    def abort(self, t: float, reason: str) -> None:
+        """Operator stop: go to RETRACTING at once, ending in ABORTED."""
+        if not self.finished:
+            self.marks.reason = f"aborted: {reason}"
+            self._go(State.RETRACTING, t, self.marks.reason, math.nan, ())
+
+    # -- guards -------------------------------------------------------------------------------
+    def _check_guards(self, obs: Observation) -> None:
+        if obs.abort and not self.marks.reason.startswith("aborted"):
+            self.abort(obs.t, "operator stop")
+            return
+        if self.state is State.RETRACTING:
+            if obs.servo_fault is not None:
+                # Retraction itself failed: stop where we are; the runner releases torque.
+                self._fault(obs, f"servo fault while retracting: {obs.servo_fault}", retract=False)
+            return
+        if obs.servo_fault is not None:
+            # Stop and retract: the runner clears the fault (reboot) before it moves again.
+            self._fault(obs, f"servo fault: {obs.servo_fault}")
+            return
+        if obs.t - self._entered > self.guards.state_timeout:
+            self._fault(obs, f"timeout in {self.state.value} after {self.guards.state_timeout:g} s")
+            return
+        in_contact_phase = self.state in (
+            State.APPROACH,
+            State.CONTACT,
+            State.INDENTING,
+            State.BUCKLED,
+        )
+        if in_contact_phase and obs.stream_age > self.guards.stream_timeout:
+            self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
+            return
+        peak = max((abs(s) for s in obs.strains), default=0.0)
+        if peak > self.guards.strain_limit:
+            self._fault(
+                obs,
+                f"fiber strain {peak * 1e6:.0f} ue over the limit "
+                f"{self.guards.strain_limit * 1e6:.0f} ue",
+            )
+            return
+        if self.marks.x_contact is not None:
+            past = obs.advance - self.marks.x_contact
+            if past > self.guards.max_travel_past_contact:
+                self._fault(obs, f"travel past contact {past * 1e3:.2f} mm over the limit")
+                return
+        if obs.contact and self.state in (State.HOMING, State.POSITIONING):
+            self._fault(obs, f"unexpected contact during {self.state.value}")
+
+    def _fault(self, obs: Observation, reason: str, *, retract: bool = True) -> None:
+        self.marks.reason = reason
+        if retract:
+            self._go(State.RETRACTING, obs.t, f"fault: {reason}", obs.advance, obs.strains)
+        else:
+            self._go(State.FAULT, obs.t, reason, obs.advance, obs.strains)
+
+    # -- states -------------------------------------------------------------------------------
+    def _go(
+        self, target: State, t: float, reason: str, advance: float, strains: tuple[float, ...]
+    ) -> None:
+        tr = Transition(
+            t=t, source=self.state, target=target, reason=reason, advance=advance, strains=strains
+        )
+        self.state = target
+        self._entered = t
+        self.on_transition(tr)
+
+    def _hold(self, obs: Observation) -> Command:
+        return Command(advance=obs.advance, roll=obs.roll, speed=0.0, torque=True)
+
+    def _homing(self, obs: Observation) -> Command:
+        p = self.plan
+        if abs(obs.advance - p.home_advance) <= p.position_tolerance:
+            self._go(State.POSITIONING, obs.t, "at home", obs.advance, obs.strains)
+        return Command(p.home_advance, obs.roll, p.fast_speed)
+
+    def _positioning(self, obs: Observation) -> Command:
+        p = self.plan
+        target = p.contact_advance - p.standoff
+        at_roll = abs(obs.roll - p.roll) <= p.roll_tolerance
+        if at_roll and abs(obs.advance - target) <= p.position_tolerance:
+            self._go(State.APPROACH, obs.t, "at stand-off", obs.advance, obs.strains)
+            return Command(target, p.roll, p.approach_speed)
+        # Roll first with the sensor back, then advance: never sweep the tip sideways near tissue.
+        goal = target if at_roll else min(obs.advance, target)
+        return Command(goal, p.roll, p.fast_speed)
+
+    def _approach(self, obs: Observation) -> Command:
+        p, g = self.plan, self.guards
+        if obs.contact:
+            if obs.advance < p.contact_advance - p.standoff - g.early_contact_margin:
+                self._fault(obs, "contact earlier than planned")
+                return self._hold(obs)
+            self.marks.x_contact = obs.advance
+            self.marks.t_contact = obs.t
+            self._go(State.CONTACT, obs.t, "contact event", obs.advance, obs.strains)
+            return self._hold(obs)
+        limit = p.contact_advance + p.approach_window
+        if obs.advance >= limit - p.position_tolerance:
+            self._fault(
+                obs, f"no contact within {p.approach_window * 1e3:.1f} mm past the expected surface"
+            )
+            return self._hold(obs)
+        return Command(limit, p.roll, p.approach_speed)
+
+    def _contact(self, obs: Observation) -> Command:
+        self.detector.reset()
+        self._go(State.INDENTING, obs.t, "indenting", obs.advance, obs.strains)
+        return self._indent_goal(obs)
+
+    def _indent_goal(self, obs: Observation) -> Command:
+        assert self.marks.x_contact is not None  # set on entering CONTACT
+        goal = self.marks.x_contact + self.guards.max_travel_past_contact
+        return Command(goal, self.plan.roll, self.plan.indent_speed)
+
+    def _indenting(self, obs: Observation) -> Command:
+        if self.detector.update(obs.advance, obs.strains):
+            self.marks.x_buckling = obs.advance
+            self.marks.t_buckling = obs.t
+            self.marks.strains_at_buckling = obs.strains
+            self._go(State.BUCKLED, obs.t, "buckling detected", obs.advance, obs.strains)
+        return self._indent_goal(obs)
+
+    def _buckled(self, obs: Observation) -> Command:
+        assert self.marks.x_buckling is not None
+        goal = self.marks.x_buckling + self.plan.post_buckling_travel
+        if obs.advance >= goal - self.plan.position_tolerance:
+            self.marks.reason = self.marks.reason or "completed"
+            self._go(
+                State.RETRACTING, obs.t, "post-buckling record complete", obs.advance, obs.strains
+            )
+            return Command(self.plan.home_advance, self.plan.roll, self.plan.fast_speed)
+        return Command(goal, self.plan.roll, self.plan.indent_speed)
+
+    def _retracting(self, obs: Observation) -> Command:
+        p = self.plan
+        if abs(obs.advance - p.home_advance) <= p.position_tolerance:
+            if self.marks.reason.startswith("aborted"):
+                target = State.ABORTED
+            elif self.marks.reason == "completed":
+                target = State.DONE
+            else:
+                target = State.FAULT
+            self._go(target, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains)
+            return self._terminal(obs)
+        return Command(p.home_advance, obs.roll, p.fast_speed)
+
+    def _terminal(self, obs: Observation) -> Command:
+        return Command(obs.advance, obs.roll, 0.0, torque=self.state is State.DONE)
+
+
+_HANDLERS: dict[State, Callable[[IndentationMachine, Observation], Command]] = {
+    State.HOMING: IndentationMachine._homing,
+    State.POSITIONING: IndentationMachine._positioning,
+    State.APPROACH: IndentationMachine._approach,
+    State.CONTACT: IndentationMachine._contact,
+    State.INDENTING: IndentationMachine._indenting,
+    State.BUCKLED: IndentationMachine._buckled,
+    State.RETRACTING: IndentationMachine._retracting,
+    State.DONE: IndentationMachine._terminal,
+    State.FAULT: IndentationMachine._terminal,
+    State.ABORTED: IndentationMachine._terminal,
+}

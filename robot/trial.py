@@ -1,0 +1,168 @@
+"""One indentation trial: the control loop that joins a rig, the state machine and the log.
+
+The loop is the same on the bench, on the emulators over ptys and on the in-process fast path;
+only the :class:`Rig` differs. Each control tick: read the rig (encoders, strains, contact event,
+stream and servo health), step the :class:`~robot.indentation.IndentationMachine`, send its
+command, log the tick, let one tick of time pass on the clock. Every record is flushed as it is
+written, so a crash keeps the trial up to the crash.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any, Protocol
+
+from robot.indentation import (
+    BucklingDetector,
+    Command,
+    Guards,
+    IndentationMachine,
+    Observation,
+    State,
+    Transition,
+    TrialMarks,
+    TrialPlan,
+)
+from robot.triallog import TrialLogWriter
+from sensor.clock import Clock
+
+
+class Rig(Protocol):
+    """What a trial needs from the hardware (or its emulation)."""
+
+    def observe(self, t: float) -> Observation:
+        """Read encoders and the newest strains; never raises on a servo or stream fault
+        (it reports them in the observation)."""
+        ...
+
+    def command(self, cmd: Command) -> None:
+        """Send goals (advance, roll) with a speed limit; apply the torque flag."""
+        ...
+
+    def recover(self) -> bool:
+        """Try to clear a servo fault (reboot the faulted servo) so the stage can retract."""
+        ...
+
+    def release(self) -> None:
+        """Torque off on every servo. Must not raise."""
+        ...
+
+
+@dataclass
+class TrialResult:
+    state: State
+    reason: str
+    marks: TrialMarks
+    ticks: int
+    duration: float  # simulated or wall seconds on the rig's clock
+    transitions: list[Transition] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return self.state is State.DONE
+
+
+def run_trial(
+    rig: Rig,
+    clock: Clock,
+    plan: TrialPlan,
+    guards: Guards,
+    detector: BucklingDetector,
+    log: TrialLogWriter | None = None,
+    *,
+    tick: float = 2e-3,
+    max_ticks: int = 200_000,
+    on_tick: Callable[[Observation, State], None] | None = None,
+) -> TrialResult:
+    """Run one trial to DONE, FAULT or ABORTED; the rig is left retracted or torque-free."""
+    transitions: list[Transition] = []
+
+    def record_transition(tr: Transition) -> None:
+        transitions.append(tr)
+        if log is not None:
+            log.write(
+                {
+                    "kind": "transition",
+                    "t": tr.t,
+                    "from": tr.source.value,
+                    "to": tr.target.value,
+                    "reason": tr.reason,
+                    "advance": tr.advance,
+                    "strains": list(tr.strains),
+                }
+            )
+
+    machine = IndentationMachine(plan, guards, detector, on_transition=record_transition)
+    t0 = clock.now()
+    ticks = 0
+    recovered = False
+    try:
+        while not machine.finished:
+            if ticks >= max_ticks:
+                machine.abort(clock.now(), f"tick budget of {max_ticks} exhausted")
+                if ticks >= max_ticks + 100_000:
+                    break
+            obs = rig.observe(clock.now())
+            cmd = machine.step(obs)
+            if obs.servo_fault is not None and machine.state is State.RETRACTING and not recovered:
+                # One attempt to clear the fault (reboot) so the sensor can be pulled back; a
+                # fault seen again while retracting ends the trial in FAULT with torque off.
+                recovered = True
+                rig.recover()
+            rig.command(cmd)
+            if log is not None:
+                log.write(_sample_record(obs, machine.state, cmd))
+            if on_tick is not None:
+                on_tick(obs, machine.state)
+            ticks += 1
+            if not machine.finished:
+                clock.sleep(tick)
+    except BaseException as exc:
+        machine.marks.reason = f"crash: {type(exc).__name__}: {exc}"
+        rig.release()
+        if log is not None:
+            log.write(_end_record(State.FAULT, machine.marks, ticks, clock.now() - t0))
+        raise
+    if machine.state is not State.DONE:
+        rig.release()  # torque policy: a trial that did not complete leaves the servos limp
+    return TrialResult(
+        state=machine.state,
+        reason=machine.marks.reason,
+        marks=machine.marks,
+        ticks=ticks,
+        duration=clock.now() - t0,
+        transitions=transitions,
+    )
+
+
+def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, Any]:
+    return {
+        "kind": "sample",
+        "t": obs.t,
+        "state": state.value,
+        "advance": obs.advance,
+        "roll": obs.roll,
+        "strains": list(obs.strains),
+        "contact": obs.contact,
+        "goal": cmd.advance,
+    }
+
+
+def _end_record(state: State, marks: TrialMarks, ticks: int, duration: float) -> dict[str, Any]:
+    m = asdict(marks)
+    m["strains_at_buckling"] = list(marks.strains_at_buckling)
+    return {
+        "kind": "end",
+        "state": state.value,
+        "reason": marks.reason,
+        "marks": m,
+        "ticks": ticks,
+        "duration": duration if math.isfinite(duration) else None,
+    }
+
+
+def end_record(result: TrialResult) -> dict[str, Any]:
+    """The closing record of a trial log."""
+    return _end_record(result.state, result.marks, result.ticks, result.duration)

@@ -1,0 +1,239 @@
+"""The indentation state machine and the trial loop on a scripted one-axis rig.
+
+The rig here is deliberately simple (a stage that moves at the commanded speed, contact at a
+known advance, strains that grow after a known buckling advance) so that each guard can be
+triggered on purpose and its transition checked. End-to-end trials on the simulator are in
+tests/sim/.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+from robot.indentation import (
+    Command,
+    Guards,
+    IndentationMachine,
+    Observation,
+    State,
+    Transition,
+    TrialPlan,
+)
+from robot.trial import end_record, run_trial
+from robot.triallog import TrialLogWriter, read_log
+from sim.clock import VirtualClock
+
+
+@dataclass
+class ThresholdDetector:
+    threshold: float = 50e-6
+
+    def reset(self) -> None:
+        pass
+
+    def update(self, advance: float, strains: tuple[float, ...]) -> bool:
+        return math.sqrt(sum(s * s for s in strains)) > self.threshold
+
+
+@dataclass
+class ScriptedRig:
+    clock: VirtualClock
+    x_contact: float = 10e-3
+    x_buckle: float = 10.3e-3
+    advance: float = 3e-3
+    roll: float = 0.0
+    fault_at: float | None = None  # advance where the servo reports a fault
+    fault_clears: bool = True
+    stream_dies_at: float | None = None
+    strain_gain: float = 0.02  # strain per metre past buckling
+    torque: bool = True
+    commands: list[Command] = field(default_factory=list)
+    _goal: Command | None = None
+    _last: float = 0.0
+    _fault: bool = False
+    released: int = 0
+
+    def observe(self, t: float) -> Observation:
+        dt = t - self._last
+        self._last = t
+        if self._goal is not None and self.torque and not self._fault:
+            step = self._goal.speed * dt
+            self.advance += max(-step, min(step, self._goal.advance - self.advance))
+            self.roll = self._goal.roll
+        if self.fault_at is not None and self.advance >= self.fault_at and not self._fault:
+            self._fault = True
+            self.fault_at = None
+        past = max(0.0, self.advance - self.x_buckle)
+        strains = (self.strain_gain * past, -self.strain_gain * past, 0.5 * self.strain_gain * past)
+        age = 0.0
+        if self.stream_dies_at is not None and self.advance >= self.stream_dies_at:
+            age = 1.0
+        return Observation(
+            t=t,
+            advance=self.advance,
+            roll=self.roll,
+            strains=strains,
+            contact=self.advance >= self.x_contact,
+            stream_age=age,
+            servo_fault="overload" if self._fault else None,
+        )
+
+    def command(self, cmd: Command) -> None:
+        self.commands.append(cmd)
+        self._goal = cmd
+        self.torque = cmd.torque
+
+    def recover(self) -> bool:
+        if self.fault_clears:
+            self._fault = False
+        return self.fault_clears
+
+    def release(self) -> None:
+        self.released += 1
+        self.torque = False
+
+
+def plan(**kw: float) -> TrialPlan:
+    base: dict[str, float] = {"roll": 0.0, "contact_advance": 10e-3, "home_advance": 0.0}
+    base.update(kw)
+    return TrialPlan(**base)
+
+
+def run(rig: ScriptedRig, p: TrialPlan | None = None, guards: Guards | None = None, log=None):  # type: ignore[no-untyped-def]
+    return run_trial(rig, rig.clock, p or plan(), guards or Guards(), ThresholdDetector(), log)
+
+
+def states(transitions: list[Transition]) -> list[str]:
+    return [tr.target.value for tr in transitions]
+
+
+def test_normal_trial_visits_every_state_in_order() -> None:
+    rig = ScriptedRig(VirtualClock())
+    result = run(rig)
+    assert result.state is State.DONE, result.reason
+    assert states(result.transitions) == [
+        "homing", "positioning", "approach", "contact",
+        "indenting", "buckled", "retracting", "done",
+    ]  # fmt: skip
+    assert result.marks.x_contact == pytest.approx(10e-3, abs=2e-6)
+    # the detector fires once the strain norm passes 50 ue: 50e-6 / (0.02 * 1.146) past buckling
+    assert result.marks.x_buckling is not None
+    assert result.marks.x_buckling > rig.x_buckle
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)  # retracted home
+    assert rig.released == 0  # a completed trial keeps torque
+
+
+def test_fiber_strain_guard_stops_and_retracts() -> None:
+    rig = ScriptedRig(VirtualClock(), strain_gain=40.0)  # strain explodes right after buckling
+    result = run(rig, guards=Guards(strain_limit=1e-4))
+    assert result.state is State.FAULT
+    assert "fiber strain" in result.reason
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)
+    assert rig.released == 1
+
+
+def test_travel_past_contact_guard() -> None:
+    rig = ScriptedRig(VirtualClock(), x_buckle=1.0)  # never buckles
+    result = run(rig, guards=Guards(max_travel_past_contact=0.5e-3))
+    assert result.state is State.FAULT
+    assert "travel past contact" in result.reason
+    indent_goals = [c.advance for c in rig.commands if c.speed == TrialPlan.indent_speed]
+    assert indent_goals
+    assert max(indent_goals) <= 10e-3 + 0.5e-3 + 1e-5
+
+
+def test_no_contact_within_window_faults() -> None:
+    rig = ScriptedRig(VirtualClock(), x_contact=1.0)
+    result = run(rig, plan(approach_window=1e-3))
+    assert result.state is State.FAULT
+    assert "no contact" in result.reason
+
+
+def test_unexpected_early_contact_faults() -> None:
+    rig = ScriptedRig(VirtualClock(), x_contact=5e-3)  # the tissue is 5 mm closer than planned
+    result = run(rig)
+    assert result.state is State.FAULT
+    assert "contact" in result.reason
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)
+
+
+def test_stream_loss_during_indentation_faults() -> None:
+    rig = ScriptedRig(VirtualClock(), stream_dies_at=10.1e-3)
+    result = run(rig)
+    assert result.state is State.FAULT
+    assert "FBG stream lost" in result.reason
+
+
+def test_servo_fault_recovers_and_retracts() -> None:
+    rig = ScriptedRig(VirtualClock(), fault_at=10.1e-3)
+    result = run(rig)
+    assert result.state is State.FAULT
+    assert "servo fault" in result.reason
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)  # retracted after the reboot
+    assert rig.released == 1
+
+
+def test_servo_fault_that_does_not_clear_stops_limp() -> None:
+    rig = ScriptedRig(VirtualClock(), fault_at=10.1e-3, fault_clears=False)
+    result = run(rig)
+    assert result.state is State.FAULT
+    assert "while retracting" in result.reason
+    assert rig.released == 1
+    assert rig.torque is False
+
+
+def test_state_timeout() -> None:
+    rig = ScriptedRig(VirtualClock())
+    result = run(rig, plan(approach_speed=1e-6), Guards(state_timeout=5.0))
+    assert result.state is State.FAULT
+    assert "timeout in approach" in result.reason
+
+
+def test_operator_abort_ends_aborted_and_retracted() -> None:
+    clock = VirtualClock()
+    machine = IndentationMachine(plan(), Guards(), ThresholdDetector())
+    obs = Observation(t=0.0, advance=0.0, roll=0.0, strains=(0, 0, 0), contact=False)
+    machine.step(obs)
+    machine.abort(clock.now(), "key pressed")
+    assert machine.state is State.RETRACTING
+    cmd = machine.step(Observation(t=0.1, advance=0.0, roll=0.0, strains=(0, 0, 0), contact=False))
+    assert machine.state is State.ABORTED
+    assert cmd.torque is False
+
+
+def test_machine_runs_one_trial_only() -> None:
+    machine = IndentationMachine(plan(), Guards(), ThresholdDetector())
+    machine.start(0.0)
+    with pytest.raises(RuntimeError, match="one trial"):
+        machine.start(1.0)
+
+
+def test_log_keeps_every_record_and_reads_back(tmp_path: Path) -> None:
+    rig = ScriptedRig(VirtualClock())
+    path = tmp_path / "trial.jsonl"
+    with TrialLogWriter(path, {"trial": "t1"}) as log:
+        result = run(rig, log=log)
+        log.write(end_record(result))
+    back = read_log(path)
+    assert back.complete
+    assert back.header["trial"] == "t1"
+    assert sum(1 for _ in back.of_kind("sample")) == result.ticks
+    assert [r["to"] for r in back.of_kind("transition")] == states(result.transitions)
+    assert back.end is not None
+    assert back.end["marks"]["x_contact"] == result.marks.x_contact
+
+
+def test_truncated_log_is_reported(tmp_path: Path) -> None:
+    path = tmp_path / "trial.jsonl"
+    with TrialLogWriter(path, {"trial": "t2"}) as log:
+        log.write({"kind": "sample", "t": 0.0})
+    with path.open("a", encoding="utf-8") as fh:
+        fh.write('{"kind": "sam')  # torn line, as after a kill
+    back = read_log(path)
+    assert not back.complete
+    assert back.bad_lines == 1
+    assert len(back.records) == 1
