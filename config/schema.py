@@ -7,6 +7,7 @@ a property without the suffix (``fiber_radius`` in m). Defaults are the paper's 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -129,31 +130,55 @@ class BoardConfig:
 
 @dataclass(frozen=True)
 class ServoConfig:
+    """One Dynamixel servo: its bus ID and model (checked against the model number on connect)."""
+
     id: int = field(default=1, metadata=limits(ge=0, le=252))
     model: Literal["XM430-W350", "XL430-W250"] = "XM430-W350"
 
 
 @dataclass(frozen=True)
 class ServoBusConfig:
-    """The Dynamixel bus: port, baud rate, and the three servos of the roller-gear drive."""
+    """The Dynamixel bus: port, baud rate, and the three servos of the roller-gear drive.
+
+    ``timeout_ms`` is how long the driver waits for a status packet beyond its transmission time;
+    a transaction that fails on the wire is retried ``retries`` times. ``max_goal_step_deg`` is
+    the safety clamp on how far a servo's goal may move in one control tick (shaft degrees).
+    """
 
     port: str = "sim"
     baudrate: int = field(default=1000000, metadata=limits(gt=0))
     timeout_ms: float = field(default=20.0, metadata=limits(gt=0, le=10000))
     retries: int = field(default=3, metadata=limits(ge=0, le=20))
+    max_goal_step_deg: float = field(default=10.0, metadata=limits(gt=0, le=360))
     outer_roll: ServoConfig = ServoConfig(id=1)
     inner_roll: ServoConfig = ServoConfig(id=2)
-    translation: ServoConfig = ServoConfig(id=3)
+    translation: ServoConfig = ServoConfig(id=3, model="XL430-W250")
 
     def validate(self) -> None:
         ids = [self.outer_roll.id, self.inner_roll.id, self.translation.id]
         if len(set(ids)) != len(ids):
             raise ValueError(f"servo ids must differ, got {ids}")
 
+    @property
+    def timeout(self) -> float:
+        return self.timeout_ms * 1e-3
+
+    @property
+    def max_goal_step(self) -> float:
+        """Largest change of a servo goal per control tick, rad of servo shaft."""
+        return math.radians(self.max_goal_step_deg)
+
 
 @dataclass(frozen=True)
 class DriveConfig:
-    """Dual roller-gear drive: joint space <-> servo shaft angles."""
+    """Dual roller-gear drive: joint space (roll phi, stage translation) <-> servo shaft angles.
+
+    Servo shaft angles: outer = outer_roll_ratio * phi, inner = inner_roll_ratio * phi (the inner
+    roll is slaved to the outer one so the sensor does not twist), translation servo =
+    2 pi / lead * (translation - coupling * phi). ``coupling_mm_per_rad`` is the translation a
+    roll produces by itself (0 for an ideal roller gear). ``home_*`` is the pose the drive is in
+    when it is homed (software homing: present shaft angles are taken as this pose).
+    """
 
     outer_roll_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1000))
     inner_roll_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1000))
@@ -165,12 +190,20 @@ class DriveConfig:
     roll_max_deg: float = field(default=200.0, metadata=limits(ge=-3600, le=3600))
     max_speed_mm_per_s: float = field(default=5.0, metadata=limits(gt=0, le=1000))
     max_roll_speed_deg_per_s: float = field(default=90.0, metadata=limits(gt=0, le=10000))
+    max_accel_mm_per_s2: float = field(default=50.0, metadata=limits(gt=0, le=100000))
+    max_roll_accel_deg_per_s2: float = field(default=360.0, metadata=limits(gt=0, le=1000000))
+    home_translation_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
+    home_roll_deg: float = field(default=0.0, metadata=limits(ge=-3600, le=3600))
 
     def validate(self) -> None:
         if self.translation_min_mm >= self.translation_max_mm:
             raise ValueError("translation_min_mm must be below translation_max_mm")
         if self.roll_min_deg >= self.roll_max_deg:
             raise ValueError("roll_min_deg must be below roll_max_deg")
+        if not self.translation_min_mm <= self.home_translation_mm <= self.translation_max_mm:
+            raise ValueError("home_translation_mm must lie within the translation limits")
+        if not self.roll_min_deg <= self.home_roll_deg <= self.roll_max_deg:
+            raise ValueError("home_roll_deg must lie within the roll limits")
 
     @property
     def lead(self) -> float:
@@ -179,22 +212,76 @@ class DriveConfig:
 
     @property
     def coupling(self) -> float:
+        """Translation per rad of roll, m/rad."""
         return self.coupling_mm_per_rad * MM
+
+    @property
+    def translation_limits(self) -> tuple[float, float]:
+        return self.translation_min_mm * MM, self.translation_max_mm * MM
+
+    @property
+    def roll_limits(self) -> tuple[float, float]:
+        return math.radians(self.roll_min_deg), math.radians(self.roll_max_deg)
+
+    @property
+    def max_speed(self) -> float:
+        return self.max_speed_mm_per_s * MM
+
+    @property
+    def max_roll_speed(self) -> float:
+        return math.radians(self.max_roll_speed_deg_per_s)
+
+    @property
+    def max_accel(self) -> float:
+        return self.max_accel_mm_per_s2 * MM
+
+    @property
+    def max_roll_accel(self) -> float:
+        return math.radians(self.max_roll_accel_deg_per_s2)
+
+    @property
+    def home_translation(self) -> float:
+        return self.home_translation_mm * MM
+
+    @property
+    def home_roll(self) -> float:
+        return math.radians(self.home_roll_deg)
 
 
 @dataclass(frozen=True)
 class TubeConfig:
-    """A 3D-printed tube: straight part, then a constant-curvature arc turning by tip_angle_deg."""
+    """A 3D-printed tube: straight part, then a constant-curvature arc turning by tip_angle_deg.
+
+    ``flush_translation_mm`` is the stage translation at which the centre of the sensor's tip
+    sphere is at the tube tip (exposed length L = 0); L = translation - flush translation.
+    """
 
     name: str
     tip_angle_deg: float = field(default=0.0, metadata=limits(ge=0, le=180))
     straight_length_mm: float = field(default=40.0, metadata=limits(ge=0, le=1000))
     arc_length_mm: float = field(default=40.0, metadata=limits(ge=0, le=1000))
     tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
+    flush_translation_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
 
     def validate(self) -> None:
         if self.tip_angle_deg > 0 and self.arc_length_mm <= 0:
             raise ValueError(f"tube {self.name!r}: a bent tube needs arc_length_mm > 0")
+
+    @property
+    def tip_angle(self) -> float:
+        return math.radians(self.tip_angle_deg)
+
+    @property
+    def straight_length(self) -> float:
+        return self.straight_length_mm * MM
+
+    @property
+    def arc_length(self) -> float:
+        return self.arc_length_mm * MM
+
+    @property
+    def flush_translation(self) -> float:
+        return self.flush_translation_mm * MM
 
 
 DEFAULT_TUBES: tuple[TubeConfig, ...] = (

@@ -14,7 +14,11 @@ from config.loader import ConfigError
 
 # Subcommand name -> module in palpate.commands exposing ``register(parser)`` and ``run(args)``.
 COMMANDS: dict[str, str] = {
+    "sim": "palpate.commands.sim",
     "bench": "palpate.commands.bench",
+    "replay": "palpate.commands.replay",
+    "emulate": "palpate.commands.emulate",
+    "calibrate": "palpate.commands.calibrate",
 }
 
 EXIT_OK = 0

@@ -100,11 +100,14 @@ class Transition:
 
 
 class BucklingDetector(Protocol):
-    """Anything that decides from strains (and stage advance) that the beam has buckled."""
+    """Anything that decides from the grating strains that the beam has buckled
+    (``sensor.detect.NormThreshold`` and ``sensor.detect.CusumDetector`` satisfy it)."""
 
     def reset(self) -> None: ...
 
-    def update(self, advance: float, strains: tuple[float, ...]) -> bool: ...
+    def update(self, strains: tuple[float, ...]) -> bool:
+        """Feed one sample of grating strains; True once buckling is detected."""
+        ...
 
 
 @dataclass
@@ -269,7 +272,7 @@ class IndentationMachine:
         return Command(goal, self.plan.roll, self.plan.indent_speed)
 
     def _indenting(self, obs: Observation) -> Command:
-        if self.detector.update(obs.advance, obs.strains):
+        if self.detector.update(obs.strains):
             self.marks.x_buckling = obs.advance
             self.marks.t_buckling = obs.t
             self.marks.strains_at_buckling = obs.strains

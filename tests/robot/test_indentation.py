@@ -35,7 +35,7 @@ class ThresholdDetector:
     def reset(self) -> None:
         pass
 
-    def update(self, advance: float, strains: tuple[float, ...]) -> bool:
+    def update(self, strains: tuple[float, ...]) -> bool:
         return math.sqrt(sum(s * s for s in strains)) > self.threshold
 
 

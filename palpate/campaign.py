@@ -1,0 +1,157 @@
+"""Campaigns: the list of trials a scene asks for, running them, and Tables I/II from them."""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import Executor, ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
+from config.schema import StackConfig
+from estimation.stiffness import SampleSummary, summarize
+from palpate.simtrial import TrialOutcome, TrialSpec, Transport, run_sim_trial
+
+
+def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> list[TrialSpec]:
+    """Trials in a fixed order; each gets its own seed derived from ``seed`` and its index."""
+    c = scene.campaign
+    specs: list[TrialSpec] = []
+
+    def add(sample_name: str, tube: str, orientation: str, length_mm: float, rep: int) -> None:
+        s = next(x for x in scene.samples if x.name == sample_name)
+        parts = [sample_name, tube, orientation, f"L{length_mm:g}"]
+        if c.repeats > 1:
+            parts.append(f"r{rep}")
+        specs.append(
+            TrialSpec(
+                trial_id="-".join(parts),
+                kind=c.kind,
+                sample=s.name,
+                modulus=s.modulus,
+                poisson=s.poisson,
+                tube=tube,
+                orientation=orientation,
+                roll=math.radians(ORIENTATION_ROLL_DEG[orientation]),
+                exposed_length=length_mm * 1e-3,
+                seed=seed * 1_000_003 + len(specs),
+            )
+        )
+
+    for sample in scene.campaign_samples():
+        for rep in range(c.repeats):
+            if c.kind == "bench":
+                for length_mm in c.exposed_lengths_mm:
+                    add(sample.name, "straight", "downward", length_mm, rep)
+                continue
+            for tube_name in c.tubes:
+                tube = stack.tube(tube_name)
+                # rolling a straight tube does not change where it points: one trial
+                orientations = c.orientations[:1] if tube.tip_angle_deg == 0 else c.orientations
+                for orientation in orientations:
+                    add(sample.name, tube_name, orientation, c.exposed_length_mm, rep)
+    return specs
+
+
+@dataclass(frozen=True)
+class _Job:
+    spec: TrialSpec
+    scene: SceneConfig
+    stack: StackConfig
+    transport: Transport
+    log_dir: Path | None
+    keep_series: bool
+
+
+def _run_job(job: _Job) -> TrialOutcome:
+    return run_sim_trial(
+        job.spec,
+        job.scene,
+        job.stack,
+        transport=job.transport,
+        log_dir=job.log_dir,
+        keep_series=job.keep_series,
+    )
+
+
+def run_campaign(
+    specs: Sequence[TrialSpec],
+    scene: SceneConfig,
+    stack: StackConfig,
+    *,
+    transport: Transport = "fast",
+    log_dir: Path | None = None,
+    workers: int = 1,
+    executor: Executor | None = None,
+    series_for: str | None = None,
+    progress: Callable[[TrialOutcome], None] | None = None,
+) -> list[TrialOutcome]:
+    """Run trials (in parallel with ``workers`` > 1 or a given executor); results keep the order
+    of ``specs`` and do not depend on the executor (every trial is seeded by its spec)."""
+    jobs = [
+        _Job(s, scene, stack, transport, log_dir, s.trial_id == series_for) for s in specs
+    ]
+    own: Executor | None = None
+    if executor is None and workers > 1:
+        own = executor = ProcessPoolExecutor(max_workers=workers)
+    try:
+        if executor is None:
+            results = []
+            for job in jobs:
+                out = _run_job(job)
+                results.append(out)
+                if progress is not None:
+                    progress(out)
+            return results
+        futures = [executor.submit(_run_job, job) for job in jobs]
+        results = []
+        for fut in futures:
+            out = fut.result()
+            results.append(out)
+            if progress is not None:
+                progress(out)
+        return results
+    finally:
+        if own is not None:
+            own.shutdown()
+
+
+def default_workers() -> int:
+    return max(1, min(2, os.cpu_count() or 1))
+
+
+@dataclass(frozen=True)
+class SampleRow:
+    sample: str
+    summary: SampleSummary
+    trials: int
+
+
+def summarize_campaign(
+    outcomes: Iterable[TrialOutcome], outlier_above: float
+) -> list[SampleRow]:
+    """Per sample: mean, RMSE, IQR and relative error of the estimates (Tables I/II)."""
+    by_sample: dict[str, list[TrialOutcome]] = {}
+    for o in outcomes:
+        by_sample.setdefault(o.spec.sample, []).append(o)
+    rows = []
+    for name, outs in by_sample.items():
+        estimates = [o.estimate for o in outs]
+        rows.append(
+            SampleRow(name, summarize(estimates, outs[0].spec.modulus, outlier_above), len(outs))
+        )
+    return rows
+
+
+def median_abs_relative_error(outcomes: Iterable[TrialOutcome]) -> float | None:
+    errs = sorted(
+        abs(o.estimate.modulus - o.spec.modulus) / o.spec.modulus
+        for o in outcomes
+        if o.estimate is not None and o.estimate.modulus is not None
+    )
+    if not errs:
+        return None
+    mid = len(errs) // 2
+    return errs[mid] if len(errs) % 2 else 0.5 * (errs[mid - 1] + errs[mid])

@@ -1,0 +1,102 @@
+"""Re-run the estimation on a recorded trial log and compare with what the trial reported."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from config.loader import from_mapping
+from config.schema import SensorConfig, StackConfig, TubeConfig
+from estimation.section import Section
+from palpate.simtrial import estimate_from_marks
+from robot.triallog import TrialLogError, read_log
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", type=Path, help="a trial log (.jsonl) written by palpate sim/trial")
+
+
+def replay(path: Path) -> dict[str, Any]:
+    """Recompute the estimate from a log; raises TrialLogError (a ValueError) if unreadable."""
+    log = read_log(path)
+    h = log.header
+    report: dict[str, Any] = {
+        "log": str(path),
+        "trial": h.get("trial"),
+        "complete": log.complete,
+        "bad_lines": log.bad_lines,
+        "records": len(log.records),
+    }
+    end = log.end
+    if end is None:
+        transitions = list(log.of_kind("transition"))
+        last = transitions[-1]["to"] if transitions else "none"
+        report["message"] = (
+            f"truncated log: no end record ({len(log.records)} records kept, last state {last}); "
+            "no estimate can be reproduced"
+        )
+        return report
+    sensor = from_mapping(SensorConfig, _tuples(h["sensor"]), str(path), "sensor")
+    section = Section(**h["section"])
+    spec = h["spec"]
+    marks = end["marks"]
+    x_b = marks.get("x_buckling")
+    length: float | None = None
+    if x_b is not None:
+        if spec["kind"] == "bench":
+            length = spec["exposed_length"]
+        else:
+            tube = from_mapping(TubeConfig, h["tube"], str(path), "tube")
+            length = x_b - tube.flush_translation
+    stack = StackConfig(sensor=sensor)
+    est = estimate_from_marks(
+        marks.get("x_contact"),
+        x_b,
+        tuple(marks.get("strains_at_buckling") or ()),
+        length,
+        stack,
+        section,
+        h["poisson"],
+    )
+    recorded = next(log.of_kind("estimate"), None)
+    modulus = None if est is None else est.modulus
+    report.update(
+        {
+            "state": end["state"],
+            "reason": end["reason"],
+            "modulus": modulus,
+            "recorded_modulus": None if recorded is None else recorded.get("modulus"),
+        }
+    )
+    rec = report["recorded_modulus"]
+    report["identical"] = (modulus is None and rec is None) or (
+        modulus is not None and rec is not None and math.isclose(modulus, rec, rel_tol=0, abs_tol=0)
+    )
+    return report
+
+
+def _tuples(d: dict[str, Any]) -> dict[str, Any]:
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        report = replay(args.log)
+    except TrialLogError as exc:
+        raise ValueError(str(exc)) from None
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        print(f"trial {report['trial']} ({report['log']})")
+        if "message" in report:
+            print(report["message"])
+            return 1
+        m, r = report["modulus"], report["recorded_modulus"]
+        print(f"final state: {report['state']} ({report['reason']})")
+        print(f"replayed estimate: {'-' if m is None else f'{m / 1e3:.3f} kPa'}")
+        print(f"recorded estimate: {'-' if r is None else f'{r / 1e3:.3f} kPa'}")
+        print("identical" if report["identical"] else "DIFFERENT")
+    return 0 if report.get("identical") else 1

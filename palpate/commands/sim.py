@@ -1,0 +1,146 @@
+"""Run a simulated campaign (the paper's robot or bench-top experiment): no hardware needed."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from tqdm import tqdm
+
+from config import load, load_stack, resolve
+from config.scene import SceneConfig
+from palpate.campaign import (
+    campaign_trials,
+    default_workers,
+    median_abs_relative_error,
+    run_campaign,
+    summarize_campaign,
+)
+from palpate.simtrial import TrialOutcome
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--campaign", choices=["robot", "bench"], default="robot", help="a shipped scene"
+    )
+    parser.add_argument("--scene", type=Path, help="a scene YAML (overrides --campaign)")
+    parser.add_argument("--seed", type=int, default=0, help="makes the run reproducible")
+    parser.add_argument("--out", type=Path, default=Path("out/sim"), help="logs and plots")
+    parser.add_argument("--workers", type=int, default=default_workers())
+    parser.add_argument(
+        "--wire", action="store_true", help="servos and board over ptys (the hardware path)"
+    )
+    parser.add_argument("--limit", type=int, help="run only the first N trials")
+    parser.add_argument("--no-plots", action="store_true")
+
+
+def run(args: argparse.Namespace) -> int:
+    scene_path = args.scene if args.scene else resolve(f"scenes/{args.campaign}.yaml")
+    scene = load(SceneConfig, scene_path)
+    stack = load_stack(resolve(scene.robot))
+    specs = campaign_trials(scene, stack, args.seed)
+    if args.limit:
+        specs = specs[: args.limit]
+    if not specs:
+        raise ValueError(f"{scene_path}: the campaign has no trials")
+    out_dir: Path = args.out / scene.name
+    log_dir = out_dir / "logs"
+    log_dir.mkdir(parents=True, exist_ok=True)
+    for old in log_dir.glob("*.jsonl"):
+        old.unlink()
+    transport = "wire" if args.wire else scene.transport
+    bar = tqdm(total=len(specs), desc=f"{scene.name} campaign", unit="trial", file=sys.stderr)
+
+    def progress(o: TrialOutcome) -> None:
+        bar.update(1)
+        bar.set_postfix_str(o.spec.trial_id)
+
+    t0 = time.perf_counter()
+    outcomes = run_campaign(
+        specs,
+        scene,
+        stack,
+        transport=transport,
+        log_dir=log_dir,
+        workers=max(1, args.workers),
+        series_for=specs[0].trial_id,
+        progress=progress,
+    )
+    wall = time.perf_counter() - t0
+    bar.close()
+    rows = summarize_campaign(outcomes, scene.campaign.outlier_above_kpa * 1e3)
+    sim_time = sum(o.sim_time for o in outcomes)
+    mare = median_abs_relative_error(outcomes)
+    failed = [o for o in outcomes if o.state != "done"]
+    figures: list[str] = []
+    if not args.no_plots:
+        from palpate import plots
+
+        title = f"{scene.name} campaign: estimated vs actual modulus"
+        figures.append(
+            str(plots.estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))
+        )
+        if outcomes[0].series.get("advance"):
+            figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
+    if args.json:
+        payload = {
+            "scene": scene.name,
+            "transport": transport,
+            "seed": args.seed,
+            "trials": [o.as_dict() for o in outcomes],
+            "samples": [
+                {"sample": r.sample, "trials": r.trials, **_kpa(r.summary.__dict__)} for r in rows
+            ],
+            "median_abs_relative_error": mare,
+            "wall_s": wall,
+            "simulated_s": sim_time,
+            "speedup": sim_time / wall if wall > 0 else None,
+            "figures": figures,
+        }
+        print(json.dumps(payload, indent=2))
+    else:
+        _print_table(scene.name, rows)
+        print()
+        if mare is not None:
+            print(f"median |relative error| over trials: {100 * mare:.1f} %")
+        print(
+            f"{len(outcomes)} trials ({transport} path, {args.workers} worker(s)) in {wall:.1f} s "
+            f"wall for {sim_time:.1f} s simulated: {sim_time / wall:.1f}x real time"
+        )
+        for o in failed:
+            print(f"  trial {o.spec.trial_id}: {o.state}: {o.reason}")
+        print(f"logs: {log_dir}")
+        for f in figures:
+            print(f"plot: {f}")
+    return 1 if len(failed) == len(outcomes) else 0
+
+
+def _kpa(d: dict[str, object]) -> dict[str, object]:
+    out: dict[str, object] = {}
+    for k, v in d.items():
+        if k in ("actual", "mean", "median", "rmse", "iqr") and isinstance(v, float):
+            out[f"{k}_kpa"] = v / 1e3
+        else:
+            out[k] = v
+    return out
+
+
+def _print_table(name: str, rows: list) -> None:  # type: ignore[type-arg]
+    print(f"{name} campaign: estimated vs actual Young's modulus (kPa), outliers > 3 MPa removed")
+    head = f"{'sample':>8} {'trials':>6} {'estimated':>10} {'actual':>9} {'RMSE':>9} {'IQR':>9} {'rel.err':>8}"
+    print(head)
+    print("-" * len(head))
+    for r in rows:
+        s = r.summary
+
+        def k(v: float | None) -> str:
+            return "-" if v is None else f"{v / 1e3:.2f}"
+
+        rel = "-" if s.relative_error is None else f"{100 * s.relative_error:+.1f}%"
+        print(
+            f"{r.sample:>8} {r.trials:>6} {k(s.mean):>10} {k(s.actual):>9} {k(s.rmse):>9} "
+            f"{k(s.iqr):>9} {rel:>8}"
+        )

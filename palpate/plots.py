@@ -1,0 +1,72 @@
+"""PNG figures like the paper's: estimates vs ground truth, force and strains vs advance."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from palpate.campaign import SampleRow  # noqa: E402
+from palpate.simtrial import TrialOutcome  # noqa: E402
+
+
+def estimates_vs_truth(
+    outcomes: Sequence[TrialOutcome], rows: Sequence[SampleRow], path: Path, title: str
+) -> Path:
+    """Every trial's estimate (dots) and each sample's mean (bar) against the actual modulus."""
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    names = [r.sample for r in rows]
+    x = {n: i for i, n in enumerate(names)}
+    ax.bar(
+        [x[r.sample] - 0.2 for r in rows],
+        [r.summary.actual / 1e3 for r in rows],
+        width=0.4,
+        label="actual",
+        color="0.75",
+    )
+    ax.bar(
+        [x[r.sample] + 0.2 for r in rows],
+        [(r.summary.mean or 0.0) / 1e3 for r in rows],
+        width=0.4,
+        label="estimated (mean)",
+        color="tab:blue",
+    )
+    for o in outcomes:
+        if o.estimate is not None and o.estimate.modulus is not None:
+            ax.plot(x[o.spec.sample] + 0.2, o.estimate.modulus / 1e3, "k.", ms=4)
+    ax.set_xticks(range(len(names)), names)
+    ax.set_ylabel("Young's modulus (kPa)")
+    ax.set_title(title)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def trial_traces(outcome: TrialOutcome, path: Path) -> Path:
+    """Force and grating strains against stage advance for one trial (as Fig. 4b,c)."""
+    s = outcome.series
+    adv = [a * 1e3 for a in s["advance"]]
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    ax1.plot(adv, s["force"], color="tab:red")
+    ax1.set_ylabel("axial force P (N)")
+    for key in ("s1", "s2", "s3"):
+        if s.get(key):
+            ax2.plot(adv[: len(s[key])], [v * 1e6 for v in s[key]], label=f"grating {key[1]}")
+    est = outcome.estimate
+    if est is not None and est.success:
+        for ax in (ax1, ax2):
+            ax.axvline(adv[0], color="0.8")
+    ax2.set_ylabel("grating strain (ue)")
+    ax2.set_xlabel("stage advance (mm)")
+    ax2.legend()
+    ax1.set_title(f"trial {outcome.spec.trial_id}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -1,0 +1,421 @@
+"""One simulated trial, wired exactly like the bench: emulators in, control stack on top.
+
+The world (``sim.world``) feeds the servo emulator and the board emulator on one virtual clock;
+the control stack drives the servos through dynamixel-sdk and reads FBG frames through the frame
+reader, then the paper's estimator runs on the trial's marks. ``transport="wire"`` puts both
+emulators on pseudo-terminals; ``"fast"`` keeps the same SDK, driver, reader and parser and only
+replaces the ptys by in-process transports (``sim.inprocess``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from config.scene import SceneConfig
+from config.schema import StackConfig
+from estimation.beam import Beam
+from estimation.section import Section, composite_section
+from estimation.stiffness import StiffnessEstimate, paper_estimate
+from robot import kinematics
+from robot.drive import TRANSLATION, DriveController, RollerGearDrive
+from robot.dynamixel.driver import DynamixelBus
+from robot.dynamixel.tables import TICKS_PER_REV
+from robot.dynamixel.units import rad_from_ticks
+from robot.indentation import Guards, State, TrialPlan
+from robot.rig import RigSettings, ServoFbgRig
+from robot.trial import TrialResult, end_record, run_trial
+from robot.triallog import TrialLogWriter
+from sensor.detect import CusumDetector, NormThreshold
+from sensor.reader import FrameReader, layout_from_config
+from sensor.strain import StrainChain, grating_intervals, strain_noise
+from sim.board import BoardEmulator
+from sim.clock import VirtualClock
+from sim.dynamixel.bus import EmulatedBus
+from sim.inprocess import InProcessPort, MemorySerial
+from sim.tissue import TissueModel
+from sim.world import Surface, World
+
+Transport = Literal["fast", "wire"]
+BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
+VERTICAL = np.array([0.0, 0.0, -1.0])
+
+
+@dataclass(frozen=True)
+class TrialSpec:
+    """One trial of a campaign."""
+
+    trial_id: str
+    kind: Literal["bench", "robot"]
+    sample: str
+    modulus: float  # Pa, the ground truth
+    poisson: float
+    tube: str
+    orientation: str
+    roll: float  # rad
+    exposed_length: float  # m at contact
+    seed: int
+
+
+@dataclass
+class TrialOutcome:
+    spec: TrialSpec
+    state: str
+    reason: str
+    estimate: StiffnessEstimate | None
+    exposed_length_at_buckling: float | None
+    ik_residual: float
+    ticks: int
+    sim_time: float
+    log_path: str | None
+    series: dict[str, list[float]] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        est = self.estimate
+        return {
+            "trial": self.spec.trial_id,
+            "sample": self.spec.sample,
+            "tube": self.spec.tube,
+            "orientation": self.spec.orientation,
+            "exposed_length_mm": self.spec.exposed_length * 1e3,
+            "actual_kpa": self.spec.modulus / 1e3,
+            "estimated_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
+            "delta_mm": None if est is None else est.delta * 1e3,
+            "force_n": None if est is None else est.force,
+            "state": self.state,
+            "reason": self.reason,
+            "ik_residual_deg": math.degrees(self.ik_residual),
+            "sim_time_s": self.sim_time,
+            "log": self.log_path,
+        }
+
+
+def sensor_section(stack: StackConfig) -> Section:
+    s = stack.sensor
+    return composite_section(
+        s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
+    )
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    plan_roll: float
+    contact_translation: float
+    surface: Surface
+    residual: float
+    tube: str
+
+
+def _robot_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
+    """Place the sample where the campaign wants it, then let the IK find the way back to it."""
+    tube = stack.tube(spec.tube)
+    nominal = kinematics.forward(tube, spec.roll, tube.flush_translation + spec.exposed_length)
+    r_tip = stack.sensor.tip_radius
+    target = nominal.sensor_tip + r_tip * nominal.tangent
+    normal = -nominal.tangent
+    ik = kinematics.inverse(
+        stack.tubes,
+        target,
+        normal,
+        tip_radius=r_tip,
+        translation_limits=stack.drive.translation_limits,
+        roll_limits=stack.drive.roll_limits,
+    )
+    if not ik.reachable:
+        raise ValueError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
+    surface = Surface(point=target, normal=normal)
+    return _Geometry(ik.roll, ik.advance, surface, ik.residual, ik.tube)
+
+
+def _bench_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
+    depth = BENCH_CONTACT_TRANSLATION + spec.exposed_length + stack.sensor.tip_radius
+    surface = Surface(point=depth * VERTICAL, normal=-VERTICAL)
+    return _Geometry(0.0, BENCH_CONTACT_TRANSLATION, surface, 0.0, "bench-stage")
+
+
+def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
+    if spec.kind == "bench":
+        length = spec.exposed_length
+
+        def bench_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
+            return translation * VERTICAL, VERTICAL, length
+
+        return bench_pose
+    tube = stack.tube(tube_name)
+
+    def robot_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
+        p = kinematics.forward(tube, roll, translation)
+        return p.tube_tip, p.tangent, p.exposed_length
+
+    return robot_pose
+
+
+def _detector(scene: SceneConfig, stack: StackConfig) -> NormThreshold | CusumDetector:
+    c = scene.campaign
+    if c.detector == "paper":
+        return NormThreshold(c.detector_threshold_ue * 1e-6)
+    sigma = max(
+        strain_noise(scene.fidelity.fbg_noise_pm, stack.fbg.strain_coefficient_pm_per_ue), 1e-7
+    )
+    return CusumDetector(sigma=sigma)
+
+
+@contextlib.contextmanager
+def _emulators(
+    transport: Transport, stack: StackConfig, clock: VirtualClock, world_source: Any
+) -> Iterator[tuple[EmulatedBus, BoardEmulator, Any, Any]]:
+    bus = EmulatedBus.from_config(stack.servos, clock=clock)
+    layout = layout_from_config(stack.sensor, stack.board)
+    if transport == "wire":
+        board = BoardEmulator(world_source, layout, rate_hz=stack.board.rate_hz, clock=clock)
+        port = bus.open()
+        try:
+            yield bus, board, port, board.port
+        finally:
+            board.stop()
+            bus.close()
+    else:
+        pipe = MemorySerial()
+        board = BoardEmulator(
+            world_source, layout, rate_hz=stack.board.rate_hz, clock=clock, sink=pipe
+        )
+        try:
+            yield bus, board, InProcessPort(bus), pipe
+        finally:
+            board.stop()
+
+
+def run_sim_trial(
+    spec: TrialSpec,
+    scene: SceneConfig,
+    stack: StackConfig,
+    *,
+    transport: Transport = "fast",
+    log_dir: Path | None = None,
+    keep_series: bool = False,
+) -> TrialOutcome:
+    """Run one simulated trial end to end and estimate the modulus from it."""
+    c = scene.campaign
+    geo = _bench_geometry(stack, spec) if spec.kind == "bench" else _robot_geometry(stack, spec)
+    retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
+    drive_cfg = dataclasses.replace(
+        stack.drive, home_translation_mm=retract * 1e3, home_roll_deg=math.degrees(geo.plan_roll)
+    )
+    stack = dataclasses.replace(stack, drive=drive_cfg)
+    section = sensor_section(stack)
+    sample = next(s for s in scene.samples if s.name == spec.sample)
+    fid = scene.fidelity
+    tissue = TissueModel(
+        modulus=sample.modulus,
+        poisson=sample.poisson,
+        thickness=sample.thickness if (sample.thickness and fid.finite_thickness) else math.inf,
+        bonded=sample.bonded,
+        tip_radius=stack.sensor.tip_radius,
+        finite_thickness=fid.finite_thickness,
+        large_indentation=fid.large_indentation,
+    )
+    rng = np.random.default_rng(spec.seed)
+    clock = VirtualClock()
+    truth = RollerGearDrive(drive_cfg)  # the servos power up at the home pose (0 ticks)
+    pose = _pose_fn(stack, spec, geo.tube)
+    servo_ids = {
+        "outer_roll": stack.servos.outer_roll.id,
+        "inner_roll": stack.servos.inner_roll.id,
+        TRANSLATION: stack.servos.translation.id,
+    }
+    holder: dict[str, EmulatedBus] = {}
+
+    def joints() -> tuple[float, float, int]:
+        bus = holder["bus"]
+        ticks = {n: bus.servo(i).position_ticks for n, i in servo_ids.items()}
+        q = truth.joints({n: rad_from_ticks(t) for n, t in ticks.items()})
+        return q.roll, q.translation, ticks[TRANSLATION]
+
+    world = World(
+        section=section,
+        sensor=stack.sensor,
+        fbg=stack.fbg,
+        fidelity=fid,
+        tissue=tissue,
+        surface=geo.surface,
+        pose=pose,
+        joints=joints,
+        rng=rng,
+        has_force=stack.board.has_force,
+        length_grows=spec.kind == "robot",
+    )
+    tick = 1.0 / scene.control_rate_hz
+    plan = TrialPlan(
+        roll=geo.plan_roll,
+        contact_advance=geo.contact_translation,
+        home_advance=retract,
+        standoff=c.standoff_mm * 1e-3,
+        post_buckling_travel=c.post_buckling_mm * 1e-3,
+        approach_speed=c.approach_speed_mm_per_s * 1e-3,
+        indent_speed=c.indent_speed_mm_per_s * 1e-3,
+        fast_speed=stack.drive.max_speed,
+        position_tolerance=1.5 * stack.drive.lead / TICKS_PER_REV,  # the encoder's resolution
+    )
+    guards = Guards(
+        max_travel_past_contact=c.max_travel_past_contact_mm * 1e-3,
+        strain_limit=stack.fbg.strain_limit,
+        stream_timeout=max(stack.board.stale_timeout_s, 5 * tick),
+    )
+    log: TrialLogWriter | None = None
+    log_path: str | None = None
+    series: dict[str, list[float]] = {"advance": [], "force": [], "s1": [], "s2": [], "s3": []}
+    with _emulators(
+        scene.transport if transport is None else transport, stack, clock, world.sample
+    ) as (
+        bus,
+        board,
+        servo_port,
+        board_port,
+    ):
+        holder["bus"] = bus
+        driver = DynamixelBus.from_config(stack.servos, port=servo_port)
+        reader = FrameReader.from_config(board_port, stack.sensor, stack.board, clock=clock)
+        settings = RigSettings(
+            tick=tick,
+            contact=c.contact,
+            sync_to_clock=True,
+            frame_period=1.0 / stack.board.rate_hz,
+        )
+        with DriveController(driver, drive_cfg) as drive, reader:
+            board.start()
+            rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
+            rig.zero()
+            if log_dir is not None:
+                path = log_dir / f"{spec.trial_id}.jsonl"
+                log_path = str(path)
+                log = TrialLogWriter(path, _header(spec, scene, stack, plan, section, geo))
+            on_tick = None
+            if keep_series:
+
+                def on_tick(obs: Any, state: State) -> None:
+                    st = world.last
+                    series["advance"].append(obs.advance)
+                    series["force"].append(st.P if st else 0.0)
+                    for k, s in zip(("s1", "s2", "s3"), obs.strains, strict=False):
+                        series[k].append(s)
+
+            try:
+                result = run_trial(
+                    rig,
+                    clock,
+                    plan,
+                    guards,
+                    _detector(scene, stack),
+                    log,
+                    tick=tick,
+                    on_tick=on_tick,
+                )
+                estimate, l_b = _estimate(result, spec, stack, section, sample.poisson)
+                if log is not None:
+                    log.write(_estimate_record(estimate, l_b))
+                    log.write(end_record(result))
+            finally:
+                if log is not None:
+                    log.close()
+    return TrialOutcome(
+        spec=spec,
+        state=result.state.value,
+        reason=result.reason,
+        estimate=estimate,
+        exposed_length_at_buckling=l_b,
+        ik_residual=geo.residual,
+        ticks=result.ticks,
+        sim_time=result.duration,
+        log_path=log_path,
+        series=series if keep_series else {},
+    )
+
+
+def exposed_length_at(
+    spec_kind: str, stack: StackConfig, tube: str, x: float, fixed: float
+) -> float:
+    """Exposed length (m) at stage position ``x``: fixed on the bench, grows on the robot."""
+    if spec_kind == "bench":
+        return fixed
+    return x - stack.tube(tube).flush_translation
+
+
+def estimate_from_marks(
+    x_contact: float | None,
+    x_buckling: float | None,
+    strains: tuple[float, ...],
+    length: float | None,
+    stack: StackConfig,
+    section: Section,
+    poisson: float,
+) -> StiffnessEstimate | None:
+    """The paper's estimate: delta from the encoder (Eq. 14), P from the FBG-fitted elastica at
+    the exposed length at buckling (Eq. 7; P_cr when the fit fails), E from Hertz (Eq. 13)."""
+    if x_contact is None or x_buckling is None or length is None:
+        return None
+    beam = Beam.from_section(section, length)
+    P: float | None = None
+    if strains:
+        fit = beam.fit_strains(np.asarray(strains), grating_intervals(stack.sensor, length))
+        if fit.success and fit.P > 0:
+            P = float(fit.P)
+    return paper_estimate(
+        x_contact, x_buckling, length, section, stack.sensor.tip_radius, poisson, P=P
+    )
+
+
+def _estimate(
+    result: TrialResult, spec: TrialSpec, stack: StackConfig, section: Section, poisson: float
+) -> tuple[StiffnessEstimate | None, float | None]:
+    m = result.marks
+    if m.x_buckling is None:
+        return None, None
+    tube = spec.tube if spec.kind == "robot" else ""
+    length = exposed_length_at(spec.kind, stack, tube, m.x_buckling, spec.exposed_length)
+    est = estimate_from_marks(
+        m.x_contact, m.x_buckling, m.strains_at_buckling, length, stack, section, poisson
+    )
+    return est, length
+
+
+def _header(
+    spec: TrialSpec,
+    scene: SceneConfig,
+    stack: StackConfig,
+    plan: TrialPlan,
+    section: Section,
+    geo: _Geometry,
+) -> dict[str, Any]:
+    return {
+        "trial": spec.trial_id,
+        "source": "simulation",
+        "spec": dataclasses.asdict(spec),
+        "scene": scene.name,
+        "plan": dataclasses.asdict(plan),
+        "section": dataclasses.asdict(section),
+        "sensor": dataclasses.asdict(stack.sensor),
+        "tube": dataclasses.asdict(stack.tube(geo.tube)) if spec.kind == "robot" else None,
+        "poisson": spec.poisson,
+        "units": "SI (m, N, Pa, rad, s); strains dimensionless",
+    }
+
+
+def _estimate_record(est: StiffnessEstimate | None, length: float | None) -> dict[str, Any]:
+    if est is None:
+        return {"kind": "estimate", "success": False, "message": "no buckling detected"}
+    return {
+        "kind": "estimate",
+        "success": est.success,
+        "modulus": est.modulus,
+        "delta": est.delta,
+        "force": est.force,
+        "exposed_length": length,
+        "message": est.message,
+    }

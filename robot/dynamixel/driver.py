@@ -1,0 +1,368 @@
+"""The Dynamixel bus driver on the real ``dynamixel_sdk`` (Protocol 2.0), in SI.
+
+:class:`DynamixelBus` satisfies :class:`robot.motors.MotorBus`. It takes its transport in the
+constructor: a port path (``"/dev/ttyUSB0"``, or the pty of ``sim.dynamixel.EmulatedBus``) or an
+already constructed ``dynamixel_sdk.PortHandler``. Nothing is patched and nothing is built behind
+the caller's back, so a test hands it the emulator's port.
+
+Per control tick it makes one sync write of the goals (:meth:`DynamixelBus.write_goals`) and one
+sync read of Moving .. Present_Position (:meth:`DynamixelBus.read_state`). The sync read is made
+from the SDK's ``syncReadTx`` / ``readRx`` rather than ``GroupSyncRead``, because the latter drops
+each status packet's error byte, and the Alert bit in it is how a servo reports a hardware fault.
+
+Safety lives here: every transaction is retried a bounded number of times and then raises
+:class:`~robot.motors.ServoTransportError`; a status error or the Alert bit raises
+:class:`~robot.motors.ServoFaultError` with the decoded Hardware Error Status (never retried);
+goals move at most ``max_goal_step`` per call; :meth:`close` (also on leaving the ``with`` block)
+turns torque off on every servo before releasing the port, whatever happened before.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, Self, TypeVar
+
+import dynamixel_sdk as sdk
+
+from config.schema import ServoBusConfig
+from robot.dynamixel import tables, units
+from robot.motors import (
+    MotorState,
+    ServoFaultError,
+    ServoIdentityError,
+    ServoTransportError,
+)
+
+R = TypeVar("R")
+
+_STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
+_STATE_END = sum(tables.X_SERIES_CONTROL_TABLE["Present_Position"])
+_STATE_LEN = _STATE_END - _STATE_START
+_GOAL_ADDR, _GOAL_LEN = tables.X_SERIES_CONTROL_TABLE["Goal_Position"]
+
+
+@dataclass(frozen=True)
+class Motor:
+    """A servo on the bus: the name the drive uses, its bus ID and its model."""
+
+    name: str
+    id: int
+    model: str
+
+
+class _TimedPortHandler(sdk.PortHandler):  # type: ignore[misc]  # the SDK is untyped
+    """The SDK's port with a configurable reply timeout instead of its fixed 2 x 16 ms + 2 ms."""
+
+    def __init__(self, port_name: str, timeout_ms: float) -> None:
+        super().__init__(port_name)
+        self.reply_timeout_ms = timeout_ms
+
+    def setPacketTimeout(self, packet_length: int) -> None:
+        self.packet_start_time = self.getCurrentTime()
+        self.packet_timeout = self.tx_time_per_byte * packet_length + self.reply_timeout_ms
+
+
+class DynamixelBus:
+    """X-series servos in extended position mode on one Protocol 2.0 bus."""
+
+    def __init__(
+        self,
+        port: str | Any,
+        motors: Sequence[Motor],
+        *,
+        baudrate: int = 1_000_000,
+        retries: int = 3,
+        timeout: float = 0.02,
+        max_goal_step: float = math.radians(10.0),
+    ) -> None:
+        names = [m.name for m in motors]
+        ids = [m.id for m in motors]
+        if not motors or len(set(names)) != len(names) or len(set(ids)) != len(ids):
+            raise ValueError(f"motors need unique names and ids, got {motors}")
+        for m in motors:
+            if m.model not in tables.MODEL_NUMBERS:
+                raise ValueError(f"motor {m.name!r}: unknown model {m.model!r}")
+        if retries < 0 or not timeout > 0 or not max_goal_step > 0:
+            raise ValueError("retries must be >= 0, timeout and max_goal_step > 0")
+        self._motors = {m.name: m for m in motors}
+        self._by_id = {m.id: m for m in motors}
+        self._port = _TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
+        self._ph = sdk.PacketHandler(2.0)
+        self._baudrate = baudrate
+        self._retries = retries
+        self.max_goal_step = max_goal_step
+        self._last_goals: dict[str, float] = {}
+        self._connected = False
+
+    @classmethod
+    def from_config(cls, cfg: ServoBusConfig, port: str | Any | None = None) -> Self:
+        """The drive's three servos; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty)."""
+        motors = [
+            Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
+            Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
+            Motor("translation", cfg.translation.id, cfg.translation.model),
+        ]
+        return cls(
+            cfg.port if port is None else port,
+            motors,
+            baudrate=cfg.baudrate,
+            retries=cfg.retries,
+            timeout=cfg.timeout,
+            max_goal_step=cfg.max_goal_step,
+        )
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self._motors)
+
+    @property
+    def port_handler(self) -> Any:
+        return self._port
+
+    # --- lifecycle ---------------------------------------------------------------------------
+    def connect(self) -> None:
+        """Open the port, ping and identify every servo, torque off, extended position mode.
+
+        Raises ServoTransportError if the port cannot be opened or a servo does not answer,
+        ServoIdentityError if a model number differs from the configured model, and
+        ServoFaultError if a servo reports a hardware error (reboot it with :meth:`reboot`).
+        """
+        if self._connected:
+            return
+        try:
+            opened = self._port.openPort() and self._port.setBaudRate(self._baudrate)
+        except (OSError, ValueError) as exc:  # pyserial's SerialException is an OSError
+            raise ServoTransportError(f"cannot open {self._port.getPortName()}: {exc}") from exc
+        if not opened:
+            raise ServoTransportError(f"cannot open {self._port.getPortName()}")
+        self._connected = True
+        try:
+            for m in self._motors.values():
+                model = self.ping(m.name)
+                if model != tables.MODEL_NUMBERS[m.model]:
+                    found = tables.MODEL_NAMES.get(model, f"model number {model}")
+                    raise ServoIdentityError(
+                        f"servo {m.id} ({m.name}) is a {found}, the configuration says {m.model}"
+                    )
+            self.check_hardware_errors()
+            self.set_torque(False)
+            for m in self._motors.values():
+                if self.read_item(m.name, "Operating_Mode") != tables.MODE_EXTENDED_POSITION:
+                    self.write_item(m.name, "Operating_Mode", tables.MODE_EXTENDED_POSITION)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Torque off on every servo (best effort, each tried), then close the port."""
+        if not self._connected:
+            return
+        try:
+            for m in self._motors.values():
+
+                def torque_off(servo_id: int = m.id) -> tuple[None, int, int]:
+                    result, error = self._ph.write1ByteTxRx(self._port, servo_id, 64, 0)
+                    return None, result, error
+
+                # keep going on failure: the other servos must still be released
+                with contextlib.suppress(ServoTransportError):
+                    self._transact(f"torque off {m.name}", torque_off, servo_id=None, retries=1)
+        finally:
+            self._port.closePort()
+            self._connected = False
+            self._last_goals.clear()
+
+    def __enter__(self) -> Self:
+        self.connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- single-servo operations -------------------------------------------------------------
+    def ping(self, name: str) -> int:
+        """The model number the servo answers with."""
+        m = self._motors[name]
+        model = self._transact(f"ping {name}", lambda: self._ph.ping(self._port, m.id), m.id)
+        return int(model)
+
+    def read_item(self, name: str, item: str) -> int:
+        """Read one control-table item (signed where the hardware is)."""
+        m = self._motors[name]
+        address, size = tables.X_SERIES_CONTROL_TABLE[item]
+        data = self._transact(
+            f"read {item} of {name}",
+            lambda: self._ph.readTxRx(self._port, m.id, address, size),
+            m.id,
+        )
+        raw = int.from_bytes(bytes(data[:size]), "little")
+        return units.to_signed(raw, size) if item in tables.SIGNED else raw
+
+    def write_item(self, name: str, item: str, value: int) -> None:
+        """Write one control-table item and wait for the servo's status packet."""
+        m = self._motors[name]
+        address, size = tables.X_SERIES_CONTROL_TABLE[item]
+        payload = list(units.to_unsigned(int(value), size).to_bytes(size, "little"))
+
+        def call() -> tuple[None, int, int]:
+            result, error = self._ph.writeTxRx(self._port, m.id, address, size, payload)
+            return None, result, error
+
+        self._transact(f"write {item}={value} to {name}", call, m.id)
+
+    def read_hardware_error(self, name: str) -> int:
+        """Hardware_Error_Status bits of one servo (does not raise on the Alert bit)."""
+        m = self._motors[name]
+        data = self._transact(
+            f"read Hardware_Error_Status of {name}",
+            lambda: self._ph.readTxRx(self._port, m.id, 70, 1),
+            servo_id=None,
+        )
+        return int(data[0])
+
+    def check_hardware_errors(self) -> None:
+        """Raise ServoFaultError for the first servo whose Hardware_Error_Status is non-zero."""
+        for m in self._motors.values():
+            bits = self.read_hardware_error(m.name)
+            if bits:
+                raise _hardware_fault(m.id, bits)
+
+    def reboot(self, name: str) -> None:
+        """Reboot one servo: clears its hardware error, torque off, turn count lost."""
+        m = self._motors[name]
+
+        def call() -> tuple[None, int, int]:
+            result, error = self._ph.reboot(self._port, m.id)
+            return None, result, error
+
+        self._transact(f"reboot {name}", call, servo_id=None)
+        self._last_goals.pop(name, None)
+
+    # --- bus-wide operations -----------------------------------------------------------------
+    def set_torque(self, enabled: bool) -> None:
+        """Torque on or off on every servo; on, the goal step clamp starts from where they are."""
+        for m in self._motors.values():
+            self.write_item(m.name, "Torque_Enable", int(enabled))
+        if enabled:
+            state = self.read_state()
+            self._last_goals = {name: s.position for name, s in state.items()}
+        else:
+            self._last_goals.clear()
+
+    def set_profile(self, name: str, velocity: float, acceleration: float) -> None:
+        """Profile_Velocity and Profile_Acceleration of one servo, from rad/s and rad/s^2."""
+        self.write_item(
+            name, "Profile_Acceleration", units.acceleration_units_from_rad_s2(acceleration)
+        )
+        self.write_item(name, "Profile_Velocity", units.velocity_units_from_rad_s(velocity))
+
+    def read_state(self) -> dict[str, MotorState]:
+        """One sync read of Moving .. Present_Position of every servo."""
+        ids = [m.id for m in self._motors.values()]
+
+        def call() -> tuple[dict[int, tuple[list[int], int]], int, int]:
+            result = self._ph.syncReadTx(self._port, _STATE_START, _STATE_LEN, ids, len(ids), False)
+            replies: dict[int, tuple[list[int], int]] = {}
+            if result != sdk.COMM_SUCCESS:
+                return replies, result, 0
+            for servo_id in ids:
+                data, result, error = self._ph.readRx(self._port, servo_id, _STATE_LEN)
+                if result != sdk.COMM_SUCCESS:
+                    return replies, result, 0
+                replies[servo_id] = (data, error)
+            return replies, result, 0
+
+        replies = self._transact("sync read of present state", call, servo_id=None)
+        out: dict[str, MotorState] = {}
+        for servo_id, (data, error) in replies.items():
+            self._raise_for_status(servo_id, error)
+            raw = bytes(data)
+            position = int.from_bytes(raw[10:14], "little", signed=True)
+            velocity = int.from_bytes(raw[6:10], "little", signed=True)
+            out[self._by_id[servo_id].name] = MotorState(
+                position=units.rad_from_ticks(position),
+                velocity=units.rad_s_from_velocity_units(velocity),
+                moving=bool(raw[0]),
+            )
+        return out
+
+    def write_goals(self, goals: Mapping[str, float]) -> dict[str, float]:
+        """One sync write of shaft-angle goals (rad), each clamped to ``max_goal_step`` from the
+        last goal sent; returns the goals actually sent. Torque must be on."""
+        if not self._last_goals:
+            raise RuntimeError("write_goals needs torque on (call set_torque(True) first)")
+        sent: dict[str, float] = {}
+        param: list[int] = []
+        for name, goal in goals.items():
+            m = self._motors[name]
+            last = self._last_goals[name]
+            step = max(-self.max_goal_step, min(self.max_goal_step, goal - last))
+            ticks = units.ticks_from_rad(last + step)
+            sent[name] = units.rad_from_ticks(ticks)
+            param += [m.id, *units.to_unsigned(ticks, _GOAL_LEN).to_bytes(_GOAL_LEN, "little")]
+
+        def call() -> tuple[None, int, int]:
+            result = self._ph.syncWriteTxOnly(self._port, _GOAL_ADDR, _GOAL_LEN, param, len(param))
+            return None, result, 0
+
+        self._transact("sync write of goals", call, servo_id=None)
+        self._last_goals.update(sent)
+        return sent
+
+    # --- the retry loop and error decoding -----------------------------------------------------
+    def _transact(
+        self,
+        what: str,
+        call: Callable[[], tuple[R, int, int]],
+        servo_id: int | None,
+        retries: int | None = None,
+    ) -> R:
+        """Run ``call`` -> (value, comm result, status error) up to 1 + retries times.
+
+        Transport failures are retried; a status error from ``servo_id`` raises at once.
+        ``servo_id=None`` leaves the error byte to the caller.
+        """
+        if not self._connected:
+            raise ServoTransportError(f"{what}: the bus is not connected")
+        attempts = 1 + (self._retries if retries is None else retries)
+        result = sdk.COMM_TX_FAIL
+        for _ in range(attempts):
+            value, result, error = call()
+            if result == sdk.COMM_SUCCESS:
+                if servo_id is not None:
+                    self._raise_for_status(servo_id, error)
+                return value
+            self._port.is_using = False  # the SDK leaves it set after some failures
+        reason = self._ph.getTxRxResult(result)
+        raise ServoTransportError(f"{what}: {reason} ({attempts} attempts)")
+
+    def _raise_for_status(self, servo_id: int, error: int) -> None:
+        if not error:
+            return
+        number = error & 0x7F
+        if error & tables.ALERT_BIT:
+            bits = self.read_hardware_error(self._by_id[servo_id].name)
+            raise _hardware_fault(servo_id, bits, number)
+        raise ServoFaultError(
+            servo_id,
+            ", ".join(tables.decode_status_error(error)),
+            error_number=number,
+        )
+
+
+def _hardware_fault(servo_id: int, bits: int, number: int = 0) -> ServoFaultError:
+    names = tables.decode_hardware_error(bits)
+    status = tables.STATUS_ERRORS.get(number)
+    message = "hardware error: " + (", ".join(names) or "none reported")
+    if status:
+        message += f" (and {status})"
+    return ServoFaultError(
+        servo_id,
+        message,
+        error_number=number,
+        hardware_error=bits,
+        hardware_error_names=names,
+    )

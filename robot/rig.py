@@ -1,0 +1,191 @@
+"""The trial rig on real interfaces: servos through the drive, FBG frames through the reader.
+
+:class:`ServoFbgRig` implements :class:`robot.trial.Rig` over a
+:class:`robot.drive.DriveController` (any :class:`robot.motors.MotorBus`: dynamixel-sdk on a
+real port, on the emulator's pty, or on the in-process transport) and a
+:class:`sensor.reader.FrameReader` (a real port, a pty, or an in-memory serial object). The
+same class runs the bench, the wire simulation and the fast simulation.
+
+Motion is streamed: each tick the rig moves its setpoint toward the state machine's goal by at
+most ``speed * tick`` and sends it, so the stage speed is the state machine's, and the servo's own
+profile only smooths it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from robot.drive import DriveController, JointState
+from robot.indentation import Command, Observation
+from robot.motors import ServoFaultError, ServoTransportError
+from sensor.clock import Clock
+from sensor.frame import Frame, Status
+from sensor.reader import FrameReader, SensorPortError
+from sensor.strain import StrainChain
+
+ContactMode = Literal["event", "fbg"]
+
+
+@dataclass(frozen=True)
+class RigSettings:
+    tick: float = 2e-3  # s, control period
+    contact: ContactMode = "event"
+    fbg_contact_strain: float = 20e-6  # compressive mean strain that means contact (FBG mode)
+    sync_to_clock: bool = False  # simulation: wait for the frame of the current clock time
+    frame_period: float = 1e-3  # s between board frames
+    frame_wait_s: float = 0.2  # real-time bound on that wait
+    roll_speed: float = math.radians(90.0)  # rad/s for roll goals
+
+
+class ServoFbgRig:
+    """A :class:`robot.trial.Rig` over a drive and an FBG frame reader."""
+
+    def __init__(
+        self,
+        drive: DriveController,
+        reader: FrameReader,
+        chain: StrainChain,
+        clock: Clock,
+        settings: RigSettings | None = None,
+    ) -> None:
+        self.drive = drive
+        self.reader = reader
+        self.chain = chain
+        self.clock = clock
+        self.settings = settings or RigSettings()
+        self._setpoint: JointState | None = None
+        self._joints: JointState | None = None
+        self._frame: Frame | None = None
+        self._frame_t = -math.inf
+        self.frames: list[Frame] = []  # every frame received, for the trial log and plots
+
+    # -- set-up ------------------------------------------------------------------------------
+    def zero(self, samples: int = 20) -> StrainChain:
+        """Capture the strain baseline at rest over ``samples`` frames (the sensor is free)."""
+        frames: list[Frame] = []
+        for _ in range(samples * 10):
+            frames += self._receive()
+            if len(frames) >= samples:
+                break
+            self.clock.sleep(self.settings.tick)
+        if not frames:
+            raise SensorPortError(f"board port {self.reader.port_name!r}: no frames to zero on")
+        wl = np.stack([f.wavelengths for f in frames])
+        ref = None
+        if frames[0].reference is not None:
+            ref = np.asarray([f.reference for f in frames], dtype=float)
+        self.chain = self.chain.zeroed(wl, ref)
+        return self.chain
+
+    # -- Rig protocol ------------------------------------------------------------------------
+    def observe(self, t: float) -> Observation:
+        fault: str | None = None
+        try:
+            joints, _ = self.drive.read()
+            self._joints = joints
+        except ServoFaultError as exc:
+            fault = str(exc)
+        except ServoTransportError as exc:
+            fault = f"bus transport: {exc}"
+        joints = self._joints or JointState(math.nan, math.nan)
+        try:
+            frames = self._receive()
+        except SensorPortError:
+            frames = []
+        if frames:
+            self._frame = frames[-1]
+            self._frame_t = t
+        strains: tuple[float, ...] = ()
+        contact = False
+        if self._frame is not None:
+            f = self._frame
+            eps = self.chain.strains(f.wavelengths, reference=f.reference)
+            strains = tuple(float(x) for x in eps)
+            if self.settings.contact == "event":
+                contact = bool(f.flags & Status.CONTACT_EVENT)
+            else:
+                contact = float(np.mean(eps)) < -self.settings.fbg_contact_strain
+        return Observation(
+            t=t,
+            advance=joints.translation,
+            roll=joints.roll,
+            strains=strains,
+            contact=contact,
+            stream_age=t - self._frame_t,
+            servo_fault=fault,
+        )
+
+    def command(self, cmd: Command) -> None:
+        if self._joints is None:
+            return
+        if not cmd.torque:
+            self.release()
+            return
+        sp = self._setpoint or self._joints
+        step = cmd.speed * self.settings.tick
+        roll_step = self.settings.roll_speed * self.settings.tick
+        target = JointState(
+            roll=sp.roll + _clamp(cmd.roll - sp.roll, roll_step),
+            translation=sp.translation + _clamp(cmd.advance - sp.translation, step),
+        )
+        try:
+            # Keep the continuous setpoint: the goal sent is rounded to encoder ticks, and
+            # feeding that back would stall motions slower than one tick per control period.
+            self.drive.command(target)
+            self._setpoint = target
+        except (ServoFaultError, ServoTransportError):
+            self._setpoint = sp  # observe() reports the fault on the next tick
+
+    def recover(self) -> bool:
+        """Reboot the servos that report a hardware error, then torque on again.
+
+        Only faulted servos are rebooted: a Dynamixel reboot resets the multi-turn count, so
+        the drive's homing offsets of a rebooted translation servo are only valid within one
+        revolution; the state machine retracts slowly and the trial is marked FAULT anyway.
+        """
+        bus = self.drive.bus
+        reboot = getattr(bus, "reboot", None)
+        read_error = getattr(bus, "read_hardware_error", None)
+        if reboot is None or read_error is None:
+            return False
+        try:
+            for name in bus.names:
+                if read_error(name):
+                    reboot(name)
+            bus.set_torque(True)
+        except (ServoFaultError, ServoTransportError):
+            return False
+        self._setpoint = None
+        return True
+
+    def release(self) -> None:
+        try:
+            self.drive.bus.set_torque(False)
+        except (ServoFaultError, ServoTransportError, OSError):
+            pass
+
+    # -- helpers -----------------------------------------------------------------------------
+    def _receive(self) -> list[Frame]:
+        """Frames that arrived since the last call. With ``sync_to_clock`` (simulation) wait, up
+        to ``frame_wait_s`` of real time, until the frame stamped at the current clock time has
+        come through the transport, so every path sees the same frames each tick."""
+        frames = self.reader.poll()
+        if self.settings.sync_to_clock:
+            due = self.clock.now() - self.settings.frame_period * 0.5
+            deadline = time.monotonic() + self.settings.frame_wait_s
+            while (not frames or frames[-1].time < due) and time.monotonic() < deadline:
+                last = self.reader.last_frame
+                if last is not None and last.time >= due:
+                    break
+                frames += self.reader.read()
+        self.frames += frames
+        return frames
+
+
+def _clamp(x: float, limit: float) -> float:
+    return max(-limit, min(limit, x))

@@ -1,0 +1,142 @@
+"""Calibration of the glued fiber's strain coefficient k'_eps from paired (strain, shift) data.
+
+The paper glued its fiber and re-measured the coefficient (Fig. 1d): a line through paired known
+strains and measured wavelength shifts, slope 0.424 pm/ue instead of the bare 1.2 pm/ue. This
+module fits that line by ordinary least squares with a Student-t confidence interval on the
+slope and the coefficient of determination R^2.
+
+Recorded files are CSV with a header row naming ``strain_ue`` and ``shift_pm`` (other columns are
+ignored; ``#`` starts a comment line).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import stats  # type: ignore[import-untyped]  # scipy ships no types
+
+UE = 1e-6
+PM = 1e-12
+
+
+@dataclass(frozen=True)
+class CalibrationFit:
+    """Result of :func:`fit_strain_coefficient` (SI: k_eps in m per unit strain, shift in m)."""
+
+    k_eps: float
+    ci: tuple[float, float]
+    intercept: float
+    r_squared: float
+    residual_std: float
+    n: int
+    confidence: float
+    through_origin: bool
+
+    @property
+    def k_pm_per_ue(self) -> float:
+        return self.k_eps * UE / PM
+
+    @property
+    def ci_pm_per_ue(self) -> tuple[float, float]:
+        return (self.ci[0] * UE / PM, self.ci[1] * UE / PM)
+
+    def as_dict(self) -> dict[str, float | int | bool | list[float]]:
+        return {
+            "k_pm_per_ue": self.k_pm_per_ue,
+            "ci_pm_per_ue": list(self.ci_pm_per_ue),
+            "intercept_pm": self.intercept / PM,
+            "r_squared": self.r_squared,
+            "residual_std_pm": self.residual_std / PM,
+            "n": self.n,
+            "confidence": self.confidence,
+            "through_origin": self.through_origin,
+        }
+
+
+def fit_strain_coefficient(
+    strain: ArrayLike,
+    shift: ArrayLike,
+    *,
+    confidence: float = 0.95,
+    through_origin: bool = False,
+) -> CalibrationFit:
+    """Fit ``shift = k_eps * strain (+ intercept)``; strain dimensionless, shift in m, shapes (n,).
+
+    Raises ValueError on mismatched shapes, non-finite values, too few points (n must exceed the
+    number of fitted parameters) or strains that do not vary.
+    """
+    x = np.asarray(strain, dtype=np.float64).reshape(-1)
+    y = np.asarray(shift, dtype=np.float64).reshape(-1)
+    if x.shape != y.shape:
+        raise ValueError(f"strain and shift differ in length: {x.shape[0]} vs {y.shape[0]}")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+        raise ValueError("strain and shift must be finite")
+    if not 0 < confidence < 1:
+        raise ValueError(f"confidence must be in (0, 1), got {confidence}")
+    params = 1 if through_origin else 2
+    n = x.shape[0]
+    if n <= params:
+        raise ValueError(f"need more than {params} points, got {n}")
+    if through_origin:
+        sxx = float(x @ x)
+        if sxx == 0:
+            raise ValueError("all strains are zero: the slope is undetermined")
+        k = float(x @ y) / sxx
+        intercept = 0.0
+        ss_tot = float(y @ y)  # uncentred, as usual for a line through the origin
+    else:
+        xm, ym = float(x.mean()), float(y.mean())
+        sxx = float((x - xm) @ (x - xm))
+        if sxx == 0:
+            raise ValueError("all strains are equal: the slope is undetermined")
+        k = float((x - xm) @ (y - ym)) / sxx
+        intercept = ym - k * xm
+        ss_tot = float((y - ym) @ (y - ym))
+    resid = y - (k * x + intercept)
+    ss_res = float(resid @ resid)
+    dof = n - params
+    s2 = ss_res / dof
+    se = math.sqrt(s2 / sxx)
+    t = float(stats.t.ppf(0.5 + confidence / 2, dof))
+    r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0
+    return CalibrationFit(
+        k_eps=k,
+        ci=(k - t * se, k + t * se),
+        intercept=intercept,
+        r_squared=r2,
+        residual_std=math.sqrt(s2),
+        n=n,
+        confidence=confidence,
+        through_origin=through_origin,
+    )
+
+
+def load_pairs_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """Read ``strain_ue``/``shift_pm`` columns; returns (strain, shift in m) as float arrays.
+
+    ValueError names the file and, where it applies, the line.
+    """
+    p = Path(path)
+    with p.open(newline="", encoding="utf-8") as fh:
+        lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = list(csv.reader(lines))
+    if not rows:
+        raise ValueError(f"{p}: empty file")
+    head = [h.strip() for h in rows[0]]
+    missing = [c for c in ("strain_ue", "shift_pm") if c not in head]
+    if missing:
+        raise ValueError(f"{p}: header lacks column(s) {missing}; found {head}")
+    i_s, i_w = head.index("strain_ue"), head.index("shift_pm")
+    strain, shift = [], []
+    for line, row in enumerate(rows[1:], start=2):
+        try:
+            strain.append(float(row[i_s]))
+            shift.append(float(row[i_w]))
+        except (IndexError, ValueError) as exc:
+            raise ValueError(f"{p}: data row {line}: {exc}") from None
+    return np.asarray(strain) * UE, np.asarray(shift) * PM

@@ -1,0 +1,394 @@
+"""Acquisition-board emulator on a pseudo-terminal, with fault injection.
+
+The emulator owns the pty master and writes frames to it; a reader opens the slave path
+(:attr:`BoardEmulator.port`) with pyserial exactly as it would open the real board. Each sample
+comes from a caller-supplied source ``source(t) -> BoardSample`` (later: the simulator's world).
+
+Two ways to run:
+
+- on a virtual clock (``clock=VirtualClock``): on every clock advance the emulator emits the
+  samples whose times fall in the elapsed interval ``(t_prev, t]``; nothing depends on wall time;
+- free-running (``clock=None``): a thread emits samples in real time (``palpate emulate``).
+
+Writes go through a writer thread, so a clock advance never blocks on a full pty buffer; a
+bounded queue models the board's transmit buffer (when full, samples are dropped and the next
+frame carries ``Status.OVERRUN``).
+
+Faults (:class:`BoardFaults`, per sample, from a seeded generator): garbage bursts between frames,
+one flipped bit, truncated frames, dropped frames (the sequence number still advances), stalls
+(the board goes silent and takes no samples, so the sequence does not jump) and a disconnect
+(the master is closed). Garbage bytes never contain the sync byte 0xA5, so the reader's expected
+counters follow exactly from :class:`BoardStats`; sync-looking garbage is a parser unit test.
+
+Import note: this module imports ``sensor.frame``, the pure wire codec, as protocol data. It is the
+one accepted exception to "sim/ never imports sensor/": the frame layout is shared by both ends of
+the wire and must not be copied.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import pty
+import queue
+import select
+import threading
+import time
+import tty
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from types import TracebackType
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from config.loader import limits
+from sensor.frame import Frame, FrameLayout, Status, encode, frame_from_si
+from sim.clock import VirtualClock
+
+SYNC_BYTE = 0xA5
+
+
+@dataclass(frozen=True)
+class BoardSample:
+    """One sample in SI: peak wavelengths (m, length N), encoder count, optional extras."""
+
+    wavelengths: Sequence[float] | NDArray[np.float64]
+    encoder: int = 0
+    reference: float | None = None
+    force: float | None = None
+    flags: int = 0
+
+
+SampleSource = Callable[[float], BoardSample]
+
+
+class ByteSink(Protocol):
+    """Where the fast path writes frames instead of a pty (``sim.inprocess.MemorySerial``)."""
+
+    @property
+    def name(self) -> str: ...
+
+    def write(self, data: bytes) -> int: ...
+
+
+@dataclass(frozen=True)
+class BoardFaults:
+    """Fault injection; probabilities are per sample. Loadable with ``config.loader``."""
+
+    garbage_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
+    garbage_max_bytes: int = field(default=64, metadata=limits(ge=1, le=4096))
+    bitflip_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
+    truncate_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
+    drop_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
+    stall_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
+    stall_s: float = field(default=0.5, metadata=limits(gt=0, le=60))
+    disconnect_after_s: float | None = field(default=None, metadata=limits(ge=0))
+    seed: int = 0
+
+    def validate(self) -> None:
+        if self.bitflip_probability + self.truncate_probability > 1:
+            raise ValueError("bitflip_probability + truncate_probability must be <= 1")
+
+
+@dataclass
+class BoardStats:
+    """What the board did; ``log`` holds ``(seq, outcome, detail)`` when recording is on.
+
+    Outcomes: ``"sent"``, ``"dropped"``, ``"bitflip"`` (detail: byte offset), ``"truncate"``
+    (detail: bytes kept) and ``"stall"`` (seq: the next sample's; detail: start time in us).
+    """
+
+    samples: int = 0
+    frames_sent: int = 0
+    frames_dropped: int = 0
+    frames_corrupted: int = 0
+    overruns: int = 0
+    garbage_bursts: int = 0
+    garbage_bytes: int = 0
+    stalls: int = 0
+    bytes_sent: int = 0
+    disconnected: bool = False
+    log: list[tuple[int, str, int]] = field(default_factory=list)
+
+
+class BoardEmulator:
+    """The board on a pty: ``with BoardEmulator(source, layout, clock=vc) as board: board.port``."""
+
+    def __init__(
+        self,
+        source: SampleSource,
+        layout: FrameLayout,
+        *,
+        rate_hz: float = 1000.0,
+        clock: VirtualClock | None = None,
+        faults: BoardFaults | None = None,
+        record: bool = False,
+        queue_chunks: int = 4096,
+        sink: ByteSink | None = None,
+    ) -> None:
+        if not rate_hz > 0:
+            raise ValueError(f"rate_hz must be > 0, got {rate_hz}")
+        self.source = source
+        self.layout = layout
+        self.rate_hz = float(rate_hz)
+        self.clock = clock
+        self.faults = faults if faults is not None else BoardFaults()
+        self.faults.validate()
+        self.record = record
+        self.stats = BoardStats()
+        self._rng = np.random.default_rng(self.faults.seed)
+        self._queue: queue.Queue[bytes | None] = queue.Queue(maxsize=queue_chunks)
+        self._lock = threading.Lock()
+        self._running = False
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+        self._sink = sink
+        if sink is None:
+            self._master, self._slave = pty.openpty()
+            tty.setraw(self._slave)  # no echo, no CR/LF mapping, no signals: bytes pass as they are
+            os.set_blocking(self._master, False)  # the writer polls: stop() never hangs on a write
+            self.port: str = os.ttyname(self._slave)
+        else:  # the in-process fast path: frames go straight into the sink, no pty, no thread
+            self._master = self._slave = -1
+            self.port = str(getattr(sink, "name", "memory"))
+        self._t0 = 0.0
+        self._next = 1  # index of the next sample time t0 + k / rate
+        self._seq = 0
+        self._resume_at = -math.inf
+        self._overrun = False
+        self._closed = False
+        if clock is not None:
+            clock.on_advance(self._on_advance)
+
+    # -- lifetime ------------------------------------------------------------------------
+
+    def start(self) -> BoardEmulator:
+        """Start streaming: sample k is taken at ``t_start + k / rate_hz``, k = 1, 2, ..."""
+        if self._running:
+            return self
+        if self._closed:
+            raise RuntimeError("board emulator was stopped; create a new one")
+        self._t0 = self.clock.now() if self.clock is not None else time.monotonic()
+        self._running = True
+        if self._sink is None:
+            writer = threading.Thread(target=self._write_loop, name="board-writer", daemon=True)
+            self._threads.append(writer)
+            writer.start()
+        if self.clock is None:
+            gen = threading.Thread(target=self._free_run, name="board-clock", daemon=True)
+            self._threads.append(gen)
+            gen.start()
+        return self
+
+    def stop(self) -> None:
+        """Stop streaming, join the threads and close the pty."""
+        with self._lock:
+            self._running = False
+        self._stop.set()
+        self._signal_writer()
+        for t in self._threads:
+            t.join(timeout=5.0)
+        self._threads.clear()
+        self._close_fds()
+        self._closed = True
+
+    def disconnect(self) -> None:
+        """Unplug: the writer closes the pty after what is already queued (reads then fail)."""
+        with self._lock:
+            self._running = False
+            self.stats.disconnected = True
+        self._signal_writer()
+
+    def __enter__(self) -> BoardEmulator:
+        return self.start()
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.stop()
+
+    # -- sample generation ---------------------------------------------------------------
+
+    def _on_advance(self, t: float) -> None:
+        self.emit_until(t)
+
+    def _free_run(self) -> None:
+        period = 1.0 / self.rate_hz
+        while not self._stop.is_set() and self._running:
+            self.emit_until(time.monotonic())
+            self._stop.wait(min(max(period, 1e-4), 2e-3))
+
+    def emit_until(self, t: float) -> int:
+        """Emit every sample with time in ``(t_prev, t]``; returns how many samples were taken."""
+        with self._lock:
+            if not self._running:
+                return 0
+            due = math.floor((t - self._t0) * self.rate_hz + 1e-9)
+            chunks: list[bytes] = []
+            taken = 0
+            sent_before = self.stats.frames_sent
+            disconnect_at = self.faults.disconnect_after_s
+            while self._next <= due:
+                ts = self._t0 + self._next / self.rate_hz
+                self._next += 1
+                if disconnect_at is not None and ts - self._t0 >= disconnect_at:
+                    self._running = False
+                    self.stats.disconnected = True
+                    break
+                if ts < self._resume_at:
+                    continue
+                if (
+                    self.faults.stall_probability
+                    and self._rng.random() < self.faults.stall_probability
+                ):
+                    self.stats.stalls += 1
+                    self._resume_at = ts + self.faults.stall_s
+                    self._log(self._seq, "stall", round(ts * 1e6))
+                    continue
+                chunks.append(self._sample(ts))
+                taken += 1
+            data = b"".join(chunks)
+            intact = self.stats.frames_sent - sent_before
+            stop_after = not self._running
+        if data:
+            self._enqueue(data, intact)
+        if stop_after:
+            self._signal_writer()
+        return taken
+
+    def _sample(self, ts: float) -> bytes:
+        f = self.faults
+        rng = self._rng
+        seq = self._seq
+        self._seq = (seq + 1) % 2**32
+        self.stats.samples += 1
+        if f.drop_probability and rng.random() < f.drop_probability:
+            self._log(seq, "dropped", 0)
+            self.stats.frames_dropped += 1
+            return b""
+        s = self.source(ts)
+        flags = s.flags | (Status.OVERRUN if self._overrun else 0)
+        self._overrun = False
+        frame = frame_from_si(
+            seq,
+            ts,
+            s.encoder,
+            tuple(float(w) for w in s.wavelengths),
+            reference=s.reference if self.layout.has_reference else None,
+            force=s.force if self.layout.has_force else None,
+            flags=flags,
+        )
+        data = self._encode(frame)
+        out = b""
+        if f.garbage_probability and rng.random() < f.garbage_probability:
+            out = self._garbage()
+        r = rng.random()
+        if r < f.bitflip_probability:
+            bit = int(rng.integers(len(data) * 8))
+            corrupted = bytearray(data)
+            corrupted[bit // 8] ^= 1 << (bit % 8)
+            data = bytes(corrupted)
+            self._log(seq, "bitflip", bit // 8)
+            self.stats.frames_corrupted += 1
+        elif r < f.bitflip_probability + f.truncate_probability:
+            keep = int(rng.integers(1, len(data)))
+            data = data[:keep]
+            self._log(seq, "truncate", keep)
+            self.stats.frames_corrupted += 1
+        else:
+            self._log(seq, "sent", 0)
+            self.stats.frames_sent += 1
+        return out + data
+
+    def _encode(self, frame: Frame) -> bytes:
+        if frame.layout != self.layout:
+            raise ValueError(f"source gave {frame.layout}, the board streams {self.layout}")
+        return encode(frame)
+
+    def _garbage(self) -> bytes:
+        n = int(self._rng.integers(1, self.faults.garbage_max_bytes + 1))
+        raw = self._rng.integers(0, 255, size=n, dtype=np.uint8)
+        raw[raw >= SYNC_BYTE] += 1  # 0..255 without 0xA5
+        self.stats.garbage_bursts += 1
+        self.stats.garbage_bytes += n
+        return raw.tobytes()
+
+    def _log(self, seq: int, outcome: str, detail: int) -> None:
+        if self.record:
+            self.stats.log.append((seq, outcome, detail))
+
+    def _enqueue(self, data: bytes, intact: int) -> None:
+        if self._sink is not None:
+            self._sink.write(data)
+            with self._lock:
+                self.stats.bytes_sent += len(data)
+            return
+        try:
+            self._queue.put_nowait(data)
+        except queue.Full:  # the transmit buffer is full: the chunk is lost, as on a real board
+            with self._lock:
+                self.stats.overruns += 1
+                self.stats.frames_sent -= intact
+                self.stats.frames_dropped += intact
+                self._overrun = True
+            return
+        with self._lock:
+            self.stats.bytes_sent += len(data)
+
+    def _signal_writer(self) -> None:
+        while True:
+            try:
+                self._queue.put_nowait(None)
+                return
+            except queue.Full:
+                with contextlib.suppress(queue.Empty):
+                    self._queue.get_nowait()
+
+    # -- writing -------------------------------------------------------------------------
+
+    def _write_loop(self) -> None:
+        while True:
+            data = self._queue.get()
+            if data is None:
+                break
+            if not self._write_all(data):
+                break
+        if self.stats.disconnected:
+            self._close_fds()
+
+    def _write_all(self, data: bytes) -> bool:
+        view = memoryview(data)
+        while view:
+            if self._stop.is_set():
+                return False
+            try:
+                view = view[os.write(self._master, view) :]
+            except BlockingIOError:
+                select.select([], [self._master], [], 0.05)
+            except OSError:
+                return False
+        return True
+
+    def _close_fds(self) -> None:
+        with self._lock:
+            fds = [fd for fd in (self._master, self._slave) if fd >= 0]
+            self._master = self._slave = -1
+        for fd in fds:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+
+def constant_source(wavelengths: Sequence[float], encoder: int = 0) -> SampleSource:
+    """A source that always returns the same sample (a sensor at rest)."""
+    sample = BoardSample(wavelengths=tuple(wavelengths), encoder=encoder)
+
+    def source(t: float) -> BoardSample:
+        return sample
+
+    return source

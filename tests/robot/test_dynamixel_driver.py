@@ -1,0 +1,217 @@
+"""The driver over the real dynamixel_sdk, against the emulator on a real pty (virtual time)."""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterator
+
+import dynamixel_sdk as sdk
+import pytest
+
+from config.schema import ServoBusConfig, ServoConfig
+from robot.dynamixel import tables
+from robot.dynamixel.driver import DynamixelBus, Motor
+from robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
+from sim.clock import VirtualClock
+from sim.dynamixel.bus import EmulatedBus
+
+CFG = ServoBusConfig(retries=2, timeout_ms=50.0)
+NAMES = ("outer_roll", "inner_roll", "translation")
+
+
+@pytest.fixture
+def clock() -> VirtualClock:
+    return VirtualClock()
+
+
+@pytest.fixture
+def emulator(clock: VirtualClock) -> Iterator[EmulatedBus]:
+    with EmulatedBus.from_config(CFG, clock=clock) as bus:
+        yield bus
+
+
+@pytest.fixture
+def driver(emulator: EmulatedBus) -> Iterator[DynamixelBus]:
+    with DynamixelBus.from_config(CFG, port=emulator.port) as bus:
+        yield bus
+
+
+def test_connect_identifies_and_sets_extended_position_mode(
+    emulator: EmulatedBus, driver: DynamixelBus
+) -> None:
+    assert driver.names == NAMES
+    assert driver.ping("translation") == 1060
+    for s in emulator.servos:
+        assert s.item("Operating_Mode") == tables.MODE_EXTENDED_POSITION
+        assert not s.torque_enabled
+
+
+def test_goals_reach_the_servos_signed_and_multi_turn(
+    emulator: EmulatedBus, driver: DynamixelBus, clock: VirtualClock
+) -> None:
+    driver.max_goal_step = 100.0
+    driver.set_torque(True)
+    goals = {"outer_roll": -3.5 * 2 * math.pi, "inner_roll": 1.0, "translation": 9 * 2 * math.pi}
+    sent = driver.write_goals(goals)
+    assert sent == pytest.approx(goals, abs=2 * math.pi / 4096)
+    state = driver.read_state()
+    assert all(not s.moving for s in state.values())
+    clock.advance(1.0)
+    assert any(s.moving for s in driver.read_state().values())
+    clock.advance(60.0)
+    state = driver.read_state()
+    for name, goal in goals.items():
+        assert state[name].position == pytest.approx(goal, abs=2 * math.pi / 4096)
+        assert state[name].velocity == 0.0
+    assert emulator.servo(1).position_ticks == -3.5 * 4096
+
+
+def test_goal_step_is_clamped_per_tick(driver: DynamixelBus) -> None:
+    driver.set_torque(True)
+    step = CFG.max_goal_step
+    sent = driver.write_goals({"outer_roll": 5.0, "translation": -5.0})
+    assert sent["outer_roll"] == pytest.approx(step, abs=1e-3)
+    assert sent["translation"] == pytest.approx(-step, abs=1e-3)
+    sent = driver.write_goals({"outer_roll": 5.0})
+    assert sent["outer_roll"] == pytest.approx(2 * step, abs=1e-3)
+
+
+def test_write_goals_needs_torque(driver: DynamixelBus) -> None:
+    with pytest.raises(RuntimeError, match="torque"):
+        driver.write_goals({"outer_roll": 0.1})
+
+
+def test_profiles_are_written_in_servo_units(emulator: EmulatedBus, driver: DynamixelBus) -> None:
+    driver.set_profile("translation", velocity=2 * math.pi, acceleration=4 * math.pi)
+    servo = emulator.servo(3)
+    assert servo.item("Profile_Velocity") == round(60 / 0.229)  # 1 rev/s
+    assert servo.item("Profile_Acceleration") == round(2 * 3600 / 214.577)
+
+
+def test_close_turns_torque_off_even_after_an_error(emulator: EmulatedBus) -> None:
+    bus = DynamixelBus.from_config(CFG, port=emulator.port)
+
+    def fail_with_torque_on() -> None:
+        with bus:
+            bus.set_torque(True)
+            assert all(s.torque_enabled for s in emulator.servos)
+            raise ZeroDivisionError
+
+    with pytest.raises(ZeroDivisionError):
+        fail_with_torque_on()
+    assert not any(s.torque_enabled for s in emulator.servos)
+    bus.close()  # idempotent
+
+
+def test_close_releases_the_other_servos_when_one_is_silent(emulator: EmulatedBus) -> None:
+    bus = DynamixelBus.from_config(CFG, port=emulator.port)
+    bus.connect()
+    bus.set_torque(True)
+    emulator.servo(1).drop_replies(100)
+    bus.close()
+    assert not emulator.servo(2).torque_enabled
+    assert not emulator.servo(3).torque_enabled
+
+
+def test_a_transient_lost_reply_is_retried(emulator: EmulatedBus, driver: DynamixelBus) -> None:
+    emulator.servo(2).drop_replies(1)
+    emulator.servo(3).corrupt_replies(1)
+    assert set(driver.read_state()) == set(NAMES)
+
+
+def test_a_silent_servo_ends_in_a_transport_error(
+    emulator: EmulatedBus, driver: DynamixelBus
+) -> None:
+    emulator.servo(3).drop_replies(100)
+    with pytest.raises(ServoTransportError, match="3 attempts") as info:
+        driver.read_state()
+    assert isinstance(info.value, OSError)
+    emulator.servo(3).corrupt_replies(100)
+    emulator.servo(3).drop_replies(0)
+    with pytest.raises(ServoTransportError, match="Incorrect status packet"):
+        driver.read_item("translation", "Present_Position")
+
+
+def test_hardware_error_ends_in_a_fault_with_decoded_bits(
+    emulator: EmulatedBus, driver: DynamixelBus
+) -> None:
+    driver.set_torque(True)
+    emulator.servo(2).raise_hardware_error(tables.HW_OVERLOAD | tables.HW_OVERHEATING)
+    with pytest.raises(ServoFaultError) as info:
+        driver.read_state()
+    fault = info.value
+    assert isinstance(fault, RuntimeError)
+    assert fault.servo_id == 2
+    assert fault.hardware_error == 0x24
+    assert fault.hardware_error_names == ("Overheating Error", "Overload Error")
+    driver.reboot("inner_roll")
+    assert driver.read_hardware_error("inner_roll") == 0
+    assert set(driver.read_state()) == set(NAMES)
+
+
+def test_a_stall_becomes_an_overload_fault(
+    emulator: EmulatedBus, driver: DynamixelBus, clock: VirtualClock
+) -> None:
+    driver.set_torque(True)
+    emulator.servo(3).set_stalled(True)
+    driver.write_goals({"translation": 0.1})
+    clock.advance(0.5)
+    driver.read_state()
+    clock.advance(1.0)
+    with pytest.raises(ServoFaultError, match="Overload") as info:
+        driver.read_state()
+    assert info.value.servo_id == 3
+    assert not emulator.servo(3).torque_enabled
+
+
+def test_access_error_is_a_fault_with_its_number(driver: DynamixelBus) -> None:
+    driver.set_torque(True)
+    with pytest.raises(ServoFaultError, match="Access Error") as info:
+        driver.write_item("outer_roll", "Operating_Mode", 3)
+    assert info.value.error_number == tables.ERR_ACCESS
+
+
+def test_connect_refuses_a_servo_with_a_hardware_error(emulator: EmulatedBus) -> None:
+    emulator.servo(1).raise_hardware_error(tables.HW_INPUT_VOLTAGE)
+    with pytest.raises(ServoFaultError, match="Input Voltage"):
+        DynamixelBus.from_config(CFG, port=emulator.port).connect()
+
+
+def test_wrong_model_is_an_identity_error(emulator: EmulatedBus) -> None:
+    cfg = ServoBusConfig(translation=ServoConfig(id=3, model="XM430-W350"), retries=0)
+    bus = DynamixelBus.from_config(cfg, port=emulator.port)
+    with pytest.raises(ServoIdentityError, match="XL430-W250"):
+        bus.connect()
+
+
+def test_missing_servo_and_missing_port_are_transport_errors(emulator: EmulatedBus) -> None:
+    cfg = ServoBusConfig(translation=ServoConfig(id=9, model="XL430-W250"), retries=0)
+    with pytest.raises(ServoTransportError, match="ping translation"):
+        DynamixelBus.from_config(cfg, port=emulator.port).connect()
+    with pytest.raises(ServoTransportError, match="cannot open"):
+        DynamixelBus.from_config(CFG, port="/nonexistent/ttyDXL").connect()
+
+
+def test_an_open_port_handler_can_be_passed_in(emulator: EmulatedBus) -> None:
+    handler = sdk.PortHandler(emulator.port)
+    with DynamixelBus(handler, [Motor("m", 2, "XM430-W350")]) as bus:
+        assert bus.port_handler is handler
+        assert bus.read_item("m", "Model_Number") == 1020
+
+
+def test_constructor_rejects_bad_motor_lists() -> None:
+    with pytest.raises(ValueError, match="unique"):
+        DynamixelBus("/dev/null", [Motor("a", 1, "XM430-W350"), Motor("a", 2, "XM430-W350")])
+    with pytest.raises(ValueError, match="unknown model"):
+        DynamixelBus("/dev/null", [Motor("a", 1, "AX-12")])
+
+
+@pytest.mark.hardware
+def test_real_bus_reads_state() -> None:
+    """On the bench: PALPATE_HW_SERVO_PORT=/dev/ttyUSB0 pytest -m hardware (torque stays off)."""
+    port = os.environ.get("PALPATE_HW_SERVO_PORT")
+    if not port:
+        pytest.skip("no servo bus: set PALPATE_HW_SERVO_PORT")
+    with DynamixelBus.from_config(ServoBusConfig(), port=port) as bus:
+        assert set(bus.read_state()) == set(NAMES)
