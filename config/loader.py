@@ -13,9 +13,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import operator
 import types
 import typing
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, Literal, TypeVar, get_args, get_origin
 
@@ -56,11 +57,11 @@ def _join(path: str, key: str | int) -> str:
 
 
 def _check_range(value: float, meta: Mapping[str, Any], source: str, path: str) -> None:
-    bounds = (
-        ("ge", lambda v, b: v >= b, ">="),
-        ("gt", lambda v, b: v > b, ">"),
-        ("le", lambda v, b: v <= b, "<="),
-        ("lt", lambda v, b: v < b, "<"),
+    bounds: tuple[tuple[str, Callable[[float, float], bool], str], ...] = (
+        ("ge", operator.ge, ">="),
+        ("gt", operator.gt, ">"),
+        ("le", operator.le, "<="),
+        ("lt", operator.lt, "<"),
     )
     for name, ok, sign in bounds:
         bound = meta.get(name)

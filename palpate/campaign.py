@@ -12,7 +12,7 @@ from pathlib import Path
 from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from config.schema import StackConfig
 from estimation.stiffness import SampleSummary, summarize
-from palpate.simtrial import TrialOutcome, TrialSpec, Transport, run_sim_trial
+from palpate.simtrial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
 
 def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> list[TrialSpec]:
@@ -90,9 +90,7 @@ def run_campaign(
 ) -> list[TrialOutcome]:
     """Run trials (in parallel with ``workers`` > 1 or a given executor); results keep the order
     of ``specs`` and do not depend on the executor (every trial is seeded by its spec)."""
-    jobs = [
-        _Job(s, scene, stack, transport, log_dir, s.trial_id == series_for) for s in specs
-    ]
+    jobs = [_Job(s, scene, stack, transport, log_dir, s.trial_id == series_for) for s in specs]
     own: Executor | None = None
     if executor is None and workers > 1:
         own = executor = ProcessPoolExecutor(max_workers=workers)
@@ -129,9 +127,7 @@ class SampleRow:
     trials: int
 
 
-def summarize_campaign(
-    outcomes: Iterable[TrialOutcome], outlier_above: float
-) -> list[SampleRow]:
+def summarize_campaign(outcomes: Iterable[TrialOutcome], outlier_above: float) -> list[SampleRow]:
     """Per sample: mean, RMSE, IQR and relative error of the estimates (Tables I/II)."""
     by_sample: dict[str, list[TrialOutcome]] = {}
     for o in outcomes:

@@ -29,14 +29,17 @@ EXIT_BAD_INPUT = 2
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="palpate",
-        description="Tissue palpation with a buckling FBG-sensorized beam: simulator and control stack.",
+        description="Tissue palpation with a buckling FBG-sensorized beam: "
+        "simulator and control stack.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, module_name in COMMANDS.items():
         module = importlib.import_module(module_name)
         doc = (module.__doc__ or "").strip().splitlines()[0] if module.__doc__ else ""
         cmd = sub.add_parser(name, help=doc, description=module.__doc__)
-        cmd.add_argument("--json", action="store_true", help="print machine-readable results on stdout")
+        cmd.add_argument(
+            "--json", action="store_true", help="print machine-readable results on stdout"
+        )
         module.register(cmd)
         cmd.set_defaults(_module=module)
     return parser

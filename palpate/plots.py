@@ -8,10 +8,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from palpate.campaign import SampleRow  # noqa: E402
-from palpate.simtrial import TrialOutcome  # noqa: E402
+from palpate.campaign import SampleRow
+from palpate.simtrial import TrialOutcome
 
 
 def estimates_vs_truth(

@@ -13,6 +13,7 @@ profile only smooths it.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass
@@ -164,10 +165,8 @@ class ServoFbgRig:
         return True
 
     def release(self) -> None:
-        try:
+        with contextlib.suppress(ServoFaultError, ServoTransportError, OSError):
             self.drive.bus.set_torque(False)
-        except (ServoFaultError, ServoTransportError, OSError):
-            pass
 
     # -- helpers -----------------------------------------------------------------------------
     def _receive(self) -> list[Frame]:

@@ -1,1 +1,2 @@
-"""FBG signal chain: board frames over pyserial, wavelength -> strain, grating averages, detection."""
+"""FBG signal chain: board frames over pyserial, wavelength -> strain, grating averages,
+detection."""

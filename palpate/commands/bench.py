@@ -22,7 +22,8 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    ctx = BenchContext(out_dir=args.out, quick=args.quick, seed=args.seed, repeats=3 if args.quick else 7)
+    repeats = 3 if args.quick else 7
+    ctx = BenchContext(out_dir=args.out, quick=args.quick, seed=args.seed, repeats=repeats)
     ctx.out_dir.mkdir(parents=True, exist_ok=True)
     names = args.only or list(SECTIONS)
     results: list[BenchSection] = []

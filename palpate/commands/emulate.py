@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import threading
-
-import numpy as np
 
 from config import load_stack
 from sensor.reader import layout_from_config
@@ -23,9 +22,7 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     stack = load_stack(args.config)
-    wavelengths = np.asarray(
-        [stack.fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in stack.sensor.used_gratings]
-    )
+    wavelengths = [stack.fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in stack.sensor.used_gratings]
     layout = layout_from_config(stack.sensor, stack.board)
     with (
         EmulatedBus.from_config(stack.servos) as bus,
@@ -39,8 +36,6 @@ def run(args: argparse.Namespace) -> int:
             print(f"acquisition board ({stack.board.rate_hz:g} frames/s): {board.port}")
             print("Ctrl-C to stop", flush=True)
         stop = threading.Event()
-        try:
+        with contextlib.suppress(KeyboardInterrupt):
             stop.wait(args.seconds)
-        except KeyboardInterrupt:
-            pass
     return 0

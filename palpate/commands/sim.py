@@ -130,7 +130,9 @@ def _kpa(d: dict[str, object]) -> dict[str, object]:
 
 def _print_table(name: str, rows: list) -> None:  # type: ignore[type-arg]
     print(f"{name} campaign: estimated vs actual Young's modulus (kPa), outliers > 3 MPa removed")
-    head = f"{'sample':>8} {'trials':>6} {'estimated':>10} {'actual':>9} {'RMSE':>9} {'IQR':>9} {'rel.err':>8}"
+    cols = [("sample", 8), ("trials", 6), ("estimated", 10), ("actual", 9), ("RMSE", 9)]
+    cols += [("IQR", 9), ("rel.err", 8)]
+    head = " ".join(f"{c:>{w}}" for c, w in cols)
     print(head)
     print("-" * len(head))
     for r in rows:

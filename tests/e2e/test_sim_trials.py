@@ -1,0 +1,102 @@
+"""End-to-end simulated trials: wire path vs fast path, seeds, replay, the CLI."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from config import load, load_stack, resolve
+from config.scene import SceneConfig
+from palpate.cli import main
+from palpate.commands.replay import replay
+from palpate.simtrial import TrialSpec, run_sim_trial
+from robot.triallog import read_log
+
+STACK = load_stack()
+BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
+ROBOT = load(SceneConfig, resolve("scenes/robot.yaml"))
+
+
+def bench_spec(seed: int = 3) -> TrialSpec:
+    return TrialSpec(
+        "S8-bench", "bench", "S8", 314.53e3, 0.45, "straight", "downward", 0.0, 44e-3, seed
+    )
+
+
+def test_wire_and_fast_paths_give_the_same_trial(tmp_path: Path) -> None:
+    fast = run_sim_trial(bench_spec(), BENCH, STACK, transport="fast")
+    wire = run_sim_trial(bench_spec(), BENCH, STACK, transport="wire")
+    assert fast.state == wire.state == "done"
+    assert fast.estimate is not None
+    assert wire.estimate is not None
+    assert fast.estimate.modulus == wire.estimate.modulus
+    assert fast.ticks == wire.ticks
+
+
+def test_seed_reproduces_and_changes_the_noise() -> None:
+    a = run_sim_trial(bench_spec(1), BENCH, STACK)
+    b = run_sim_trial(bench_spec(1), BENCH, STACK)
+    c = run_sim_trial(bench_spec(2), BENCH, STACK)
+    assert a.estimate is not None
+    assert b.estimate is not None
+    assert c.estimate is not None
+    assert a.estimate.modulus == b.estimate.modulus
+    assert a.estimate.modulus != c.estimate.modulus
+
+
+def test_robot_trial_with_bent_tube_estimates_the_modulus(tmp_path: Path) -> None:
+    spec = TrialSpec(
+        "S7-bent30-up", "robot", "S7", 1122.86e3, 0.45, "bent30", "upward", 3.14159, 42e-3, 5
+    )
+    out = run_sim_trial(spec, ROBOT, STACK, log_dir=tmp_path)
+    assert out.state == "done", out.reason
+    assert out.ik_residual < 1e-9  # the IK found the orthogonal pose the sample was placed at
+    assert out.estimate is not None
+    assert out.estimate.modulus is not None
+    # the estimate is biased (finite thickness, large indentation, detection delay) but sane
+    assert 0.5 < out.estimate.modulus / spec.modulus < 2.0
+    log = read_log(Path(str(out.log_path)))
+    assert log.complete
+    states = [r["to"] for r in log.of_kind("transition")]
+    assert states[-1] == "done"
+    assert "buckled" in states
+
+
+def test_replay_reproduces_the_estimate_exactly(tmp_path: Path) -> None:
+    out = run_sim_trial(bench_spec(), BENCH, STACK, log_dir=tmp_path)
+    report = replay(Path(str(out.log_path)))
+    assert report["identical"] is True
+    assert out.estimate is not None
+    assert report["modulus"] == out.estimate.modulus
+
+
+def test_replay_reports_a_truncated_log(tmp_path: Path) -> None:
+    out = run_sim_trial(bench_spec(), BENCH, STACK, log_dir=tmp_path)
+    path = Path(str(out.log_path))
+    lines = path.read_text(encoding="utf-8").splitlines()
+    cut = tmp_path / "cut.jsonl"
+    cut.write_text("\n".join(lines[: len(lines) // 2]) + '\n{"kind": "sa', encoding="utf-8")
+    report = replay(cut)
+    assert report["complete"] is False
+    assert "truncated" in report["message"]
+    assert main(["replay", str(cut)]) == 1
+
+
+def test_cli_sim_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["sim", "--campaign", "bench", "--limit", "2", "--workers", "1", "--json",
+                 "--no-plots", "--out", str(tmp_path)])  # fmt: skip
+    assert code == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert len(payload["trials"]) == 2
+    assert payload["samples"][0]["sample"] == "S1"
+    assert all(t["state"] == "done" for t in payload["trials"])
+    assert len(list((tmp_path / "bench" / "logs").glob("*.jsonl"))) == 2
+
+
+def test_cli_bad_scene_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "scene.yaml"
+    bad.write_text("campaign: {kind: sideways}\n", encoding="utf-8")
+    assert main(["sim", "--scene", str(bad), "--out", str(tmp_path)]) == 2
+    assert "campaign.kind" in capsys.readouterr().err
