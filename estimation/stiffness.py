@@ -23,7 +23,10 @@ from typing import Protocol
 
 import numpy as np
 
-EULER_FIXED_PINNED = 4.493409457909064**2
+from estimation.contact import hertz_modulus
+from estimation.section import P_CRIT, euler_load
+
+EULER_FIXED_PINNED = P_CRIT  # kept as a name the tests and callers use
 """p_cr = P_cr L^2 / EI = mu^2 with tan(mu) = mu: 20.1907 (fixed-pinned column)."""
 
 PAPER_OUTLIER_ABOVE = 3e6
@@ -54,23 +57,6 @@ class StiffnessEstimate:
     delta: float
     force: float
     message: str
-
-
-def hertz_modulus(force: float, delta: float, tip_radius: float, poisson: float) -> float:
-    """Eq. 13: E = 3/4 P (1 - nu^2) / sqrt(delta^3 R). Inputs must be positive (ValueError)."""
-    if not (force > 0 and delta > 0 and tip_radius > 0):
-        raise ValueError(
-            f"hertz_modulus needs force, delta, tip_radius > 0; got {force}, {delta}, {tip_radius}"
-        )
-    _check_poisson(poisson)
-    return 0.75 * force * (1.0 - poisson**2) / math.sqrt(delta**3 * tip_radius)
-
-
-def euler_fixed_pinned(EI: float, length: float) -> float:
-    """P_cr = 20.19 EI / L^2 (N) of the clamped-pinned sensor of exposed length L."""
-    if not (EI > 0 and length > 0 and math.isfinite(EI) and math.isfinite(length)):
-        raise ValueError(f"EI and length must be positive and finite; got {EI}, {length}")
-    return EULER_FIXED_PINNED * EI / length**2
 
 
 def paper_estimate(
@@ -106,7 +92,11 @@ def paper_estimate(
     if not tip_radius > 0:
         raise ValueError(f"tip_radius must be > 0, got {tip_radius}")
     _check_poisson(poisson)
-    force = euler_fixed_pinned(EI, exposed_length_at_buckling)  # also validates EI and L
+    if not (math.isfinite(exposed_length_at_buckling) and exposed_length_at_buckling > 0):
+        raise ValueError(
+            f"exposed_length_at_buckling must be > 0 m, got {exposed_length_at_buckling}"
+        )
+    force = euler_load(EI, exposed_length_at_buckling)  # also validates EI
     if P is not None:
         if not (math.isfinite(P) and P > 0):
             raise ValueError(f"P must be a positive finite load in N, got {P}")
@@ -125,7 +115,7 @@ def paper_estimate(
         )
     return StiffnessEstimate(
         success=True,
-        modulus=hertz_modulus(force, delta, tip_radius, poisson),
+        modulus=float(hertz_modulus(force, delta, tip_radius, poisson)),
         delta=delta,
         force=force,
         message="ok",

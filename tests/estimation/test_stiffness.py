@@ -10,12 +10,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from estimation.contact import hertz_modulus
+from estimation.section import euler_load
 from estimation.stiffness import (
     EULER_FIXED_PINNED,
     PAPER_OUTLIER_ABOVE,
     StiffnessEstimate,
-    euler_fixed_pinned,
-    hertz_modulus,
     paper_estimate,
     summarize,
 )
@@ -35,7 +35,7 @@ def test_euler_load_of_the_fixed_pinned_sensor() -> None:
         math.sqrt(EULER_FIXED_PINNED), rel=1e-12
     )
     # Paper sensor: P_cr about 0.95-1.35 N for L = 42-50 mm.
-    assert 0.9 < euler_fixed_pinned(EI, 0.050) < euler_fixed_pinned(EI, 0.042) < 1.4
+    assert 0.9 < euler_load(EI, 0.050) < euler_load(EI, 0.042) < 1.4
 
 
 @given(
