@@ -58,10 +58,6 @@ def trial_traces(outcome: TrialOutcome, path: Path) -> Path:
     for key in ("s1", "s2", "s3"):
         if s.get(key):
             ax2.plot(adv[: len(s[key])], [v * 1e6 for v in s[key]], label=f"grating {key[1]}")
-    est = outcome.estimate
-    if est is not None and est.success:
-        for ax in (ax1, ax2):
-            ax.axvline(adv[0], color="0.8")
     ax2.set_ylabel("grating strain (ue)")
     ax2.set_xlabel("stage advance (mm)")
     ax2.legend()
