@@ -271,9 +271,7 @@ def run_sim_trial(
     log: TrialLogWriter | None = None
     log_path: str | None = None
     series: dict[str, list[float]] = {"advance": [], "force": [], "s1": [], "s2": [], "s3": []}
-    with _emulators(
-        scene.transport if transport is None else transport, stack, clock, world.sample
-    ) as (
+    with _emulators(transport, stack, clock, world.sample) as (
         bus,
         board,
         servo_port,
@@ -338,13 +336,12 @@ def run_sim_trial(
     )
 
 
-def exposed_length_at(
-    spec_kind: str, stack: StackConfig, tube: str, x: float, fixed: float
-) -> float:
-    """Exposed length (m) at stage position ``x``: fixed on the bench, grows on the robot."""
-    if spec_kind == "bench":
-        return fixed
-    return x - stack.tube(tube).flush_translation
+def exposed_length_at(kind: str, x: float, fixed_length: float, flush_translation: float) -> float:
+    """Exposed length (m) at stage position ``x``: fixed on the bench, on the robot the stage
+    translation past the tube's flush translation. Shared by the trial and ``palpate replay``."""
+    if kind == "bench":
+        return fixed_length
+    return x - flush_translation
 
 
 def estimate_from_marks(
@@ -377,8 +374,8 @@ def _estimate(
     m = result.marks
     if m.x_buckling is None:
         return None, None
-    tube = spec.tube if spec.kind == "robot" else ""
-    length = exposed_length_at(spec.kind, stack, tube, m.x_buckling, spec.exposed_length)
+    flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
+    length = exposed_length_at(spec.kind, m.x_buckling, spec.exposed_length, flush)
     est = estimate_from_marks(
         m.x_contact, m.x_buckling, m.strains_at_buckling, length, stack, section, poisson
     )

@@ -11,7 +11,7 @@ from typing import Any
 from config.loader import from_mapping
 from config.schema import SensorConfig, StackConfig, TubeConfig
 from estimation.section import Section
-from palpate.simtrial import estimate_from_marks
+from palpate.simtrial import estimate_from_marks, exposed_length_at
 from robot.triallog import TrialLogError, read_log
 
 
@@ -46,11 +46,10 @@ def replay(path: Path) -> dict[str, Any]:
     x_b = marks.get("x_buckling")
     length: float | None = None
     if x_b is not None:
-        if spec["kind"] == "bench":
-            length = spec["exposed_length"]
-        else:
-            tube = from_mapping(TubeConfig, h["tube"], str(path), "tube")
-            length = x_b - tube.flush_translation
+        flush = 0.0
+        if spec["kind"] == "robot":
+            flush = from_mapping(TubeConfig, h["tube"], str(path), "tube").flush_translation
+        length = exposed_length_at(spec["kind"], x_b, spec["exposed_length"], flush)
     stack = StackConfig(sensor=sensor)
     est = estimate_from_marks(
         marks.get("x_contact"),
