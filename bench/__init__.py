@@ -10,4 +10,5 @@ SECTIONS: dict[str, str] = {
     "mechanics": "bench.mechanics",
     "sensor": "bench.sensor",
     "robot": "bench.robot",
+    "fuzz": "bench.fuzz",
 }

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
+from config.faults import FaultsConfig
 from config.loader import limits
 from config.schema import MM
 
@@ -100,9 +101,14 @@ class SceneConfig:
     robot: str = "robot.yaml"
     transport: Literal["fast", "wire"] = "fast"
     control_rate_hz: float = field(default=500.0, metadata=limits(gt=0, le=10000))
+    # The acquisition board's frame rate in this scene; null: the robot configuration's. The
+    # control loop uses the newest frame of each tick, so frames beyond the control rate are
+    # computed, sent and parsed only to be dropped: a campaign scene streams at its control rate.
+    board_rate_hz: float | None = field(default=None, metadata=limits(gt=0, le=100000))
     samples: tuple[SampleConfig, ...] = PAPER_SAMPLES
     fidelity: FidelityConfig = FidelityConfig()
     campaign: CampaignConfig = CampaignConfig()
+    faults: FaultsConfig = field(default_factory=FaultsConfig)  # for ``palpate sim --faults``
 
     def validate(self) -> None:
         names = [s.name for s in self.samples]

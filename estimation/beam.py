@@ -175,12 +175,19 @@ class Beam:
         s < 0 is inside the tube (straight). Bending strain is dy_fbg times the mean of dtheta/ds,
         0 before buckling; ``include_axial`` adds the uniform -P/EA the fiber also carries.
         """
-        s0, s1 = self._intervals(intervals)
-        g = self.geometric_shortening(e)[..., None]
-        bending = self._bending(g, s0, s1)
+        bending = self.bending_strains(self.geometric_shortening(e), intervals)
         if not include_axial:
             return bending
         return np.asarray(bending - (self.force(e) / self.EA)[..., None])
+
+    def bending_strains(self, g: ArrayLike, intervals: ArrayLike) -> FloatArray:
+        """Mean bending strain over each interval for the elastica at geometric (inextensible)
+        shortening ratio ``g`` = e_g/L: shape g.shape + (G,). ``grating_strains`` is this at
+        ``geometric_shortening(e)``; a caller that knows the shape's e_g (say from the pin
+        reaction of an imperfect beam) asks for it directly."""
+        s0, s1 = self._intervals(intervals)
+        g_arr = np.clip(np.asarray(g, dtype=float), 0.0, E_OVER_L_MAX)[..., None]
+        return self._bending(g_arr, s0, s1)
 
     def _intervals(self, intervals: ArrayLike) -> tuple[FloatArray, FloatArray]:
         arr = np.asarray(intervals, dtype=float)

@@ -5,13 +5,14 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
 from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from config.schema import StackConfig
 from estimation.stiffness import SampleSummary, summarize
+from palpate.executors import SerialExecutor
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
 
@@ -89,13 +90,16 @@ def run_campaign(
     progress: Callable[[TrialOutcome], None] | None = None,
 ) -> list[TrialOutcome]:
     """Run trials (in parallel with ``workers`` > 1 or a given executor); results keep the order
-    of ``specs`` and do not depend on the executor (every trial is seeded by its spec)."""
+    of ``specs`` and do not depend on the executor (every trial is seeded by its spec).
+
+    ``executor``: any ``concurrent.futures.Executor`` (``palpate.executors.open_executor`` builds
+    process, thread, serial and Dask ones); ``progress`` is called as trials finish."""
     jobs = [_Job(s, scene, stack, transport, log_dir, s.trial_id == series_for) for s in specs]
     own: Executor | None = None
     if executor is None and workers > 1:
         own = executor = ProcessPoolExecutor(max_workers=workers)
     try:
-        if executor is None:
+        if executor is None or isinstance(executor, SerialExecutor):
             results = []
             for job in jobs:
                 out = _run_job(job)
@@ -104,13 +108,10 @@ def run_campaign(
                     progress(out)
             return results
         futures = [executor.submit(_run_job, job) for job in jobs]
-        results = []
-        for fut in futures:
-            out = fut.result()
-            results.append(out)
-            if progress is not None:
-                progress(out)
-        return results
+        if progress is not None:
+            for fut in as_completed(futures):
+                progress(fut.result())
+        return [fut.result() for fut in futures]
     finally:
         if own is not None:
             own.shutdown()
@@ -127,25 +128,30 @@ class SampleRow:
     trials: int
 
 
-def summarize_campaign(outcomes: Iterable[TrialOutcome], outlier_above: float) -> list[SampleRow]:
-    """Per sample: mean, RMSE, IQR and relative error of the estimates (Tables I/II)."""
+def summarize_campaign(
+    outcomes: Iterable[TrialOutcome], outlier_above: float, method: str = "joint"
+) -> list[SampleRow]:
+    """Per sample: mean, RMSE, IQR and relative error of the estimates (Tables I/II), by
+    ``method``: "joint" (the contact-point-free fit, the default) or "paper" (Eqs. 13-14)."""
     by_sample: dict[str, list[TrialOutcome]] = {}
     for o in outcomes:
         by_sample.setdefault(o.spec.sample, []).append(o)
     rows = []
     for name, outs in by_sample.items():
-        estimates = [o.estimate for o in outs]
+        estimates = [o.modulus(method) for o in outs]
         rows.append(
             SampleRow(name, summarize(estimates, outs[0].spec.modulus, outlier_above), len(outs))
         )
     return rows
 
 
-def median_abs_relative_error(outcomes: Iterable[TrialOutcome]) -> float | None:
+def median_abs_relative_error(
+    outcomes: Iterable[TrialOutcome], method: str = "joint"
+) -> float | None:
     errs = sorted(
-        abs(o.estimate.modulus - o.spec.modulus) / o.spec.modulus
+        abs(m - o.spec.modulus) / o.spec.modulus
         for o in outcomes
-        if o.estimate is not None and o.estimate.modulus is not None
+        if (m := o.modulus(method)) is not None
     )
     if not errs:
         return None

@@ -19,6 +19,9 @@ COMMANDS: dict[str, str] = {
     "replay": "palpate.commands.replay",
     "emulate": "palpate.commands.emulate",
     "calibrate": "palpate.commands.calibrate",
+    "design": "palpate.commands.design",
+    "trial": "palpate.commands.trial",
+    "teleop": "palpate.commands.teleop",
 }
 
 EXIT_OK = 0

@@ -36,8 +36,8 @@ def estimates_vs_truth(
         color="tab:blue",
     )
     for o in outcomes:
-        if o.estimate is not None and o.estimate.modulus is not None:
-            ax.plot(x[o.spec.sample] + 0.2, o.estimate.modulus / 1e3, "k.", ms=4)
+        if (m := o.modulus()) is not None:  # the method the table reports (joint fit)
+            ax.plot(x[o.spec.sample] + 0.2, m / 1e3, "k.", ms=4)
     ax.set_xticks(range(len(names)), names)
     ax.set_ylabel("Young's modulus (kPa)")
     ax.set_title(title)
@@ -49,17 +49,28 @@ def estimates_vs_truth(
 
 
 def trial_traces(outcome: TrialOutcome, path: Path) -> Path:
-    """Force and grating strains against stage advance for one trial (as Fig. 4b,c)."""
+    """Force and grating strains against stage advance for one trial (as Fig. 4b,c), with the
+    encoder positions the trial marked as contact (Eq. 14's X_contact) and buckling."""
     s = outcome.series
     adv = [a * 1e3 for a in s["advance"]]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     ax1.plot(adv, s["force"], color="tab:red")
-    ax1.set_ylabel("axial force P (N)")
+    ax1.set_ylabel("axial force P (N, world)")
     for key in ("s1", "s2", "s3"):
         if s.get(key):
             ax2.plot(adv[: len(s[key])], [v * 1e6 for v in s[key]], label=f"grating {key[1]}")
     ax2.set_ylabel("grating strain (ue)")
     ax2.set_xlabel("stage advance (mm)")
+    m = outcome.marks
+    for x, label, style in (
+        (m.x_contact if m else None, "contact", ":"),
+        (m.x_buckling if m else None, "buckling", "--"),
+    ):
+        if x is None:
+            continue
+        for ax in (ax1, ax2):
+            ax.axvline(x * 1e3, color="0.3", linestyle=style, linewidth=1, label=label)
+    ax1.legend(loc="upper left")
     ax2.legend()
     ax1.set_title(f"trial {outcome.spec.trial_id}")
     fig.tight_layout()

@@ -12,31 +12,35 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
 
 import numpy as np
 
-from config.scene import SceneConfig
-from config.schema import StackConfig
+from config.scene import FidelityConfig, SampleConfig, SceneConfig
+from config.schema import ServoBusConfig, StackConfig
 from estimation.beam import Beam
+from estimation.beamstate import onset_mode
+from estimation.jointfit import JointFit
 from estimation.section import Section, composite_section
 from estimation.stiffness import StiffnessEstimate, paper_estimate
+from palpate.estimates import EstimatorInputs, joint_estimate, joint_record, loading_rows
 from robot import kinematics
 from robot.drive import TRANSLATION, DriveController, RollerGearDrive
 from robot.dynamixel.driver import DynamixelBus
 from robot.dynamixel.tables import TICKS_PER_REV
 from robot.dynamixel.units import rad_from_ticks
-from robot.indentation import Guards, State, TrialPlan
+from robot.indentation import Guards, State, TrialMarks, TrialPlan
 from robot.rig import RigSettings, ServoFbgRig
 from robot.trial import TrialResult, end_record, run_trial
 from robot.triallog import TrialLogWriter
 from sensor.detect import CusumDetector, NormThreshold
 from sensor.reader import FrameReader, layout_from_config
 from sensor.strain import StrainChain, grating_intervals, strain_noise
-from sim.board import BoardEmulator
+from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 from sim.inprocess import InProcessPort, MemorySerial
@@ -76,9 +80,25 @@ class TrialOutcome:
     sim_time: float
     log_path: str | None
     series: dict[str, list[float]] = field(default_factory=dict)
+    marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
+    joint: JointFit | None = None  # the contact-point-free estimate (palpate.estimates)
+    joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
+
+    def modulus(self, method: str = "joint") -> float | None:
+        """E (Pa) by ``"joint"`` (the whole-record fit) or ``"paper"`` (Eqs. 13-14)."""
+        if method == "joint":
+            return None if self.joint is None else self.joint.modulus
+        if method == "paper":
+            return None if self.estimate is None else self.estimate.modulus
+        raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
 
     def as_dict(self) -> dict[str, Any]:
         est = self.estimate
+        jf = self.joint
+
+        def kpa(v: float | None) -> float | None:
+            return None if v is None else v / 1e3
+
         return {
             "trial": self.spec.trial_id,
             "sample": self.spec.sample,
@@ -89,6 +109,11 @@ class TrialOutcome:
             "estimated_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
             "delta_mm": None if est is None else est.delta * 1e3,
             "force_n": None if est is None else est.force,
+            "joint_kpa": kpa(None if jf is None else jf.modulus),
+            "joint_ci_kpa": None if jf is None else [kpa(jf.ci_low), kpa(jf.ci_high)],
+            "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,
+            "joint_message": "no loading record" if jf is None else jf.message,
+            "warnings": [] if jf is None else list(jf.warnings),
             "state": self.state,
             "reason": self.reason,
             "ik_residual_deg": math.degrees(self.ik_residual),
@@ -101,6 +126,21 @@ def sensor_section(stack: StackConfig) -> Section:
     s = stack.sensor
     return composite_section(
         s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
+    )
+
+
+def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
+    """The simulated tissue's force law for a scene's sample and fidelity switches."""
+    return TissueModel(
+        modulus=sample.modulus,
+        poisson=sample.poisson,
+        thickness=(
+            sample.thickness if (sample.thickness and fidelity.finite_thickness) else math.inf
+        ),
+        bonded=sample.bonded,
+        tip_radius=tip_radius,
+        finite_thickness=fidelity.finite_thickness,
+        large_indentation=fidelity.large_indentation,
     )
 
 
@@ -140,6 +180,11 @@ def _bench_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
     return _Geometry(0.0, BENCH_CONTACT_TRANSLATION, surface, 0.0, "bench-stage")
 
 
+def trial_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
+    """Where the sample is and how the robot reaches it; ValueError if it cannot."""
+    return _bench_geometry(stack, spec) if spec.kind == "bench" else _robot_geometry(stack, spec)
+
+
 def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
     if spec.kind == "bench":
         length = spec.exposed_length
@@ -149,10 +194,16 @@ def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
 
         return bench_pose
     tube = stack.tube(tube_name)
+    last: dict[float, kinematics.TipPose] = {}
 
     def robot_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
-        p = kinematics.forward(tube, roll, translation)
-        return p.tube_tip, p.tangent, p.exposed_length
+        # The tip frame depends on the roll only, which is constant while the stage moves:
+        # keep the last one (the board asks for a pose at every sample).
+        p = last.get(roll)
+        if p is None:
+            last.clear()
+            p = last[roll] = kinematics.forward(tube, roll, 0.0)
+        return p.tube_tip, p.tangent, translation - tube.flush_translation
 
     return robot_pose
 
@@ -167,29 +218,67 @@ def _detector(scene: SceneConfig, stack: StackConfig) -> NormThreshold | CusumDe
     return CusumDetector(sigma=sigma)
 
 
+class EmulatorHook(Protocol):
+    """Fault injection and ground-truth checks around one trial's emulators
+    (``palpate.faults.FaultInjector``); the control stack never sees it."""
+
+    @property
+    def board_faults(self) -> BoardFaults | None: ...
+
+    def make_bus(self, cfg: ServoBusConfig, clock: VirtualClock) -> EmulatedBus: ...
+
+    def attach(
+        self, clock: VirtualClock, bus: EmulatedBus, board: BoardEmulator, world: World
+    ) -> None:
+        """Called once the emulators exist, before the control stack connects."""
+        ...
+
+    def log_opened(self, log: TrialLogWriter) -> None: ...
+
+    def detach(self) -> None:
+        """Called after the control stack has closed its ports, before the emulators stop."""
+        ...
+
+
 @contextlib.contextmanager
 def _emulators(
-    transport: Transport, stack: StackConfig, clock: VirtualClock, world_source: Any
+    transport: Transport,
+    stack: StackConfig,
+    clock: VirtualClock,
+    world: World,
+    hook: EmulatorHook | None = None,
 ) -> Iterator[tuple[EmulatedBus, BoardEmulator, Any, Any]]:
-    bus = EmulatedBus.from_config(stack.servos, clock=clock)
+    if hook is None:
+        bus = EmulatedBus.from_config(stack.servos, clock=clock)
+    else:
+        bus = hook.make_bus(stack.servos, clock)
+    faults = None if hook is None else hook.board_faults
     layout = layout_from_config(stack.sensor, stack.board)
+    rate = stack.board.rate_hz
     if transport == "wire":
-        board = BoardEmulator(world_source, layout, rate_hz=stack.board.rate_hz, clock=clock)
+        board = BoardEmulator(world.sample, layout, rate_hz=rate, clock=clock, faults=faults)
         port = bus.open()
-        try:
-            yield bus, board, port, board.port
-        finally:
-            board.stop()
-            bus.close()
+        servo_port: Any = port
+        board_port: Any = board.port
     else:
         pipe = MemorySerial()
         board = BoardEmulator(
-            world_source, layout, rate_hz=stack.board.rate_hz, clock=clock, sink=pipe
+            world.sample, layout, rate_hz=rate, clock=clock, sink=pipe, faults=faults
         )
-        try:
-            yield bus, board, InProcessPort(bus), pipe
-        finally:
-            board.stop()
+        servo_port, board_port = InProcessPort(bus), pipe
+        if hook is not None:
+            # in-process a reply is there at once or never: with injected packet loss, do not
+            # spin 20 ms of wall time per lost reply (simulated time is not affected)
+            servo_port.reply_timeout_ms = 1.0
+    if hook is not None:
+        hook.attach(clock, bus, board, world)
+    try:
+        yield bus, board, servo_port, board_port
+    finally:
+        if hook is not None:
+            hook.detach()
+        board.stop()
+        bus.close()  # no-op on the fast path (no pty)
 
 
 def run_sim_trial(
@@ -200,27 +289,23 @@ def run_sim_trial(
     transport: Transport = "fast",
     log_dir: Path | None = None,
     keep_series: bool = False,
+    hook: EmulatorHook | None = None,
 ) -> TrialOutcome:
     """Run one simulated trial end to end and estimate the modulus from it."""
     c = scene.campaign
-    geo = _bench_geometry(stack, spec) if spec.kind == "bench" else _robot_geometry(stack, spec)
+    geo = trial_geometry(stack, spec)
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
     drive_cfg = dataclasses.replace(
         stack.drive, home_translation_mm=retract * 1e3, home_roll_deg=math.degrees(geo.plan_roll)
     )
-    stack = dataclasses.replace(stack, drive=drive_cfg)
+    board_cfg = stack.board
+    if scene.board_rate_hz is not None:
+        board_cfg = dataclasses.replace(board_cfg, rate_hz=scene.board_rate_hz)
+    stack = dataclasses.replace(stack, drive=drive_cfg, board=board_cfg)
     section = sensor_section(stack)
     sample = next(s for s in scene.samples if s.name == spec.sample)
     fid = scene.fidelity
-    tissue = TissueModel(
-        modulus=sample.modulus,
-        poisson=sample.poisson,
-        thickness=sample.thickness if (sample.thickness and fid.finite_thickness) else math.inf,
-        bonded=sample.bonded,
-        tip_radius=stack.sensor.tip_radius,
-        finite_thickness=fid.finite_thickness,
-        large_indentation=fid.large_indentation,
-    )
+    tissue = tissue_model(sample, fid, stack.sensor.tip_radius)
     rng = np.random.default_rng(spec.seed)
     clock = VirtualClock()
     truth = RollerGearDrive(drive_cfg)  # the servos power up at the home pose (0 ticks)
@@ -231,12 +316,17 @@ def run_sim_trial(
         TRANSLATION: stack.servos.translation.id,
     }
     holder: dict[str, EmulatedBus] = {}
+    memo: dict[tuple[int, ...], tuple[float, float, int]] = {}
 
     def joints() -> tuple[float, float, int]:
         bus = holder["bus"]
-        ticks = {n: bus.servo(i).position_ticks for n, i in servo_ids.items()}
-        q = truth.joints({n: rad_from_ticks(t) for n, t in ticks.items()})
-        return q.roll, q.translation, ticks[TRANSLATION]
+        ticks = tuple(bus.servo(i).position_ticks for i in servo_ids.values())
+        known = memo.get(ticks)  # the servos rest for most board samples: keep the last answer
+        if known is None:
+            q = truth.joints({n: rad_from_ticks(t) for n, t in zip(servo_ids, ticks, strict=True)})
+            memo.clear()
+            known = memo[ticks] = (q.roll, q.translation, ticks[2])
+        return known
 
     world = World(
         section=section,
@@ -271,7 +361,7 @@ def run_sim_trial(
     log: TrialLogWriter | None = None
     log_path: str | None = None
     series: dict[str, list[float]] = {"advance": [], "force": [], "s1": [], "s2": [], "s3": []}
-    with _emulators(transport, stack, clock, world.sample) as (
+    with _emulators(transport, stack, clock, world, hook) as (
         bus,
         board,
         servo_port,
@@ -285,7 +375,18 @@ def run_sim_trial(
             contact=c.contact,
             sync_to_clock=True,
             frame_period=1.0 / stack.board.rate_hz,
+            fbg_bending_mode=tuple(
+                onset_mode(
+                    grating_intervals(stack.sensor, spec.exposed_length),
+                    spec.exposed_length,
+                    section.fiber_offset,
+                ).tolist()
+            ),
         )
+        if hook is not None and transport == "fast":
+            # in-process frames arrive during the clock advance or never: with injected board
+            # faults, do not wait 0.2 s of wall time for each lost frame
+            settings = dataclasses.replace(settings, frame_wait_s=0.0)
         with DriveController(driver, drive_cfg) as drive, reader:
             board.start()
             rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
@@ -294,6 +395,8 @@ def run_sim_trial(
                 path = log_dir / f"{spec.trial_id}.jsonl"
                 log_path = str(path)
                 log = TrialLogWriter(path, _header(spec, scene, stack, plan, section, geo))
+                if hook is not None:
+                    hook.log_opened(log)
             on_tick = None
             if keep_series:
 
@@ -316,8 +419,13 @@ def run_sim_trial(
                     on_tick=on_tick,
                 )
                 estimate, l_b = _estimate(result, spec, stack, section, sample.poisson)
+                fit_start = time.perf_counter()
+                joint = joint_from_rows(
+                    result.record, _estimator_inputs(spec, scene, stack, geo), stack, section
+                )
+                joint_seconds = time.perf_counter() - fit_start
                 if log is not None:
-                    log.write(_estimate_record(estimate, l_b))
+                    log.write(_estimate_record(estimate, l_b, joint))
                     log.write(end_record(result))
             finally:
                 if log is not None:
@@ -333,6 +441,9 @@ def run_sim_trial(
         sim_time=result.duration,
         log_path=log_path,
         series=series if keep_series else {},
+        marks=result.marks,
+        joint=joint,
+        joint_seconds=joint_seconds,
     )
 
 
@@ -400,13 +511,47 @@ def _header(
         "sensor": dataclasses.asdict(stack.sensor),
         "tube": dataclasses.asdict(stack.tube(geo.tube)) if spec.kind == "robot" else None,
         "poisson": spec.poisson,
+        "estimator": _estimator_inputs(spec, scene, stack, geo).as_dict(),
         "units": "SI (m, N, Pa, rad, s); strains dimensionless",
     }
 
 
-def _estimate_record(est: StiffnessEstimate | None, length: float | None) -> dict[str, Any]:
+def _estimator_inputs(
+    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: _Geometry
+) -> EstimatorInputs:
+    """What the joint fit is told: the sample as the user knows it (not the sim's switches)."""
+    sample = next(s for s in scene.samples if s.name == spec.sample)
+    return EstimatorInputs(
+        kind=spec.kind,
+        exposed_length=spec.exposed_length,
+        flush_translation=stack.tube(geo.tube).flush_translation if spec.kind == "robot" else 0.0,
+        tip_radius=stack.sensor.tip_radius,
+        poisson=sample.poisson,
+        thickness=sample.thickness,
+        bonded=sample.bonded,
+        encoder_resolution=stack.drive.lead / TICKS_PER_REV,
+        misalignment=geo.residual,
+    )
+
+
+def joint_from_rows(
+    rows: Any, inputs: EstimatorInputs, stack: StackConfig, section: Section
+) -> JointFit:
+    """The joint fit from (state, advance, strains) rows: the trial's record or a log's samples."""
+    advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
+    return joint_estimate(advance, strains, inputs, stack.sensor, section)
+
+
+def _estimate_record(
+    est: StiffnessEstimate | None, length: float | None, joint: JointFit | None = None
+) -> dict[str, Any]:
     if est is None:
-        return {"kind": "estimate", "success": False, "message": "no buckling detected"}
+        return {
+            "kind": "estimate",
+            "success": False,
+            "message": "no buckling detected",
+            "joint": joint_record(joint),
+        }
     return {
         "kind": "estimate",
         "success": est.success,
@@ -415,4 +560,5 @@ def _estimate_record(est: StiffnessEstimate | None, length: float | None) -> dic
         "force": est.force,
         "exposed_length": length,
         "message": est.message,
+        "joint": joint_record(joint),
     }

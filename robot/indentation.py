@@ -67,6 +67,7 @@ class Guards:
     stream_timeout: float = 0.1  # s without a fresh FBG frame
     state_timeout: float = 60.0  # s in any one state
     early_contact_margin: float = 0.5e-3  # contact this much before the plan is "unexpected"
+    bus_grace: float = 0.5  # s of lost servo replies tolerated while retracting (goals still go)
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,7 @@ class Observation:
     contact: bool  # the contact event (force scale / camera / FBG), as the rig reports it
     stream_age: float = 0.0  # s since the last good FBG frame
     servo_fault: str | None = None  # a fault the servo bus reported, if any
+    bus_lost: bool = False  # servo_fault is a transport failure (no or garbled replies)
     abort: bool = False  # the operator pressed stop
 
 
@@ -97,6 +99,23 @@ class Transition:
     reason: str
     advance: float
     strains: tuple[float, ...]
+
+
+def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -> str | None:
+    """Why the fiber-strain or travel-past-contact guard trips on ``obs``, or None.
+
+    One function for the state machine and for teleoperation (``robot.teleop``), so a jog is
+    held to exactly the limits of a scripted trial. ``x_contact`` is the stage position at
+    contact (m), None while the sensor is free.
+    """
+    peak = max((abs(s) for s in obs.strains), default=0.0)
+    if peak > guards.strain_limit:
+        return f"fiber strain {peak * 1e6:.0f} ue over the limit {guards.strain_limit * 1e6:.0f} ue"
+    if x_contact is not None:
+        past = obs.advance - x_contact
+        if past > guards.max_travel_past_contact:
+            return f"travel past contact {past * 1e3:.2f} mm over the limit"
+    return None
 
 
 class BucklingDetector(Protocol):
@@ -134,6 +153,8 @@ class IndentationMachine:
     marks: TrialMarks = field(default_factory=TrialMarks)
     _entered: float = 0.0
     _last_command: Command | None = None
+    _first_touch: float | None = None  # advance at the first contact event, planned or not
+    _lost_since: float | None = None  # time the servo replies were lost while retracting
 
     # -- public -------------------------------------------------------------------------------
     @property
@@ -168,10 +189,21 @@ class IndentationMachine:
         if obs.abort and not self.marks.reason.startswith("aborted"):
             self.abort(obs.t, "operator stop")
             return
+        if obs.contact and self._first_touch is None and math.isfinite(obs.advance):
+            self._first_touch = obs.advance
         if self.state is State.RETRACTING:
-            if obs.servo_fault is not None:
-                # Retraction itself failed: stop where we are; the runner releases torque.
-                self._fault(obs, f"servo fault while retracting: {obs.servo_fault}", retract=False)
+            if obs.servo_fault is None:
+                self._lost_since = None
+                return
+            if obs.bus_lost:
+                # Replies lost, but goals still reach the servos: keep pulling back (away from
+                # the tissue) for a grace period in case the bus comes back.
+                if self._lost_since is None:
+                    self._lost_since = obs.t
+                if obs.t - self._lost_since < self.guards.bus_grace:
+                    return
+            # Retraction itself failed: stop where we are; the runner releases torque.
+            self._fault(obs, f"servo fault while retracting: {obs.servo_fault}", retract=False)
             return
         if obs.servo_fault is not None:
             # Stop and retract: the runner clears the fault (reboot) before it moves again.
@@ -189,19 +221,10 @@ class IndentationMachine:
         if in_contact_phase and obs.stream_age > self.guards.stream_timeout:
             self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
             return
-        peak = max((abs(s) for s in obs.strains), default=0.0)
-        if peak > self.guards.strain_limit:
-            self._fault(
-                obs,
-                f"fiber strain {peak * 1e6:.0f} ue over the limit "
-                f"{self.guards.strain_limit * 1e6:.0f} ue",
-            )
+        violation = limit_violation(self.guards, obs, self.marks.x_contact)
+        if violation is not None:
+            self._fault(obs, violation)
             return
-        if self.marks.x_contact is not None:
-            past = obs.advance - self.marks.x_contact
-            if past > self.guards.max_travel_past_contact:
-                self._fault(obs, f"travel past contact {past * 1e3:.2f} mm over the limit")
-                return
         if obs.contact and self.state in (State.HOMING, State.POSITIONING):
             self._fault(obs, f"unexpected contact during {self.state.value}")
 
@@ -222,6 +245,14 @@ class IndentationMachine:
         self.state = target
         self._entered = t
         self.on_transition(tr)
+
+    def _retract_goal(self) -> float:
+        """Home, or further back if the tissue was touched where the plan did not expect it:
+        never end a retraction still touching."""
+        p = self.plan
+        if self._first_touch is None:
+            return p.home_advance
+        return min(p.home_advance, self._first_touch - p.standoff)
 
     def _hold(self, obs: Observation) -> Command:
         return Command(advance=obs.advance, roll=obs.roll, speed=0.0, torque=True)
@@ -277,7 +308,15 @@ class IndentationMachine:
             self.marks.t_buckling = obs.t
             self.marks.strains_at_buckling = obs.strains
             self._go(State.BUCKLED, obs.t, "buckling detected", obs.advance, obs.strains)
-        return self._indent_goal(obs)
+            return self._indent_goal(obs)
+        cmd = self._indent_goal(obs)
+        if obs.advance >= cmd.advance - self.plan.position_tolerance:
+            # The whole travel window is used up without buckling (a compliant tube tip, a
+            # stiff sample): stop now rather than press on the tissue until the state timeout.
+            travel = self.guards.max_travel_past_contact * 1e3
+            self._fault(obs, f"no buckling: travel past contact reached the {travel:.2f} mm limit")
+            return self._hold(obs)
+        return cmd
 
     def _buckled(self, obs: Observation) -> Command:
         assert self.marks.x_buckling is not None
@@ -287,12 +326,13 @@ class IndentationMachine:
             self._go(
                 State.RETRACTING, obs.t, "post-buckling record complete", obs.advance, obs.strains
             )
-            return Command(self.plan.home_advance, self.plan.roll, self.plan.fast_speed)
+            return Command(self._retract_goal(), self.plan.roll, self.plan.fast_speed)
         return Command(goal, self.plan.roll, self.plan.indent_speed)
 
     def _retracting(self, obs: Observation) -> Command:
         p = self.plan
-        if abs(obs.advance - p.home_advance) <= p.position_tolerance:
+        goal = self._retract_goal()
+        if abs(obs.advance - goal) <= p.position_tolerance:
             if self.marks.reason.startswith("aborted"):
                 target = State.ABORTED
             elif self.marks.reason == "completed":
@@ -301,7 +341,7 @@ class IndentationMachine:
                 target = State.FAULT
             self._go(target, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains)
             return self._terminal(obs)
-        return Command(p.home_advance, obs.roll, p.fast_speed)
+        return Command(goal, obs.roll, p.fast_speed)
 
     def _terminal(self, obs: Observation) -> Command:
         return Command(obs.advance, obs.roll, 0.0, torque=self.state is State.DONE)

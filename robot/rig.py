@@ -21,6 +21,7 @@ from typing import Literal
 
 import numpy as np
 
+from estimation.beamstate import axial_strain
 from robot.drive import DriveController, JointState
 from robot.indentation import Command, Observation
 from robot.motors import ServoFaultError, ServoTransportError
@@ -36,7 +37,11 @@ ContactMode = Literal["event", "fbg"]
 class RigSettings:
     tick: float = 2e-3  # s, control period
     contact: ContactMode = "event"
-    fbg_contact_strain: float = 20e-6  # compressive mean strain that means contact (FBG mode)
+    fbg_contact_strain: float = 20e-6  # compressive axial strain P/EA that means contact (FBG)
+    # The gratings' onset bending shape (estimation.beamstate.onset_mode) at the exposed length:
+    # FBG contact reads the axial strain with the bow of a not-quite-straight beam taken out.
+    # None: the mean strain (right for a straight beam only).
+    fbg_bending_mode: tuple[float, ...] | None = None
     sync_to_clock: bool = False  # simulation: wait for the frame of the current clock time
     frame_period: float = 1e-3  # s between board frames
     frame_wait_s: float = 0.2  # real-time bound on that wait
@@ -70,10 +75,12 @@ class ServoFbgRig:
         """Capture the strain baseline at rest over ``samples`` frames (the sensor is free)."""
         frames: list[Frame] = []
         for _ in range(samples * 10):
+            # Sleep first: a stream that has just started has no frame due yet, and waiting for
+            # one would only spin until the real-time bound.
+            self.clock.sleep(self.settings.tick)
             frames += self._receive()
             if len(frames) >= samples:
                 break
-            self.clock.sleep(self.settings.tick)
         if not frames:
             raise SensorPortError(f"board port {self.reader.port_name!r}: no frames to zero on")
         wl = np.stack([f.wavelengths for f in frames])
@@ -86,6 +93,7 @@ class ServoFbgRig:
     # -- Rig protocol ------------------------------------------------------------------------
     def observe(self, t: float) -> Observation:
         fault: str | None = None
+        lost = False
         try:
             joints, _ = self.drive.read()
             self._joints = joints
@@ -93,6 +101,7 @@ class ServoFbgRig:
             fault = str(exc)
         except ServoTransportError as exc:
             fault = f"bus transport: {exc}"
+            lost = True
         joints = self._joints or JointState(math.nan, math.nan)
         try:
             frames = self._receive()
@@ -110,7 +119,9 @@ class ServoFbgRig:
             if self.settings.contact == "event":
                 contact = bool(f.flags & Status.CONTACT_EVENT)
             else:
-                contact = float(np.mean(eps)) < -self.settings.fbg_contact_strain
+                mode = self.settings.fbg_bending_mode
+                axial = axial_strain(eps, mode) if mode else -float(np.mean(eps))
+                contact = axial > self.settings.fbg_contact_strain
         return Observation(
             t=t,
             advance=joints.translation,
@@ -119,6 +130,7 @@ class ServoFbgRig:
             contact=contact,
             stream_age=t - self._frame_t,
             servo_fault=fault,
+            bus_lost=lost,
         )
 
     def command(self, cmd: Command) -> None:

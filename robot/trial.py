@@ -58,6 +58,9 @@ class TrialResult:
     ticks: int
     duration: float  # simulated or wall seconds on the rig's clock
     transitions: list[Transition] = field(default_factory=list)
+    # (state after the tick, advance m, strains) per tick, as in the log's sample records: the
+    # whole-record estimators (``palpate.estimates``) read it without a log
+    record: list[tuple[str, float, tuple[float, ...]]] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -78,6 +81,7 @@ def run_trial(
 ) -> TrialResult:
     """Run one trial to DONE, FAULT or ABORTED; the rig is left retracted or torque-free."""
     transitions: list[Transition] = []
+    record: list[tuple[str, float, tuple[float, ...]]] = []
 
     def record_transition(tr: Transition) -> None:
         transitions.append(tr)
@@ -112,6 +116,7 @@ def run_trial(
                 recovered = True
                 rig.recover()
             rig.command(cmd)
+            record.append((machine.state.value, obs.advance, tuple(obs.strains)))
             if log is not None:
                 log.write(_sample_record(obs, machine.state, cmd))
             if on_tick is not None:
@@ -134,6 +139,7 @@ def run_trial(
         ticks=ticks,
         duration=clock.now() - t0,
         transitions=transitions,
+        record=record,
     )
 
 

@@ -42,6 +42,7 @@ class TrialLogWriter:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._fsync = fsync
+        self.records = 0  # lines written (header included), each flushed to the OS
         self._fh: IO[str] | None = open(self.path, "x", encoding="utf-8")  # noqa: SIM115
         self.write({"kind": "header", "format": FORMAT, "version": VERSION, **header})
 
@@ -53,6 +54,7 @@ class TrialLogWriter:
         self._fh.flush()
         if self._fsync:
             os.fsync(self._fh.fileno())
+        self.records += 1
 
     def close(self) -> None:
         if self._fh is not None:

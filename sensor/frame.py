@@ -182,6 +182,14 @@ class FrameLayout:
         return np.dtype(items)
 
 
+@lru_cache(maxsize=256)
+def layout_of(n_peaks: int, has_reference: bool = False, has_force: bool = False) -> FrameLayout:
+    """The shared :class:`FrameLayout` instance for these fields, so its cached ``struct`` and
+    ``dtype`` are built once per layout rather than once per frame (a frame's ``layout`` is
+    asked for on every encode and decode)."""
+    return FrameLayout(n_peaks, has_reference, has_force)
+
+
 def parse_header(header: bytes) -> FrameLayout:
     """The layout announced by six header bytes; :class:`FrameError` if impossible."""
     if len(header) < HEADER_SIZE:
@@ -191,7 +199,7 @@ def parse_header(header: bytes) -> FrameLayout:
     n, options, length = header[3], header[4], header[5]
     if not 1 <= n <= MAX_PEAKS or options & ~(OPTION_REFERENCE | OPTION_FORCE):
         raise FrameError("header", f"n_peaks {n} or options {options:#04x} out of range")
-    layout = FrameLayout(n, bool(options & OPTION_REFERENCE), bool(options & OPTION_FORCE))
+    layout = layout_of(n, bool(options & OPTION_REFERENCE), bool(options & OPTION_FORCE))
     if length != layout.payload_size:
         raise FrameError("header", f"length {length} impossible for {layout}")
     return layout
@@ -210,7 +218,7 @@ class Frame(NamedTuple):
 
     @property
     def layout(self) -> FrameLayout:
-        return FrameLayout(
+        return layout_of(
             len(self.peak_fm), self.reference_fm is not None, self.force_un is not None
         )
 
@@ -362,7 +370,7 @@ class FrameBlock:
 
     @property
     def layout(self) -> FrameLayout:
-        return FrameLayout(
+        return layout_of(
             int(self.peak_fm.shape[1]), self.reference_fm is not None, self.force_un is not None
         )
 

@@ -30,7 +30,8 @@ import serial
 
 from config.schema import BoardConfig, SensorConfig
 from sensor.clock import Clock, SystemClock
-from sensor.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, unpack
+from sensor.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
+from sensor.ports import open_failure
 
 SEQ_MOD = 2**32
 
@@ -163,7 +164,7 @@ class FrameParser:
 
 def layout_from_config(sensor: SensorConfig, board: BoardConfig) -> FrameLayout:
     """The stream's layout: one peak per used grating, in ``sensor.used_gratings`` order."""
-    return FrameLayout(len(sensor.used_gratings), board.has_reference, board.has_force)
+    return layout_of(len(sensor.used_gratings), board.has_reference, board.has_force)
 
 
 class FrameReader:
@@ -305,4 +306,4 @@ def _open(port: str, baudrate: int, timeout_s: float) -> SerialLike:
     try:
         return serial.serial_for_url(port, baudrate=baudrate, timeout=timeout_s)
     except (serial.SerialException, OSError, ValueError) as exc:
-        raise SensorPortError(f"cannot open board port {port!r}: {exc}") from exc
+        raise SensorPortError(open_failure("board", port, exc)) from exc

@@ -47,6 +47,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from estimation.corrections import (
+    dimitriadis_bracket,
+    dimitriadis_coefficients,
+    sneddon_bracket,
+    sneddon_bracket_at,
+    sneddon_y,
+    sneddon_y_at,
+)
+
 FloatArray = NDArray[np.float64]
 
 CHI_MAX = 1.0
@@ -108,27 +117,16 @@ class TissueModel:
         return self.layer_coefficients()
 
     def layer_coefficients(self) -> tuple[float, float, float, float]:
-        """The Dimitriadis bracket coefficients (k1, k2, k3, k4) of chi^1..chi^4."""
-        nu = self.poisson
-        if self.bonded:
-            a0 = -(1.2876 - 1.4678 * nu + 1.3442 * nu**2) / (1.0 - nu)
-            b0 = (0.6387 - 1.0277 * nu + 1.5164 * nu**2) / (1.0 - nu)
-        else:
-            a0 = -0.347 * (3.0 - 2.0 * nu) / (1.0 - nu)
-            b0 = 0.056 * (5.0 - 2.0 * nu) / (1.0 - nu)
-        pi = math.pi
-        k1 = -2.0 * a0 / pi
-        k2 = 4.0 * a0**2 / pi**2
-        k3 = -8.0 / pi**3 * (a0**3 + 4.0 * pi**2 / 15.0 * b0)
-        k4 = 16.0 * a0 / pi**4 * (a0**3 + 3.0 * pi**2 / 5.0 * b0)
-        return k1, k2, k3, k4
+        """The Dimitriadis bracket coefficients (k1, k2, k3, k4) of chi^1..chi^4
+        (``estimation.corrections.dimitriadis_coefficients``)."""
+        return dimitriadis_coefficients(self.poisson, self.bonded)
 
     # ----------------------------------------------------------------- public laws
     def contact_radius(self, delta: ArrayLike) -> FloatArray:
         """Contact radius a (m) at depth ``delta`` (m) for the active half-space law."""
         d = _depths(delta)
         if self.large_indentation:
-            return self.tip_radius * np.tanh(_sneddon_y(d / self.tip_radius))
+            return self.tip_radius * np.tanh(sneddon_y(d / self.tip_radius))
         return np.sqrt(self.tip_radius * d)
 
     def layer_ratio(self, delta: ArrayLike) -> FloatArray:
@@ -199,13 +197,13 @@ class TissueModel:
                 return 0.0, 0.0
             raise ValueError("indentation depth delta must be finite and >= 0")
         if self.large_indentation:
-            y = _sneddon_y_at(delta / R)
+            y = sneddon_y_at(delta / R)
             t = math.tanh(y)
             if t == 0.0:  # delta below ~1e-300 m
                 return 0.0, 0.0
             sech2 = 1.0 - t * t
             a = R * t
-            f0 = es * R**2 * _sneddon_bracket_at(y, t)
+            f0 = es * R**2 * sneddon_bracket_at(y, t)
             da = sech2 / (t + y * sech2)
         else:
             a = math.sqrt(R * delta)
@@ -259,7 +257,7 @@ class TissueModel:
             sech2 = 1.0 - t * t
             a = R * t
             d = R * v * t
-            f0 = es * R**2 * _sneddon_bracket_at(v, t)
+            f0 = es * R**2 * sneddon_bracket_at(v, t)
             dlog0 = v * 2.0 * es * R**2 * t * (t + v * sech2) / f0
             dlog_a = v * sech2 / t
         else:
@@ -288,7 +286,7 @@ class TissueModel:
             sech2 = 1.0 - t * t
             a = R * t
             d = R * v * t
-            f0 = es * R**2 * _sneddon_bracket(v, t)
+            f0 = es * R**2 * sneddon_bracket(v, t)
             dlog0 = v * 2.0 * es * R**2 * t * (t + v * sech2) / f0  # v dF0/dv / F0
             dlog_a = v * sech2 / np.where(t > 0, t, 1.0)  # v da/dv / a
         else:
@@ -308,10 +306,10 @@ class TissueModel:
         R = self.tip_radius
         es = self.reduced_modulus
         if self.large_indentation:
-            y = _sneddon_y(d / R)
+            y = sneddon_y(d / R)
             t = np.tanh(y)
             a = R * t
-            f0 = es * R**2 * _sneddon_bracket(y, t)
+            f0 = es * R**2 * sneddon_bracket(y, t)
             sech2 = 1.0 - t * t
             # da/ddelta = sech^2 / (tanh + y sech^2); the (y == 0) term only avoids 0/0.
             da = sech2 / (t + y * sech2 + (y == 0))
@@ -339,81 +337,12 @@ def _layer_bracket(
     chi: FloatArray, k: tuple[float, float, float, float]
 ) -> tuple[FloatArray, FloatArray]:
     """Dimitriadis bracket B(chi) and dB/dchi, continued linearly beyond CHI_MAX."""
-    k1, k2, k3, k4 = k
     c = np.minimum(chi, CHI_MAX)
-    b = 1.0 + c * (k1 + c * (k2 + c * (k3 + c * k4)))
-    db = k1 + c * (2.0 * k2 + c * (3.0 * k3 + c * 4.0 * k4))
-    over = chi - c
-    return b + db * over, db
-
-
-def _sneddon_bracket(y: FloatArray, t: FloatArray) -> FloatArray:
-    """(1 + tanh^2 y) y - tanh y = (y - tanh y) + y tanh^2 y, with a series for y - tanh y below
-    y = 0.05 (the direct difference loses 3 eps / y^2 relative; the series' truncation error is
-    below 1e-15 there)."""
-    y2 = y * y
-    series = (
-        y * y2 * (1 / 3 - y2 * (2 / 15 - y2 * (17 / 315 - y2 * (62 / 2835 - y2 * 1382 / 155925))))
-    )
-    return np.where(y < 0.05, series, y - t) + y * t * t
-
-
-def _layer_bracket_at(chi: float, k: tuple[float, float, float, float]) -> tuple[float, float]:
-    k1, k2, k3, k4 = k
-    c = min(chi, CHI_MAX)
-    b = 1.0 + c * (k1 + c * (k2 + c * (k3 + c * k4)))
-    db = k1 + c * (2.0 * k2 + c * (3.0 * k3 + c * 4.0 * k4))
+    b, db = dimitriadis_bracket(c, k)
     return b + db * (chi - c), db
 
 
-def _sneddon_bracket_at(y: float, t: float) -> float:
-    if y < 0.05:
-        y2 = y * y
-        series = (
-            y
-            * y2
-            * (1 / 3 - y2 * (2 / 15 - y2 * (17 / 315 - y2 * (62 / 2835 - y2 * 1382 / 155925))))
-        )
-        return series + y * t * t
-    return y - t + y * t * t
-
-
-def _sneddon_y_at(d: float) -> float:
-    y = math.sqrt(d) if d < 1.0 else d / math.tanh(d)
-    lo = 0.0
-    for _ in range(_MAX_ITER):
-        t = math.tanh(y)
-        g = y * t - d
-        if g < 0:
-            lo = y
-        new = y - g / (t + y * (1.0 - t * t))
-        if new <= lo:
-            new = 0.5 * (lo + y)
-        if abs(new - y) <= 1e-15 * y:
-            return new
-        y = new
-    return y
-
-
-def _sneddon_y(d_over_r: FloatArray) -> FloatArray:
-    """Solve y tanh(y) = d for y >= 0 (vectorised Newton from above; g is increasing).
-
-    g is convex where y tanh y < 1 and concave beyond; the start (sqrt(d) below d = 1, the upper
-    bound d / tanh(d) above) is within a few percent of the root, and iterates are kept above the
-    largest point known to lie left of the root. Converges in <= 6 steps for d in [1e-12, 1e3]."""
-    d = d_over_r
-    with np.errstate(divide="ignore", invalid="ignore"):
-        y = np.where(d < 1.0, np.sqrt(d), d / np.tanh(np.maximum(d, 1.0)))
-    lo = np.zeros_like(y)
-    for _ in range(_MAX_ITER):
-        t = np.tanh(y)
-        g = y * t - d
-        dg = t + y * (1.0 - t * t)
-        lo = np.where(g < 0, y, lo)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            new = np.where(dg > 0, y - g / dg, y)
-        new = np.where(new <= lo, 0.5 * (lo + y), new)
-        if np.all(np.abs(new - y) <= 1e-15 * np.maximum(y, 1e-300)):
-            return np.where(d > 0, new, 0.0)
-        y = new
-    return np.where(d > 0, y, 0.0)
+def _layer_bracket_at(chi: float, k: tuple[float, float, float, float]) -> tuple[float, float]:
+    c = min(chi, CHI_MAX)
+    b, db = dimitriadis_bracket(c, k)
+    return b + db * (chi - c), db

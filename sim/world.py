@@ -83,6 +83,7 @@ class WorldState:
     R: float
     strains: tuple[float, ...]
     contact_event: bool
+    encoder: int = 0  # the stage encoder count the board reports with this state
 
 
 class World:
@@ -131,12 +132,12 @@ class World:
 
     # -- physics ------------------------------------------------------------------------------
     def state(self, t: float) -> WorldState:
-        roll, translation, _ = self.joints()
+        roll, translation, encoder = self.joints()
         tip, tangent, length = self.pose(roll, translation)
         r_tip = self.sensor.tip_radius
         n = self.surface.normal
-        cos_a = float(-tangent @ n)  # 1 when the sensor points straight into the surface
-        centre_height = float((tip + length * tangent - self.surface.point) @ n)
+        cos_a = -float(tangent @ n)  # 1 when the sensor points straight into the surface
+        centre_height = float((tip - self.surface.point) @ n) - length * cos_a
         past = (r_tip - centre_height) / cos_a if cos_a > 0.05 else -math.inf
         strains: tuple[float, ...] = (0.0,) * len(self._centres)
         delta = e = P = R = 0.0
@@ -146,7 +147,7 @@ class World:
             delta, e, P, R, eps = self._table.at(past)
             strains = tuple(float(x) for x in eps)
         event = past > self.contact_offset
-        st = WorldState(t, roll, translation, length, past, delta, e, P, R, strains, event)
+        st = WorldState(t, roll, translation, length, past, delta, e, P, R, strains, event, encoder)
         self.last = st
         return st
 
@@ -159,18 +160,18 @@ class World:
             raise RuntimeError(f"contact equilibrium failed at L = {length:.6g} m: {sol.message}")
         R = np.abs(sol.R)
         r = R * length**2 / self.section.EI
-        e_eq = shortening_for_reaction(r) * length
+        g = shortening_for_reaction(r)  # e_g/L of the shape that carries this pin reaction
         half = 0.5 * self.sensor.grating_length
         centres = length - self._centres
         intervals = np.stack([centres - half, np.minimum(centres + half, length)], axis=-1)
-        eps = beam.grating_strains(e_eq, intervals)
+        eps = beam.bending_strains(g, intervals)
         eps = eps - (sol.P / self.section.EA)[:, None]
         return sol.delta, sol.e, sol.P, R, eps
 
     # -- what the board sends ----------------------------------------------------------------
     def sample(self, t: float) -> BoardSample:
         st = self.state(t)
-        _, _, encoder = self.joints()
+        encoder = st.encoder
         shift = self.fbg.strain_coefficient * np.asarray(st.strains)
         drift = self.fidelity.temperature_drift_degc_per_s * t
         if drift:
@@ -220,14 +221,20 @@ class ContactTable:
         self.grows = grows
         self.bin_width = bin_width
         self.n = max(2, round(bin_width / step)) + 1
-        self._bins: dict[int, tuple[Vector, list[tuple[Vector, ...]]]] = {}
+        self._bins: dict[int, tuple[Vector, list[Vector]]] = {}
 
-    def _bin(self, k: int) -> tuple[Vector, list[tuple[Vector, ...]]]:
+    def _bin(self, k: int) -> tuple[Vector, list[Vector]]:
+        """Bin ``k``: its u grid (n,) and, per edge length, the rows ``[delta, e, P, |R|,
+        strains...]`` on that grid, shape (n, 4 + G)."""
         if k not in self._bins:
             u = np.linspace(k * self.bin_width, (k + 1) * self.bin_width, self.n)
             edges = (k, k + 1) if self.grows else (k,)
             values = [
-                self.world.solve_on_grid(u, self.contact_length + j * self.bin_width * self.grows)
+                np.column_stack(
+                    self.world.solve_on_grid(
+                        u, self.contact_length + j * self.bin_width * self.grows
+                    )
+                )
                 for j in edges
             ]
             self._bins[k] = (u, values)
@@ -238,12 +245,10 @@ class ContactTable:
         grid, values = self._bin(k)
         i = min(int((u - grid[0]) / (grid[1] - grid[0])), self.n - 2)
         w_u = (u - grid[i]) / (grid[i + 1] - grid[i])
-        w_l = (u - grid[0]) / self.bin_width if self.grows else 0.0
-        out: list[Vector] = []
-        for q in range(5):
-            lo = values[0][q][i] * (1 - w_u) + values[0][q][i + 1] * w_u
-            if self.grows:
-                hi = values[1][q][i] * (1 - w_u) + values[1][q][i + 1] * w_u
-                lo = lo * (1 - w_l) + hi * w_l
-            out.append(np.asarray(lo))
-        return float(out[0]), float(out[1]), float(out[2]), float(out[3]), out[4]
+        row = values[0][i] * (1 - w_u) + values[0][i + 1] * w_u
+        if self.grows:
+            w_l = (u - grid[0]) / self.bin_width
+            hi = values[1][i] * (1 - w_u) + values[1][i + 1] * w_u
+            row = row * (1 - w_l) + hi * w_l
+        delta, e, P, R = row[:4].tolist()
+        return delta, e, P, R, row[4:]

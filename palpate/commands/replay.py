@@ -11,8 +11,9 @@ from typing import Any
 from config.loader import from_mapping
 from config.schema import SensorConfig, StackConfig, TubeConfig
 from estimation.section import Section
-from palpate.simtrial import estimate_from_marks, exposed_length_at
-from robot.triallog import TrialLogError, read_log
+from palpate.estimates import EstimatorInputs, joint_record
+from palpate.simtrial import estimate_from_marks, exposed_length_at, joint_from_rows
+from robot.triallog import TrialLog, TrialLogError, read_log
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -71,10 +72,29 @@ def replay(path: Path) -> dict[str, Any]:
         }
     )
     rec = report["recorded_modulus"]
-    report["identical"] = (modulus is None and rec is None) or (
+    paper_same = (modulus is None and rec is None) or (
         modulus is not None and rec is not None and math.isclose(modulus, rec, rel_tol=0, abs_tol=0)
     )
+    report["identical"] = paper_same and _replay_joint(log, stack, section, report)
     return report
+
+
+def _replay_joint(
+    log: TrialLog, stack: StackConfig, section: Section, report: dict[str, Any]
+) -> bool:
+    """Re-run the joint fit on the log's samples; True if it equals the recorded one exactly
+    (every field of the fit, compared as JSON values), or if the log predates it."""
+    recorded = next(log.of_kind("estimate"), None)
+    inputs = log.header.get("estimator")
+    if recorded is None or "joint" not in recorded or inputs is None:
+        report["joint"] = None
+        return True
+    rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
+    fit = joint_from_rows(rows, EstimatorInputs.from_dict(inputs), stack, section)
+    replayed = json.loads(json.dumps(joint_record(fit)))
+    report["joint"] = replayed
+    report["recorded_joint"] = recorded["joint"]
+    return bool(replayed == recorded["joint"])
 
 
 def _tuples(d: dict[str, Any]) -> dict[str, Any]:
@@ -97,5 +117,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"final state: {report['state']} ({report['reason']})")
         print(f"replayed estimate: {'-' if m is None else f'{m / 1e3:.3f} kPa'}")
         print(f"recorded estimate: {'-' if r is None else f'{r / 1e3:.3f} kPa'}")
+        j = report.get("joint")
+        if j is not None:
+            jm = j.get("modulus")
+            shown = "-" if jm is None else f"{jm / 1e3:.3f} kPa"
+            print(f"replayed joint fit: {shown} ({j['message']})")
         print("identical" if report["identical"] else "DIFFERENT")
     return 0 if report.get("identical") else 1

@@ -35,6 +35,7 @@ from robot.motors import (
     ServoIdentityError,
     ServoTransportError,
 )
+from sensor.ports import open_failure
 
 R = TypeVar("R")
 
@@ -135,7 +136,8 @@ class DynamixelBus:
         try:
             opened = self._port.openPort() and self._port.setBaudRate(self._baudrate)
         except (OSError, ValueError) as exc:  # pyserial's SerialException is an OSError
-            raise ServoTransportError(f"cannot open {self._port.getPortName()}: {exc}") from exc
+            name = self._port.getPortName()
+            raise ServoTransportError(open_failure("servo bus", name, exc)) from exc
         if not opened:
             raise ServoTransportError(f"cannot open {self._port.getPortName()}")
         self._connected = True
@@ -281,6 +283,12 @@ class DynamixelBus:
             self._raise_for_status(servo_id, error)
             raw = bytes(data)
             position = int.from_bytes(raw[10:14], "little", signed=True)
+            if abs(position) > tables.EXTENDED_POSITION_LIMIT:
+                # Beyond what extended position mode can reach or be commanded to: a corrupt
+                # reply that passed the CRC, never a goal to start the step clamp from.
+                raise ServoTransportError(
+                    f"servo {servo_id}: implausible present position {position} ticks"
+                )
             velocity = int.from_bytes(raw[6:10], "little", signed=True)
             out[self._by_id[servo_id].name] = MotorState(
                 position=units.rad_from_ticks(position),

@@ -41,6 +41,7 @@ from sim.dynamixel.servo import EmulatedServo
 _PING, _READ, _OTHER = 0, 1, 2  # reply kinds, compared with Status_Return_Level
 _CLEAR_KEY = bytes([0x01, 0x44, 0x58, 0x4C, 0x22])
 _REALTIME_POLL_S = 0.01
+_ID_ADDRESS = tables.X_SERIES_CONTROL_TABLE["ID"][0]
 
 
 class EmulatedBus:
@@ -159,7 +160,7 @@ class EmulatedBus:
 
     def _find(self, servo_id: int) -> EmulatedServo | None:
         for s in self._servos:
-            if s.id == servo_id:
+            if s.memory[_ID_ADDRESS] == servo_id:  # one byte: no lock needed
                 return s
         return None
 

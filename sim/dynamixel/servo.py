@@ -30,6 +30,7 @@ the indirect address area is not modelled.
 
 from __future__ import annotations
 
+import bisect
 import math
 import threading
 from typing import Final
@@ -71,6 +72,10 @@ class EmulatedServo:
         self.model_number = tables.MODEL_NUMBERS[self.model]
         self._table = tables.control_table(self.model)
         self._items = sorted((a, s, n) for n, (a, s) in self._table.items())
+        self._starts = [a for a, _, _ in self._items]
+        self._covered = bytearray(tables.TABLE_SIZE)  # 1 where an item of the table lives
+        for a, size, _ in self._items:
+            self._covered[a : a + size] = b"\x01" * size
         self._lock = threading.RLock()
         self.memory = bytearray(tables.TABLE_SIZE)
         self._reset_items(eeprom=True, keep=())
@@ -198,9 +203,7 @@ class EmulatedServo:
             if not data or address < 0 or end > tables.TABLE_SIZE:
                 return tables.ERR_ACCESS
             torque_on = self.memory[64] == 1
-            for a, size, name in self._items:
-                if a + size <= address or a >= end:
-                    continue
+            for a, size, name in self._overlapping(address, end):
                 if a < address or a + size > end:
                     return tables.ERR_DATA_LENGTH
                 if name in tables.READ_ONLY or (a < tables.EEPROM_END and torque_on):
@@ -213,10 +216,15 @@ class EmulatedServo:
                 error = self._check_value(name, value)
                 if error:
                     return error
-            for a in range(address, end):
-                if not any(ia <= a < ia + s for ia, s, _ in self._items):
-                    return tables.ERR_ACCESS
+            if 0 in self._covered[address:end]:
+                return tables.ERR_ACCESS  # a byte outside every item
             return 0
+
+    def _overlapping(self, address: int, end: int) -> list[tuple[int, int, str]]:
+        """The items that share a byte with ``[address, end)``, in address order."""
+        i = max(bisect.bisect_right(self._starts, address) - 1, 0)
+        j = bisect.bisect_left(self._starts, end, lo=i)
+        return [it for it in self._items[i:j] if it[0] + it[1] > address]
 
     def _check_value(self, name: str, value: int) -> int:
         bounds = tables.VALUE_RANGES.get(name)
@@ -245,12 +253,13 @@ class EmulatedServo:
             error = self.check_write(address, data)
             if error:
                 return error
+            end = address + len(data)
+            if self.memory[address:end] == data:
+                return 0  # the same bytes again (a streamed goal at rest): nothing changes
             before_torque = self.memory[64]
             before_mode = self.memory[11]
-            end = address + len(data)
-            for a, size, _ in self._items:
-                if address <= a and a + size <= end:
-                    self.memory[a : a + size] = data[a - address : a - address + size]
+            for a, size, _ in self._overlapping(address, end):
+                self.memory[a : a + size] = data[a - address : a - address + size]
             if self.memory[64] != before_torque:
                 self._vel = 0.0
                 if self.memory[64] == 1:
@@ -320,7 +329,12 @@ class EmulatedServo:
             dt = t - self._t
             if dt > 0:
                 self._t = t
+                before = (self._pos, self._vel, self._stalled)
                 self._integrate(dt)
+                if (self._pos, self._vel, self._stalled) == before and not self._stalled:
+                    # at rest: only the clock register moves
+                    self._set("Realtime_Tick", int(self._t * 1000.0) % 32768)
+                    return
             self._refresh()
 
     def _limits(self) -> tuple[float, float]:

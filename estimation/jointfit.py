@@ -1,0 +1,412 @@
+"""Contact-point-free stiffness: fit the modulus and the contact position jointly on a record.
+
+The paper's estimate (Eqs. 13-14) uses two instants, contact and buckling, so an error in the
+contact event goes straight into the indentation (E ~ delta^-1.5: 0.1 mm on 0.8 mm is 20 %). As
+AFM tools do, we treat the contact position x0 as a free parameter and fit the whole loading
+record instead: for every sample i (stage advance u_i, axial load P_i and beam shortening e_i
+from the strains, ``estimation.beamstate``)::
+
+    delta_i = u_i - x0 - e_i,        P_i = E f(delta_i)        (f = 0 for delta_i <= 0)
+
+with f the corrected contact law (``estimation.corrections.ContactLaw``). Samples before
+contact (f = 0) pin the baseline; loading samples give the curve's shape (which places x0) and
+its scale (E).
+
+Method.
+1. Scan x0 over ``contact_guess +- search`` on a grid; E is linear, so for each x0 it has a
+   closed form (weighted least squares): the global basin without local-minimum trouble.
+2. Refine (log E, x0) with ``scipy.optimize.least_squares`` and a robust loss (``soft_l1``,
+   ``f_scale`` in noise units) on residuals standardised by the effective variance
+   ``sigma_i^2 = sigma_P,i^2 + (E f'(delta_i))^2 (sigma_e,i^2 + q^2/12)``: the load's noise
+   plus the depth's (the strain-inferred shortening and the encoder's quantisation q).
+3. Confidence interval for E by profile likelihood over x0: with the weights frozen at the
+   solution (robust weights included, i.e. the last IRLS step), for each x0 on a fine grid E
+   has a closed form Ê(x0), the weighted residual RSS(x0) and curvature S(x0); the region
+   ``RSS(x0) + S(x0) (E - Ê(x0))^2 <= RSS_min + q_chi2 s^2`` projected on E is the interval,
+   and projected on x0 the contact interval. ``s^2`` inflates the nominal noise by the model
+   residual (reduced chi^2 when above 1) and by the residuals' lag-1 autocorrelation rho
+   ((1 + rho)/(1 - rho), the effective-sample-size factor for an AR(1) misfit), so a curve the
+   model does not follow gets a wider interval rather than a falsely tight one.
+4. Model form: the thin-layer series was derived for a paraboloid; with Sneddon's sphere its
+   layer ratio can be sqrt(R delta)/h (published, used for the estimate) or a/h. The modulus
+   refitted with the other choice (same x0 and weights) differs by ``model_spread``, which is
+   added in quadrature to both sides of the interval.
+
+Cost: ~10-40 ms for a 700-sample record (two vectorised law evaluations per least-squares step,
+a 121 x N scan, a 241 x N profile). Failure (too few points, no contact in the record, solver
+not converged, non-finite result) is a :class:`JointFit` with ``success`` False and a message;
+bad input raises ValueError.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from statistics import NormalDist
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from estimation.corrections import ContactLaw, validity_warnings
+from estimation.elastica._scipy import least_squares
+
+FloatArray = NDArray[np.float64]
+
+MIN_POINTS = 20
+MIN_CONTACT_POINTS = 10
+SCAN_POINTS = 121
+PROFILE_POINTS = 241
+MAX_RHO = 0.95
+MIN_SIGNIFICANCE = 5.0  # sigmas by which the contact model must beat "no load at all"
+
+
+@dataclass(frozen=True)
+class JointFit:
+    """Result of :func:`joint_fit`; moduli in Pa, positions in m.
+
+    Attributes:
+        success: True when E and x0 were fitted (check ``warnings`` too).
+        message: "ok" or what failed.
+        modulus: E, or None on failure.
+        contact: x0, the stage position at contact.
+        ci_low, ci_high: the confidence interval of E at ``confidence``.
+        contact_low, contact_high: the same for x0.
+        confidence: the interval's level.
+        n_points: samples used; n_contact: those with delta > 0 at the solution.
+        max_depth: the largest fitted indentation delta.
+        rms: rms of the standardised residuals (about 1 when the noise model holds).
+        noise_scale: s, the factor the nominal noise was inflated by for the interval.
+        model_spread: |E(other layer ratio) - E| (Pa), in the interval (0 for a half-space).
+        nfev: residual evaluations of the refinement.
+        law: the contact law's name.
+        warnings: validity flags and fit diagnostics, one sentence each.
+    """
+
+    success: bool
+    message: str
+    modulus: float | None = None
+    contact: float | None = None
+    ci_low: float | None = None
+    ci_high: float | None = None
+    contact_low: float | None = None
+    contact_high: float | None = None
+    confidence: float = 0.95
+    n_points: int = 0
+    n_contact: int = 0
+    max_depth: float | None = None
+    rms: float | None = None
+    noise_scale: float | None = None
+    model_spread: float | None = None
+    nfev: int = 0
+    law: str = ""
+    warnings: tuple[str, ...] = field(default=())
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready fields (SI units, as named)."""
+        return {
+            "success": self.success,
+            "message": self.message,
+            "modulus": self.modulus,
+            "contact": self.contact,
+            "ci_low": self.ci_low,
+            "ci_high": self.ci_high,
+            "contact_low": self.contact_low,
+            "contact_high": self.contact_high,
+            "confidence": self.confidence,
+            "n_points": self.n_points,
+            "n_contact": self.n_contact,
+            "max_depth": self.max_depth,
+            "rms": self.rms,
+            "noise_scale": self.noise_scale,
+            "model_spread": self.model_spread,
+            "nfev": self.nfev,
+            "law": self.law,
+            "warnings": list(self.warnings),
+        }
+
+
+def _vector(name: str, value: ArrayLike, n: int | None) -> FloatArray:
+    arr = np.asarray(value, dtype=np.float64)
+    if n is not None:
+        if arr.ndim > 1 or arr.size not in (1, n):
+            raise ValueError(f"{name} must have {n} values (one per sample), got {arr.shape}")
+        arr = np.broadcast_to(arr, (n,))
+    if arr.ndim != 1 or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be a finite 1-D array (or a scalar), got shape {arr.shape}")
+    return arr
+
+
+def _closed_form(
+    f: FloatArray, P: FloatArray, w: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Per row of f (K, N): Ê = sum w f P / sum w f^2, RSS at Ê, and S = sum w f^2."""
+    S = f * f @ w
+    safe = np.where(S > 0, S, 1.0)
+    E = np.where(S > 0, (f * P) @ w / safe, 0.0)
+    rss = ((P - E[:, None] * f) ** 2) @ w
+    return E, rss, S
+
+
+def _shapes(law: ContactLaw, depth_base: FloatArray, x0: FloatArray) -> FloatArray:
+    """f(u - x0 - e) for each x0 (K,): (K, N)."""
+    return law.shape(depth_base[None, :] - x0[:, None])[0]
+
+
+def joint_fit(
+    advance: ArrayLike,
+    force: ArrayLike,
+    shortening: ArrayLike,
+    law: ContactLaw,
+    *,
+    sigma_force: ArrayLike,
+    sigma_shortening: ArrayLike = 0.0,
+    encoder_resolution: float = 0.0,
+    contact_guess: float | None = None,
+    search: float = 1.0e-3,
+    confidence: float = 0.95,
+    f_scale: float = 3.0,
+    misalignment: float | None = None,
+    min_points: int = MIN_POINTS,
+    min_contact_points: int = MIN_CONTACT_POINTS,
+    max_nfev: int = 200,
+) -> JointFit:
+    """Fit E and the contact position x0 on a loading record (see the module docstring).
+
+    Args:
+        advance: (N,) stage positions u (m), from before contact to the end of loading.
+        force: (N,) axial loads P (N) inferred from the strains.
+        shortening: (N,) beam end shortening e (m) inferred from the strains.
+        law: the contact law ``F = E f(delta)``.
+        sigma_force: (N,) or scalar standard deviation of P (N, > 0).
+        sigma_shortening: (N,) or scalar standard deviation of e (m).
+        encoder_resolution: one encoder count of stage advance (m); adds q^2/12 to the depth
+            variance.
+        contact_guess: first guess of x0 (m), e.g. the contact event or
+            ``estimation.contactpoint``; None: the middle of the record's advance range.
+        search: x0 is searched within contact_guess +- search (m), and within the record.
+        confidence: the interval's level, in (0, 1).
+        f_scale: the robust loss's soft threshold, in noise units.
+        misalignment: angle (rad) between the sensor axis and the surface normal, for the flags.
+        min_points, min_contact_points: below these the fit is refused (success False).
+        max_nfev: least-squares budget.
+
+    Raises:
+        ValueError: non-finite or mismatched arrays, non-positive sigmas, bad options.
+    """
+    u = _vector("advance", advance, None)
+    n = u.size
+    P = _vector("force", force, n)
+    e = _vector("shortening", shortening, n)
+    sig_p = _vector("sigma_force", sigma_force, n)
+    sig_e = _vector("sigma_shortening", sigma_shortening, n)
+    if np.any(sig_p <= 0) or np.any(sig_e < 0):
+        raise ValueError("sigma_force must be > 0 and sigma_shortening >= 0")
+    if not (0.0 < confidence < 1.0):
+        raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
+    if not (math.isfinite(search) and search > 0 and f_scale > 0 and encoder_resolution >= 0):
+        raise ValueError("search and f_scale must be > 0, encoder_resolution >= 0")
+
+    def failed(message: str, n_contact: int = 0, nfev: int = 0) -> JointFit:
+        return JointFit(
+            False,
+            message,
+            n_points=n,
+            n_contact=n_contact,
+            nfev=nfev,
+            confidence=confidence,
+            law=law.name,
+        )
+
+    if n < min_points:
+        return failed(f"too few points: {n} samples, the fit needs {min_points}")
+    depth_base = u - e  # delta = depth_base - x0
+    var_depth = sig_e**2 + encoder_resolution**2 / 12.0
+
+    # 1. scan x0 with E in closed form
+    guess = 0.5 * (float(u.min()) + float(u.max())) if contact_guess is None else contact_guess
+    if not math.isfinite(guess):
+        raise ValueError(f"contact_guess must be finite, got {contact_guess!r}")
+    lo = max(guess - search, float(u.min()) - search)
+    hi = min(guess + search, float(depth_base.max()))
+    if not hi > lo:
+        return failed("no contact: the record ends before the contact search window")
+    grid = np.linspace(lo, hi, SCAN_POINTS)
+    w0 = 1.0 / sig_p**2
+    E_grid, rss_grid, S_grid = _closed_form(_shapes(law, depth_base, grid), P, w0)
+    usable = (S_grid > 0) & (E_grid > 0)
+    if not np.any(usable):
+        return failed("no contact: no contact position in the window gives a positive load")
+    k = int(np.argmin(np.where(usable, rss_grid, np.inf)))
+    theta0 = np.array([math.log(E_grid[k]), grid[k]])
+
+    # 2. robust refinement with the effective variance
+    x0_scale = max(1e-6, (hi - lo) / SCAN_POINTS)
+
+    def sigma(theta: FloatArray) -> FloatArray:
+        f, df = law.shape(depth_base - theta[1])
+        del f
+        slope = math.exp(theta[0]) * df
+        return np.asarray(np.sqrt(sig_p**2 + slope**2 * var_depth))
+
+    def residuals(theta: FloatArray) -> FloatArray:
+        f, df = law.shape(depth_base - theta[1])
+        E = math.exp(theta[0])
+        return np.asarray((P - E * f) / np.sqrt(sig_p**2 + (E * df) ** 2 * var_depth))
+
+    try:
+        sol = least_squares(
+            residuals,
+            theta0,
+            loss="soft_l1",
+            f_scale=f_scale,
+            bounds=([-np.inf, lo], [np.inf, hi]),
+            x_scale=np.array([1.0, x0_scale]),
+            max_nfev=max_nfev,
+        )
+    except (ValueError, FloatingPointError) as exc:
+        return failed(f"least squares failed: {exc}")
+    if sol.status <= 0 or not np.all(np.isfinite(sol.x)):
+        return failed(f"least squares did not converge: {sol.message}", nfev=int(sol.nfev))
+    E_hat, x0_hat = math.exp(float(sol.x[0])), float(sol.x[1])
+    depth = depth_base - x0_hat
+    n_contact = int(np.count_nonzero(depth > 0))
+    if n_contact < min_contact_points:
+        return failed(
+            f"no contact: {n_contact} samples past the fitted contact point, the fit needs "
+            f"{min_contact_points}",
+            n_contact,
+            int(sol.nfev),
+        )
+
+    # 3. profile likelihood over x0 with the weights frozen at the solution
+    r = residuals(sol.x)
+    robust = 1.0 / np.sqrt(1.0 + (r / f_scale) ** 2)  # soft_l1's IRLS weight
+    w = robust / sigma(sol.x) ** 2
+    dof = max(1, n - 2)
+    chi2_red = float(np.sum(robust * r * r)) / dof
+    rho = _lag1(r[depth > 0])
+    scale2 = max(1.0, chi2_red) * (1.0 + rho) / (1.0 - rho)
+    threshold = NormalDist().inv_cdf(0.5 + 0.5 * confidence) ** 2 * scale2  # chi2(1) quantile
+    gain = float(np.sum(w * P * P) - np.sum(w * (P - E_hat * law.shape(depth)[0]) ** 2))
+    if gain < MIN_SIGNIFICANCE**2 * scale2:
+        return failed(
+            f"no contact: the fitted load is not significant (chi^2 gain {gain / scale2:.3g} "
+            f"over zero load, needs {MIN_SIGNIFICANCE**2:g})",
+            n_contact,
+            int(sol.nfev),
+        )
+    jac = sol.jac  # of the standardised residuals in (log E, x0)
+    try:
+        cov = np.linalg.inv(jac.T @ jac) * scale2
+        sd_x0 = math.sqrt(max(cov[1, 1], 0.0))
+    except np.linalg.LinAlgError:
+        sd_x0 = search
+    span = min(max(8.0 * sd_x0, 2e-6), search)
+    prof = _profile(law, depth_base, P, w, x0_hat, span, threshold, lo, hi)
+    warnings = list(validity_warnings(law, float(depth.max()), misalignment))
+    if prof is None:
+        return failed(
+            "profile likelihood failed: no contact position gives a positive load",
+            n_contact,
+            int(sol.nfev),
+        )
+    ci_low, ci_high, c_low, c_high, edge = prof
+    spread = _model_spread(law, depth_base, P, w, x0_hat)
+    ci_low = E_hat - math.hypot(E_hat - ci_low, spread)
+    ci_high = E_hat + math.hypot(ci_high - E_hat, spread)
+    if edge:
+        warnings.append("the contact position's interval reaches the search window's edge")
+    if rho > 0.5:
+        warnings.append(
+            f"residuals are correlated (lag-1 {rho:.2f}): the model misses part of the curve; "
+            f"the interval is widened by {math.sqrt((1 + rho) / (1 - rho)):.2g}x"
+        )
+    if not np.all(np.isfinite([ci_low, ci_high, E_hat])):
+        return failed("non-finite modulus or interval", n_contact, int(sol.nfev))
+    return JointFit(
+        success=True,
+        message="ok",
+        modulus=E_hat,
+        contact=x0_hat,
+        ci_low=ci_low,
+        ci_high=ci_high,
+        contact_low=c_low,
+        contact_high=c_high,
+        confidence=confidence,
+        n_points=n,
+        n_contact=n_contact,
+        max_depth=float(depth.max()),
+        rms=float(np.sqrt(np.mean(r * r))),
+        noise_scale=math.sqrt(scale2),
+        model_spread=spread,
+        nfev=int(sol.nfev),
+        law=law.name,
+        warnings=tuple(warnings),
+    )
+
+
+def _model_spread(
+    law: ContactLaw, depth_base: FloatArray, P: FloatArray, w: FloatArray, x0: float
+) -> float:
+    """|E with the other thin-layer ratio - E| at x0 (0 when the choice does not arise)."""
+    if law.thickness is None or not law.large_indentation:
+        return 0.0
+    other = dataclasses.replace(
+        law, layer_ratio_from="sphere" if law.layer_ratio_from == "published" else "published"
+    )
+    x = np.array([x0])
+    E0 = _closed_form(_shapes(law, depth_base, x), P, w)[0][0]
+    E1 = _closed_form(_shapes(other, depth_base, x), P, w)[0][0]
+    return abs(float(E1 - E0))
+
+
+def _lag1(r: FloatArray) -> float:
+    """Lag-1 autocorrelation of residuals in record order, clipped to [0, MAX_RHO]."""
+    if r.size < 3:
+        return 0.0
+    c = r - r.mean()
+    denom = float(c @ c)
+    if denom == 0.0:
+        return 0.0
+    return min(max(float(c[1:] @ c[:-1]) / denom, 0.0), MAX_RHO)
+
+
+def _profile(
+    law: ContactLaw,
+    depth_base: FloatArray,
+    P: FloatArray,
+    w: FloatArray,
+    x0_hat: float,
+    span: float,
+    threshold: float,
+    lo: float,
+    hi: float,
+) -> tuple[float, float, float, float, bool] | None:
+    """E and x0 intervals from the profile over x0; widens the grid until the region closes
+    (at most 5 times, x3 each; still open then: reported as reaching the edge)."""
+    tries = 6
+    for attempt in range(tries):
+        a, b = max(lo, x0_hat - span), min(hi, x0_hat + span)
+        grid = np.linspace(a, b, PROFILE_POINTS)
+        E, rss, S = _closed_form(_shapes(law, depth_base, grid), P, w)
+        ok = S > 0
+        if not np.any(ok):
+            return None
+        best = float(np.min(rss[ok]))
+        inside = ok & (rss <= best + threshold)
+        idx = np.nonzero(inside)[0]
+        window_edge = bool((inside[0] and a <= lo) or (inside[-1] and b >= hi))
+        open_grid = bool(inside[0] or inside[-1]) and not window_edge
+        if open_grid and attempt < tries - 1:
+            span *= 3.0
+            continue
+        h = np.sqrt(np.maximum(best + threshold - rss[idx], 0.0) / S[idx])
+        return (
+            float(np.min(E[idx] - h)),
+            float(np.max(E[idx] + h)),
+            float(grid[idx[0]]),
+            float(grid[idx[-1]]),
+            window_edge or open_grid,
+        )
+    return None

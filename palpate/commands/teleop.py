@@ -1,0 +1,261 @@
+"""Jog roll, advance and tube from the keyboard; live pose, strains and flags; store poses.
+
+``palpate teleop`` runs on the simulator by default (both emulators in-process, real time, a
+world with a tissue sample of a scene, so strains and contact respond), on the real bench with
+``--config config/bench.yaml``, or on any two ports with ``--servo-port`` and ``--board-port``.
+The terminal interface is the standard library's curses (no extra dependency; it runs over ssh
+and in tmux, which the tests use); the jog logic, limits and screen text are
+:mod:`robot.teleop`. Torque is released on quit, on Ctrl-C, on SIGTERM/SIGHUP and on a crash.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import curses
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from config import CONFIG_DIR, load, load_stack, resolve
+from config.bench import load_bench
+from config.scene import CampaignConfig, SceneConfig
+from config.schema import StackConfig
+from config.targets import save_target
+from palpate.benchtrial import detector_for, guards_for, rig_settings
+from palpate.hardware import open_hardware, run_on_hardware
+from palpate.simbench import SimulatedBench
+from robot.indentation import State
+from robot.rig import ServoFbgRig
+from robot.teleop import Teleop, render
+from sensor.clock import Clock, SystemClock
+from sensor.strain import StrainChain
+
+DRAW_PERIOD_S = 0.05
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--config", help="a bench file: real ports, robot, limits, targets")
+    parser.add_argument("--servo-port", help="Dynamixel bus port (with --board-port)")
+    parser.add_argument("--board-port", help="acquisition board port (with --servo-port)")
+    parser.add_argument("--robot", default="robot.yaml", help="robot file with explicit ports")
+    parser.add_argument(
+        "--scene", default="scenes/robot.yaml", help="simulator: the scene whose tissue is used"
+    )
+    parser.add_argument("--sample", help="simulator: the scene's sample (default: the first)")
+    parser.add_argument("--tube", help="the tube mounted at start (default: the first)")
+    parser.add_argument(
+        "--targets", type=Path, help="where s saves poses (default: the bench file's targets)"
+    )
+    parser.add_argument("--rate", type=float, default=100.0, help="control ticks per second")
+
+
+@dataclass
+class Session:
+    """What the terminal loop drives; built by :func:`run`."""
+
+    model: Teleop
+    rig: ServoFbgRig
+    clock: Clock
+    tick: float
+    targets: Path
+    title: str
+    sim: SimulatedBench | None = None
+    saved: list[str] = field(default_factory=list)
+
+
+def run(args: argparse.Namespace) -> int:
+    if not (sys.stdin.isatty() and sys.stdout.isatty()):
+        raise ValueError("palpate teleop needs a terminal (stdin and stdout)")
+    if not 1.0 <= args.rate <= 1000.0:
+        raise ValueError(f"--rate: {args.rate} outside 1..1000 ticks per second")
+    if (args.servo_port is None) != (args.board_port is None):
+        raise ValueError("--servo-port and --board-port go together")
+    sim: SimulatedBench | None = None
+    ports: dict[str, Any] = {}
+    if args.config is not None:
+        loaded = load_bench(args.config)
+        stack, campaign, targets = loaded.stack, loaded.bench.campaign, loaded.targets_path
+        ports = {
+            "servo_key": f"servos.port in {loaded.path}",
+            "board_key": f"board.port in {loaded.path}",
+        }
+        mode = f"bench {loaded.path}"
+    elif args.servo_port is not None:
+        stack, campaign = load_stack(args.robot), CampaignConfig()
+        targets = CONFIG_DIR / "targets.yaml"
+        ports = {"servo_key": "--servo-port", "board_key": "--board-port"}
+        mode = f"ports {args.servo_port} {args.board_port}"
+    else:
+        scene = load(SceneConfig, resolve(args.scene))
+        stack, campaign = load_stack(resolve(scene.robot)), scene.campaign
+        targets = CONFIG_DIR / "targets.yaml"
+        _check_tube(stack, args.tube)
+        sim = SimulatedBench(stack, scene, sample=args.sample, tube=args.tube, wire=False)
+        s = sim.sample
+        mode = f"simulator: sample {s.name} ({s.modulus_kpa:g} kPa), scene {scene.name}"
+    if args.servo_port is not None:
+        ports.update(servo_port=args.servo_port, board_port=args.board_port)
+    if sim is not None:
+        ports.update(servo_port=sim.servo_port, board_port=sim.board_port)
+    if args.targets is not None:
+        targets = args.targets
+    _check_tube(stack, args.tube)
+    summary: dict[str, Any] = {}
+
+    def body() -> int:
+        with contextlib.ExitStack() as stack_:
+            if sim is not None:
+                stack_.enter_context(sim)
+            hw = stack_.enter_context(open_hardware(stack, clock=SystemClock(), **ports))
+            session = _session(stack, campaign, hw.drive, hw.reader, hw.clock, args, targets)
+            session.title = f"palpate teleop ({mode})"
+            session.sim = sim
+            try:
+                os.environ.setdefault("ESCDELAY", "25")  # a lone Esc cancels at once
+                summary.update(curses.wrapper(_loop, session))
+            finally:
+                session.rig.release()
+        return 0
+
+    code = run_on_hardware("teleop", body, stopped_exit=0)
+    if code or not summary:
+        return code
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        for name in summary["saved"]:
+            print(f"saved target {name!r} in {summary['targets']}")
+        print(f"final state {summary['state']}; torque off")
+    return 0
+
+
+def _check_tube(stack: StackConfig, name: str | None) -> None:
+    if name is not None and name not in [t.name for t in stack.tubes]:
+        raise ValueError(f"--tube: no tube {name!r}; known: {[t.name for t in stack.tubes]}")
+
+
+def _session(
+    stack: StackConfig,
+    campaign: CampaignConfig,
+    drive: Any,
+    reader: Any,
+    clock: Clock,
+    args: argparse.Namespace,
+    targets: Path,
+) -> Session:
+    tick = 1.0 / args.rate
+    settings = rig_settings(campaign, stack, tick)
+    rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
+    chain = rig.zero()  # the sensor must be free now, as before a trial
+    model = Teleop(
+        stack.drive,
+        stack.tubes,
+        guards_for(campaign, stack, tick),
+        detector_for(campaign, chain),
+        tube_name=args.tube,
+    )
+    return Session(model, rig, clock, tick, targets, "palpate teleop")
+
+
+_SPECIAL_KEYS = {
+    curses.KEY_UP: "up",
+    curses.KEY_DOWN: "down",
+    curses.KEY_LEFT: "left",
+    curses.KEY_RIGHT: "right",
+    curses.KEY_ENTER: "enter",
+    10: "enter",
+    13: "enter",
+    27: "escape",
+    curses.KEY_BACKSPACE: "backspace",
+    127: "backspace",
+    8: "backspace",
+}
+
+
+def key_name(code: int) -> str | None:
+    """A curses key code as the key name :mod:`robot.teleop` uses; None for others."""
+    if code in _SPECIAL_KEYS:
+        return _SPECIAL_KEYS[code]
+    if 32 <= code < 127:
+        return chr(code)
+    return None
+
+
+def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
+    with contextlib.suppress(curses.error):
+        curses.curs_set(0)
+    stdscr.nodelay(True)
+    stdscr.keypad(True)
+    model, rig, clock = s.model, s.rig, s.clock
+    recovered = False
+    next_draw = next_tick = clock.now()
+    while True:
+        while (code := stdscr.getch()) != -1:
+            name = key_name(code)
+            effect = model.press(name) if name is not None else None
+            if effect is None:
+                continue
+            if effect.kind == "quit":
+                return _summary(s)
+            if effect.kind == "save":
+                _save(s, effect.value)
+            elif effect.kind == "recover":
+                recovered = False
+                if not rig.recover():
+                    model.fail("could not clear the servo fault: power-cycle the servos")
+            elif effect.kind == "tube" and s.sim is not None:
+                s.sim.tube = s.sim.stack.tube(effect.value)  # the operator swapped the tube
+        obs = rig.observe(clock.now())
+        cmd = model.step(obs)
+        if obs.servo_fault is not None and model.state is State.RETRACTING and not recovered:
+            recovered = True  # one reboot so the sensor can be pulled back, as in a trial
+            rig.recover()
+        rig.command(cmd)
+        now = clock.now()
+        if now >= next_draw:
+            _draw(stdscr, render(model.view(), _width(stdscr), s.title))
+            next_draw = now + DRAW_PERIOD_S
+        # fell behind (a slow draw)? then do not try to catch up in a burst
+        next_tick = max(next_tick + s.tick, now)
+        clock.sleep(next_tick - now)
+
+
+def _save(s: Session, name: str) -> None:
+    try:
+        save_target(s.targets, s.model.target(name, note="saved by palpate teleop"))
+    except (OSError, ValueError) as exc:
+        s.model.message = f"not saved: {exc}"
+        return
+    s.saved.append(name)
+    s.model.message = f"saved pose {name!r} in {s.targets}"
+
+
+def _width(stdscr: Any) -> int:
+    _, w = stdscr.getmaxyx()
+    return max(1, int(w) - 1)
+
+
+def _draw(stdscr: Any, lines: list[str]) -> None:
+    stdscr.erase()
+    h, _ = stdscr.getmaxyx()
+    for row, line in enumerate(lines[: max(0, int(h))]):
+        with contextlib.suppress(curses.error):
+            stdscr.addstr(row, 0, line)
+    stdscr.refresh()
+
+
+def _summary(s: Session) -> dict[str, Any]:
+    obs = s.model.obs
+    return {
+        "state": s.model.state.value,
+        "tube": s.model.tube.name,
+        "roll_deg": None if obs is None else math.degrees(obs.roll),
+        "translation_mm": None if obs is None else obs.advance * 1e3,
+        "saved": s.saved,
+        "targets": str(s.targets),
+    }

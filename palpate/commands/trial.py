@@ -1,0 +1,192 @@
+"""Run scripted indentation trials on the real bench: ports, stored poses and protocol from a YAML.
+
+``palpate trial --config config/bench.yaml [--target NAME] [--dry-run]``. The trials run through
+the same state machine and trial loop as ``palpate sim``, with dynamixel-sdk on the servo port and
+pyserial on the board port; each writes its log as it goes. ``--dry-run`` checks the file, the
+targets and the limits and shows the plan without opening a port.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from config.bench import LoadedBench, load_bench
+from estimation.stiffness import summarize
+from palpate.benchtrial import (
+    SKIPPED,
+    BenchOutcome,
+    BenchTrial,
+    plan_bench_trials,
+    run_bench_trials,
+)
+from palpate.hardware import open_hardware, port_problem, run_on_hardware
+from sensor.clock import Clock
+from sensor.reader import SerialLike
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--config", default="bench.yaml", help="the bench file (default: config/bench.yaml)"
+    )
+    parser.add_argument("--target", help="run only the trials at this stored pose")
+    parser.add_argument(
+        "--dry-run", action="store_true", help="check and show the plan; open no port"
+    )
+    parser.add_argument("--log-dir", type=Path, help="overrides log_dir of the bench file")
+
+
+def run_session(
+    loaded: LoadedBench,
+    trials: list[BenchTrial],
+    log_dir: Path,
+    *,
+    servo_port: str | Any | None = None,
+    board_port: str | SerialLike | None = None,
+    clock: Clock | None = None,
+    sync_to_clock: bool = False,
+    progress: Callable[[BenchOutcome], None] | None = None,
+) -> list[BenchOutcome]:
+    """Open the bench (ports from the file unless given) and run ``trials``; torque is off and
+    the ports closed on return, whatever happened. Tests pass the emulators' ptys and a
+    virtual clock (with ``sync_to_clock``)."""
+    key = str(loaded.path)
+    with open_hardware(
+        loaded.stack,
+        servo_port=servo_port,
+        board_port=board_port,
+        clock=clock,
+        servo_key=f"servos.port in {key}",
+        board_key=f"board.port in {key}",
+    ) as hw:
+        return run_bench_trials(
+            hw, trials, loaded, log_dir, sync_to_clock=sync_to_clock, progress=progress
+        )
+
+
+def run(args: argparse.Namespace) -> int:
+    loaded = load_bench(args.config)
+    trials = plan_bench_trials(loaded, args.target)
+    if args.dry_run:
+        return _dry_run(loaded, trials, args.json)
+    base = args.log_dir if args.log_dir is not None else Path(loaded.bench.log_dir)
+    log_dir = base / time.strftime("%Y%m%d-%H%M%S")
+    quiet = args.json
+
+    def progress(o: BenchOutcome) -> None:
+        if not quiet:
+            print(_row(o.as_dict()), flush=True)
+
+    if not quiet:
+        print(f"{len(trials)} trial(s) from {loaded.path}; logs in {log_dir}")
+        print(_HEAD)
+    outcomes: list[BenchOutcome] = []
+
+    def body() -> int:
+        outcomes.extend(run_session(loaded, trials, log_dir, progress=progress))
+        return 0
+
+    code = run_on_hardware("trial", body)
+    if code:
+        return code
+    samples = _summaries(outcomes, loaded.bench.campaign.outlier_above_kpa * 1e3)
+    if args.json:
+        payload = {
+            "bench": str(loaded.path),
+            "log_dir": str(log_dir),
+            "trials": [o.as_dict() for o in outcomes],
+            "samples": samples,
+        }
+        print(json.dumps(payload, indent=2))
+    else:
+        for o in outcomes:
+            if o.state == SKIPPED:
+                print(_row(o.as_dict()))
+        for s in samples:
+            rel = s["relative_error"]
+            print(
+                f"sample {s['sample']}: mean {_kpa(s['mean_kpa'])} kPa vs {s['actual_kpa']:.2f} "
+                f"kPa, RMSE {_kpa(s['rmse_kpa'])}, IQR {_kpa(s['iqr_kpa'])}, relative error "
+                + ("-" if rel is None else f"{100 * rel:+.1f} %")
+                + f" ({s['count']} kept, {s['outliers']} outliers, {s['failed']} failed)"
+            )
+    return 0 if all(o.state == "done" for o in outcomes) else 1
+
+
+def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> int:
+    stack = loaded.stack
+    ports = {
+        "servos": (stack.servos.port, port_problem(stack.servos.port, "servo bus", "servos.port")),
+        "board": (
+            stack.board.port,
+            port_problem(stack.board.port, "acquisition board", "board.port"),
+        ),
+    }
+    if as_json:
+        payload = {
+            "bench": str(loaded.path),
+            "targets": str(loaded.targets_path),
+            "ports": {k: {"port": p, "problem": why} for k, (p, why) in ports.items()},
+            "trials": [t.describe() for t in trials],
+        }
+        print(json.dumps(payload, indent=2))
+        return 0
+    print(f"bench file {loaded.path}, targets {loaded.targets_path}: {len(trials)} trial(s)")
+    for name, (port, why) in ports.items():
+        print(f"  {name} port {port}: {why or 'present'}")
+    for t in trials:
+        d = t.describe()
+        print(
+            f"  {d['trial']}: tube {d['tube']}, roll {d['roll_deg']:.1f} deg, stand-off "
+            f"{d['standoff_translation_mm']:.3f} mm, contact expected at "
+            f"{d['contact_translation_mm']:.3f} mm (exposed {d['exposed_length_mm']:.2f} mm), "
+            f"retract to {d['retract_translation_mm']:.3f} mm"
+        )
+    print("dry run: no port opened, nothing moved")
+    return 0
+
+
+def _summaries(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[str, Any]]:
+    """Per sample with a known modulus: mean, RMSE, IQR, relative error (Tables I/II)."""
+    by_sample: dict[str, list[BenchOutcome]] = {}
+    for o in outcomes:
+        if o.trial.modulus is not None and o.state != SKIPPED:
+            by_sample.setdefault(o.trial.sample, []).append(o)
+    rows = []
+    for name, outs in by_sample.items():
+        actual = outs[0].trial.modulus
+        assert actual is not None
+        s = summarize([o.estimate for o in outs], actual, outlier_above)
+        rows.append(
+            {
+                "sample": name,
+                "actual_kpa": actual / 1e3,
+                "mean_kpa": None if s.mean is None else s.mean / 1e3,
+                "rmse_kpa": None if s.rmse is None else s.rmse / 1e3,
+                "iqr_kpa": None if s.iqr is None else s.iqr / 1e3,
+                "relative_error": s.relative_error,
+                "count": s.count,
+                "outliers": s.outliers,
+                "failed": s.failed,
+            }
+        )
+    return rows
+
+
+_HEAD = f"{'trial':<28} {'state':<9} {'E kPa':>9} {'actual':>9} {'rel.err':>8}  reason"
+
+
+def _kpa(v: float | None) -> str:
+    return "-" if v is None else f"{v:.2f}"
+
+
+def _row(d: dict[str, Any]) -> str:
+    rel = "-" if d["relative_error"] is None else f"{100 * d['relative_error']:+.1f}%"
+    return (
+        f"{d['trial']:<28} {d['state']:<9} {_kpa(d['estimated_kpa']):>9} "
+        f"{_kpa(d['actual_kpa']):>9} {rel:>8}  {d['reason']}"
+    )

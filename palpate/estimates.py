@@ -1,0 +1,142 @@
+"""The contact-point-free estimate of one trial, from its loading record (trial and replay alike).
+
+A trial's record is one row per control tick: state, stage advance (encoder, m) and grating
+strains. The joint fit uses the loading rows (approach to the end of the post-buckling travel):
+``estimation.beamstate`` turns each row's strains into the axial load and the beam's end
+shortening, ``estimation.contactpoint`` gives a model-independent first guess of the contact,
+and ``estimation.jointfit`` fits the modulus and the contact position together. It never uses
+the contact event: a late or early event cannot bias it.
+
+The strain noise is measured on the record itself (each row's 3-grating fit has one degree of
+freedom left; the median of its squared residual gives sigma), so nothing about the simulator's
+noise setting leaks in. What the estimator is told about the sample (thickness, bonding, Poisson
+ratio) is written to the log header under ``"estimator"`` so ``palpate replay`` re-runs it with
+the same inputs and reproduces the fit bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import asdict, dataclass
+from statistics import NormalDist
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from config.schema import SensorConfig
+from estimation.beamstate import infer_states
+from estimation.contactpoint import baseline_deviation
+from estimation.corrections import ContactLaw
+from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
+from estimation.section import Section
+from sensor.strain import grating_intervals
+
+FloatArray = NDArray[np.float64]
+LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})
+_UNIT_SIGMA = 1e-6  # infer_states is linear in sigma: run at 1e-6, rescale by the measured one
+
+
+@dataclass(frozen=True)
+class EstimatorInputs:
+    """What the joint fit is told besides the record (all SI).
+
+    Attributes:
+        kind: "bench" (exposed length fixed) or "robot" (L = advance - flush translation).
+        exposed_length: L on the bench (m); flush_translation: the tube's, on the robot (m).
+        tip_radius, poisson: the tip and the sample's Poisson ratio.
+        thickness: sample layer thickness (m) on a rigid substrate, None for a half-space.
+        bonded: the layer is glued to its substrate.
+        encoder_resolution: stage advance per encoder count (m).
+        misalignment: angle between the sensor axis and the surface normal (rad), the IK residual.
+    """
+
+    kind: str
+    exposed_length: float
+    flush_translation: float
+    tip_radius: float
+    poisson: float
+    thickness: float | None
+    bonded: bool
+    encoder_resolution: float
+    misalignment: float
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> EstimatorInputs:
+        return cls(**d)
+
+    def law(self) -> ContactLaw:
+        return ContactLaw(self.tip_radius, self.poisson, self.thickness, self.bonded, True)
+
+
+def loading_rows(
+    rows: Iterable[tuple[str, float, Sequence[float]]], gratings: int
+) -> tuple[FloatArray, FloatArray]:
+    """(advance (N,), strains (N, G)) of the loading rows (state, advance, strains) in order."""
+    adv: list[float] = []
+    eps: list[Sequence[float]] = []
+    for state, advance, strains in rows:
+        if state in LOADING_STATES and len(strains) == gratings:
+            adv.append(advance)
+            eps.append(strains)
+    return np.asarray(adv, dtype=np.float64), np.asarray(eps, dtype=np.float64).reshape(
+        -1, gratings
+    )
+
+
+def strain_sigma(residual: FloatArray, gratings: int) -> float:
+    """Per-grating strain noise from per-row rms residuals of the 2-parameter fit (median-based,
+    so a few rows the model misses do not inflate it)."""
+    dof = gratings - 2
+    ss = gratings * residual**2  # sum of squares per row ~ sigma^2 chi2(dof)
+    # chi2(1)'s median is exact through the normal; Wilson-Hilferty (< 1 % off) above
+    median = NormalDist().inv_cdf(0.75) ** 2 if dof == 1 else dof * (1 - 2 / (9 * dof)) ** 3
+    return max(math.sqrt(float(np.median(ss)) / median), 1e-9)
+
+
+def joint_estimate(
+    advance: FloatArray,
+    strains: FloatArray,
+    inputs: EstimatorInputs,
+    sensor: SensorConfig,
+    section: Section,
+) -> JointFit:
+    """The joint fit of one trial's loading record (see the module docstring)."""
+    law = inputs.law()
+    n, gratings = strains.shape
+    if n < MIN_POINTS:
+        return JointFit(False, f"too few points: {n} loading samples, the fit needs {MIN_POINTS}")
+    if inputs.kind == "robot":
+        lengths = advance - inputs.flush_translation
+    else:
+        lengths = np.full(n, inputs.exposed_length)
+    intervals = grating_intervals(sensor, 0.0)[None, :, :] + lengths[:, None, None]
+    states = infer_states(
+        strains, intervals, lengths, section.EA, section.fiber_offset, _UNIT_SIGMA
+    )
+    k = strain_sigma(states.residual, gratings) / _UNIT_SIGMA
+    guess = baseline_deviation(advance, states.P, baseline_points=min(30, n // 4))
+    if not guess.success:
+        return JointFit(False, guess.message, n_points=n, law=law.name)
+    return joint_fit(
+        advance,
+        states.P,
+        states.e,
+        law,
+        sigma_force=k * states.sigma_P,
+        sigma_shortening=k * states.sigma_e,
+        encoder_resolution=inputs.encoder_resolution,
+        contact_guess=guess.position,
+        misalignment=inputs.misalignment,
+    )
+
+
+def joint_record(fit: JointFit | None) -> dict[str, Any]:
+    """The joint fit as it goes into the log's estimate record and ``--json``."""
+    if fit is None:
+        return {"success": False, "message": "no loading record"}
+    return fit.as_dict()

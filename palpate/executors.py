@@ -1,0 +1,127 @@
+"""Where campaign trials run: a standard ``concurrent.futures.Executor``, chosen by name.
+
+- ``process`` (default): a local process pool, one trial per core (``workers`` = 1: serial).
+- ``thread``: a thread pool (the GIL serialises most of the work; useful to check that trials
+  share no state, and where processes cannot be forked).
+- ``serial``: every trial in the calling thread, in order.
+- ``dask``: a Dask distributed client's executor (``Client.get_executor()``, the
+  ``concurrent.futures`` interface). With ``scheduler`` an address (``tcp://host:8786``) it uses a
+  running cluster; without, it starts a local one with ``workers`` worker processes. Dask is an
+  optional extra (``pip install 'palpate[dask]'``), imported only when asked for.
+
+No scheduling of our own: every backend is an Executor, ``palpate.campaign.run_campaign``
+submits one job per trial and each trial is seeded by its spec, so results do not depend on
+which executor ran them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import importlib
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
+from typing import Any, TypeVar
+
+T = TypeVar("T")
+
+
+class ExecutorUnavailableError(ValueError):
+    """The executor asked for cannot be built here (missing optional dependency, bad option)."""
+
+
+class SerialExecutor(Executor):
+    """Runs each submitted call at once in the caller's thread (an Executor with no workers)."""
+
+    def submit(self, fn: Callable[..., T], /, *args: Any, **kwargs: Any) -> Future[T]:
+        future: Future[T] = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except BaseException as exc:
+            future.set_exception(exc)
+        return future
+
+
+@contextlib.contextmanager
+def _serial(workers: int, scheduler: str | None) -> Iterator[Executor]:
+    yield SerialExecutor()
+
+
+@contextlib.contextmanager
+def _threads(workers: int, scheduler: str | None) -> Iterator[Executor]:
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        yield pool
+
+
+@contextlib.contextmanager
+def _processes(workers: int, scheduler: str | None) -> Iterator[Executor]:
+    if workers == 1:  # a pool of one process only adds start-up and pickling
+        yield SerialExecutor()
+        return
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        yield pool
+
+
+@contextlib.contextmanager
+def _dask(workers: int, scheduler: str | None) -> Iterator[Executor]:
+    try:  # optional: typed as Any, so the code checks the same with or without it installed
+        distributed: Any = importlib.import_module("distributed")
+    except ImportError as exc:
+        raise ExecutorUnavailableError(
+            "--executor dask needs Dask distributed, an optional extra: "
+            "pip install 'palpate[dask]' (or pip install distributed)"
+        ) from exc
+    if scheduler:
+        with distributed.Client(scheduler) as client:
+            yield client.get_executor()
+        return
+    with (
+        distributed.LocalCluster(
+            n_workers=workers, threads_per_worker=1, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        yield client.get_executor()
+
+
+EXECUTORS: dict[str, Callable[[int, str | None], contextlib.AbstractContextManager[Executor]]] = {
+    "process": _processes,
+    "thread": _threads,
+    "serial": _serial,
+    "dask": _dask,
+}
+"""Executor name -> context manager factory ``(workers, scheduler) -> Executor``."""
+
+
+def open_executor(
+    kind: str, workers: int = 1, scheduler: str | None = None
+) -> contextlib.AbstractContextManager[Executor]:
+    """The executor called ``kind`` (a key of ``EXECUTORS``), shut down when the block ends.
+
+    Raises:
+        ExecutorUnavailableError: unknown kind, ``workers`` < 1, a scheduler address for a local
+            executor, or Dask not installed.
+    """
+    if kind not in EXECUTORS:
+        raise ExecutorUnavailableError(f"unknown executor {kind!r}; known: {sorted(EXECUTORS)}")
+    if workers < 1:
+        raise ExecutorUnavailableError(f"--workers must be >= 1, got {workers}")
+    if scheduler and kind != "dask":
+        raise ExecutorUnavailableError(f"--scheduler is for --executor dask, not {kind!r}")
+    return EXECUTORS[kind](workers, scheduler)
+
+
+def add_executor_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--executor`` and ``--scheduler`` for a command that runs campaigns (with ``--workers``)."""
+    parser.add_argument(
+        "--executor",
+        choices=sorted(EXECUTORS),
+        default="process",
+        help="where trials run: local process pool (default), threads, serial, or Dask",
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="Dask scheduler address (tcp://host:8786) for --executor dask; "
+        "without it a local Dask cluster is started",
+    )

@@ -1,0 +1,204 @@
+"""Open the bench's real interfaces: the servo bus and the acquisition board, on the ports named.
+
+:func:`open_hardware` is a context manager that opens the board's stream first, then the
+Dynamixel bus through the real ``dynamixel_sdk`` (connect, identify, profiles, software homing,
+torque on), and on the way out always turns torque off and closes both ports, whatever happened.
+Ports are parameters: device paths on the bench, the emulators' pseudo-terminals in tests, or
+already built transports (an SDK ``PortHandler``, a serial-like object) for the in-process path,
+so tests run exactly this code. The clock is a parameter too (:class:`SystemClock` on hardware).
+
+When a port cannot be opened the error (:class:`HardwareError`) names the port and says what to
+do: plug it in, join the ``dialout`` group, close the program that holds it. These operator
+hints live here only; the drivers report the bare failure.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from types import FrameType
+from typing import Any
+
+from config.schema import StackConfig
+from robot.drive import DriveController
+from robot.dynamixel.driver import DynamixelBus
+from robot.motors import ServoFaultError, ServoTransportError
+from sensor.clock import Clock, SystemClock
+from sensor.reader import FrameReader, SensorPortError, SerialLike
+
+SIM_PORT = "sim"
+LIST_PORTS = "python -m serial.tools.list_ports"
+
+
+class HardwareError(OSError):
+    """A bench port cannot be opened or does not answer; the message names it and the remedy."""
+
+
+class Terminated(BaseException):  # like KeyboardInterrupt, not an error
+    """SIGTERM or SIGHUP arrived: unwind (torque off, logs closed) and exit."""
+
+
+@dataclass
+class Hardware:
+    """The opened bench: the drive (homed, torque on), the FBG frame reader and the clock."""
+
+    drive: DriveController
+    reader: FrameReader
+    clock: Clock
+
+
+def port_problem(port: str, role: str, key: str) -> str | None:
+    """What is wrong with a device path before opening it, or None (also for pyserial URLs).
+
+    ``role`` is what the port is for ("servo bus"), ``key`` where it is configured.
+    """
+    if port == SIM_PORT:
+        return (
+            f"{role} port is {SIM_PORT!r} (the simulator): name the device in {key}, "
+            f"e.g. /dev/ttyUSB0 (list the ports with `{LIST_PORTS}`)"
+        )
+    if "://" in port:
+        return None
+    if not os.path.exists(port):
+        return _hint(errno.ENOENT, port, role, key)
+    if not os.access(port, os.R_OK | os.W_OK):
+        return _hint(errno.EACCES, port, role, key)
+    return None
+
+
+def _hint(code: int | None, port: str, role: str, key: str) -> str:
+    if code == errno.ENOENT:
+        return (
+            f"{role} port {port}: no such device. Is it plugged in and powered? List the serial "
+            f"ports with `{LIST_PORTS}` and set {key}"
+        )
+    if code in (errno.EACCES, errno.EPERM):
+        return (
+            f"{role} port {port}: permission denied. Add your user to the group that owns it "
+            "(usually dialout): `sudo usermod -aG dialout $USER`, then log out and in again"
+        )
+    if code == errno.EBUSY:
+        return (
+            f"{role} port {port}: busy. Another program holds it (Dynamixel Wizard, a serial "
+            "monitor, another palpate): close it and try again"
+        )
+    return f"{role} port {port}: cannot open it"
+
+
+def _errno_of(exc: BaseException) -> int | None:
+    """The OS error number behind a driver's exception (pyserial keeps it on its exception)."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        code = getattr(seen, "errno", None)
+        if isinstance(code, int):
+            return code
+        seen = seen.__cause__ or seen.__context__
+    return None
+
+
+def explain(exc: BaseException, port: str, role: str, key: str) -> HardwareError:
+    """A :class:`HardwareError` for a failed open or a silent bus, with the remedy."""
+    code = _errno_of(exc)
+    if code is not None:
+        return HardwareError(f"{_hint(code, port, role, key)} ({exc})")
+    if isinstance(exc, ServoTransportError) and not str(exc).startswith("cannot open"):
+        return HardwareError(
+            f"{role} port {port} opened but the servos do not answer ({exc}). Check the servo "
+            "power supply, the cable, the IDs and the baud rate (servos.* of the robot file)"
+        )
+    return HardwareError(f"{role} port {port}: {exc}")
+
+
+def _name(port: str | Any) -> str:
+    if isinstance(port, str):
+        return port
+    getter = getattr(port, "getPortName", None)
+    return str(getter() if callable(getter) else getattr(port, "name", port))
+
+
+@contextlib.contextmanager
+def open_hardware(
+    stack: StackConfig,
+    *,
+    servo_port: str | Any | None = None,
+    board_port: str | SerialLike | None = None,
+    clock: Clock | None = None,
+    servo_key: str = "servos.port",
+    board_key: str = "board.port",
+) -> Iterator[Hardware]:
+    """Open the board, then the servo bus (homed at the present pose, torque on); yield them.
+
+    Ports default to ``stack.servos.port`` and ``stack.board.port``. ``servo_key`` and
+    ``board_key`` say where the ports are configured, for the messages. Raises
+    :class:`HardwareError` if a port cannot be opened or the servos do not answer.
+    """
+    sp = stack.servos.port if servo_port is None else servo_port
+    bp = stack.board.port if board_port is None else board_port
+    clock = clock if clock is not None else SystemClock()
+    for port, role, key in ((bp, "acquisition board", board_key), (sp, "servo bus", servo_key)):
+        if isinstance(port, str) and (problem := port_problem(port, role, key)):
+            raise HardwareError(problem)
+    try:
+        reader = FrameReader.from_config(bp, stack.sensor, stack.board, clock=clock)
+    except SensorPortError as exc:
+        raise explain(exc, _name(bp), "acquisition board", board_key) from exc
+    try:
+        drive = DriveController(DynamixelBus.from_config(stack.servos, port=sp), stack.drive)
+        try:
+            drive.start()
+        except ServoTransportError as exc:
+            drive.close()
+            raise explain(exc, _name(sp), "servo bus", servo_key) from exc
+        except BaseException:
+            drive.close()
+            raise
+        try:
+            yield Hardware(drive, reader, clock)
+        finally:
+            drive.close()  # torque off on every servo, then the port is released
+    finally:
+        reader.close()
+
+
+@contextlib.contextmanager
+def terminate_as_interrupt() -> Iterator[None]:
+    """Turn SIGTERM and SIGHUP into :class:`Terminated` while inside, so ``finally`` blocks run
+    (torque off) when the process is killed or its terminal closes. No-op off the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        raise Terminated(signal.Signals(signum).name)
+
+    previous = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+def run_on_hardware(command: str, body: Callable[[], int], *, stopped_exit: int = 1) -> int:
+    """Run ``body`` (which opens the bench) with SIGTERM/SIGHUP as interrupts, and turn what
+    can go wrong with the hardware into a message on stderr and an exit code: 1 when a port
+    cannot be opened or a servo or stream fails, ``stopped_exit`` when interrupted. Torque is
+    already off by then: ``open_hardware`` released it on the way out."""
+    try:
+        with terminate_as_interrupt():
+            return body()
+    except HardwareError as exc:
+        print(f"palpate {command}: {exc}", file=sys.stderr)
+        return 1
+    except (ServoTransportError, ServoFaultError, SensorPortError) as exc:
+        print(f"palpate {command}: hardware fault, torque off: {exc}", file=sys.stderr)
+        return 1
+    except (KeyboardInterrupt, Terminated) as exc:
+        print(f"palpate {command}: stopped ({type(exc).__name__}), torque off", file=sys.stderr)
+        return stopped_exit

@@ -1,0 +1,37 @@
+"""What to tell the user when a serial port cannot be opened: one wording for every device.
+
+The common case on Linux is a permission error (EACCES): serial devices belong to the
+``dialout`` group (``uucp`` on some distributions), and the user is not in it.
+"""
+
+from __future__ import annotations
+
+import errno
+
+DIALOUT_HINT = (
+    "permission denied: add your user to the 'dialout' group "
+    "(sudo usermod -aG dialout $USER, then log out and in again) or give the device to that "
+    'group with a udev rule (/etc/udev/rules.d/, MODE="0660", GROUP="dialout")'
+)
+
+
+def open_failure(device: str, port: str, exc: BaseException) -> str:
+    """The message for a port that did not open: the device, the port, the cause and, for a
+    permission error, what to do about it."""
+    if _is_permission_error(exc):
+        return f"cannot open {device} port {port!r}: {DIALOUT_HINT} ({exc})"
+    return f"cannot open {device} port {port!r}: {exc}"
+
+
+def _is_permission_error(exc: BaseException) -> bool:
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:  # pyserial wraps the OSError; follow the chain
+        seen.add(id(e))
+        if isinstance(e, PermissionError) or getattr(e, "errno", None) in (
+            errno.EACCES,
+            errno.EPERM,
+        ):
+            return True
+        e = e.__cause__ or e.__context__
+    return False

@@ -1,0 +1,69 @@
+"""``palpate design``: the proposal, the simulated check on kPa phantoms, and how it refuses."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from palpate.cli import main
+
+QUICK = ["--tip-radii-mm", "3,4,5,6,8", "--wire-diameters-um", "25,50,100"]
+
+
+def test_design_for_soft_tissue_and_its_simulated_check(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["design", "--modulus-range", "1:10", "--unit", "kPa", "--json", *QUICK]
+    code = main([*argv, "--moduli", "3", "--lengths", "1", "--executor", "serial"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert out["success"] is True
+    d = out["design"]
+    assert d["modulus_range_kpa"] == [1.0, 10.0]
+    assert d["depth_ratio_at_min_modulus"] <= 0.1
+    assert d["contact_ratio_at_min_modulus"] <= 0.1
+    assert d["delta_at_max_modulus_mm"] * 1e-3 >= 20 * out["encoder_resolution_um"] * 1e-6
+    assert all(c["ok"] for c in d["checks"])
+    assert d["critical_load_mn"] < 10  # the paper's sensor buckles at 1353 mN
+    trials = out["campaign"]["trials"]
+    assert [t["actual_kpa"] for t in trials] == pytest.approx([1.0, 10**0.5, 10.0])
+    assert {t["exposed_length_mm"] for t in trials} == {round(d["exposed_length_mm"], 1)}
+    # the soft sensor reaches DONE on every phantom, and the paper's estimate lands close:
+    # the remaining error is the layer (a/h ~ 0.09) and large-indentation bias of the tissue
+    assert all(t["state"] == "done" for t in trials)
+    assert all(abs(t["relative_error_paper"]) < 0.25 for t in trials)
+    assert out["campaign"]["paper"]["median_abs_relative_error"] < 0.2
+
+
+def test_text_output_without_the_campaign(capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["design", "--modulus-range", "300:1100", "--thickness-mm", "10", "--no-sim"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert out.startswith("design: ")
+    for label in ("exposed length", "tip radius", "delta at 300 kPa", "detector threshold"):
+        assert label in out
+    assert "simulated bench campaign" not in out
+
+
+def test_an_impossible_range_exits_2_and_says_why(capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["design", "--modulus-range", "1:100", "--json", *QUICK])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 2
+    assert out["success"] is False
+    assert "too wide for any sensor" in out["message"]
+    assert out["campaign"] is None
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["--modulus-range", "10:1"], "--modulus-range"),
+        (["--modulus-range", "soft"], "MIN:MAX"),
+        (["--modulus-range", "1:10", "--tip-radii-mm", "3,x"], "--tip-radii-mm"),
+        (["--modulus-range", "1:10", "--executor", "process", "--scheduler", "tcp://h:1"], "dask"),
+    ],
+)
+def test_bad_arguments_exit_2(
+    argv: list[str], needle: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["design", *argv]) == 2
+    assert needle in capsys.readouterr().err

@@ -1,0 +1,111 @@
+"""Campaigns through standard executors: the same trials give the same results on every one."""
+
+from __future__ import annotations
+
+import json
+import sys
+from concurrent.futures import Executor
+from pathlib import Path
+
+import pytest
+
+from config import load, load_stack, resolve
+from config.scene import SceneConfig
+from palpate.campaign import campaign_trials, run_campaign
+from palpate.cli import main
+from palpate.executors import EXECUTORS, ExecutorUnavailableError, SerialExecutor, open_executor
+from palpate.simtrial import TrialOutcome, TrialSpec
+
+STACK = load_stack()
+BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
+# three trials on different samples and lengths (every 7th of the 55 of the bench campaign)
+SPECS: list[TrialSpec] = campaign_trials(BENCH, STACK, seed=4)[::7][:3]
+
+
+def _fingerprint(outcomes: list[TrialOutcome]) -> list[tuple[object, ...]]:
+    """What must not depend on the executor: trial, state, estimate, encoder ticks, sim time."""
+    rows = []
+    for o in outcomes:
+        est = o.estimate
+        rows.append(
+            (
+                o.spec.trial_id,
+                o.state,
+                None if est is None else est.modulus,
+                None if est is None else est.delta,
+                None if est is None else est.force,
+                o.ticks,
+                o.sim_time,
+            )
+        )
+    return rows
+
+
+@pytest.fixture(scope="module")
+def serial() -> list[tuple[object, ...]]:
+    return _fingerprint(run_campaign(SPECS, BENCH, STACK))
+
+
+def test_the_reference_run_estimates_every_trial(serial: list[tuple[object, ...]]) -> None:
+    assert [r[0] for r in serial] == [s.trial_id for s in SPECS]
+    assert len({s.sample for s in SPECS}) == 3
+    assert all(r[1] == "done" and r[2] is not None for r in serial)
+
+
+@pytest.mark.parametrize("kind", ["serial", "thread", "process"])
+def test_results_do_not_depend_on_the_executor(kind: str, serial: list[tuple[object, ...]]) -> None:
+    seen: list[str] = []
+    with open_executor(kind, workers=2) as executor:
+        outcomes = run_campaign(
+            SPECS, BENCH, STACK, executor=executor, progress=lambda o: seen.append(o.spec.trial_id)
+        )
+    assert _fingerprint(outcomes) == serial  # in the order of the specs, bit for bit
+    assert sorted(seen) == sorted(s.trial_id for s in SPECS)  # progress once per trial
+
+
+def test_a_local_dask_cluster_gives_the_same_results(serial: list[tuple[object, ...]]) -> None:
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        executor: Executor = client.get_executor()
+        outcomes = run_campaign(SPECS, BENCH, STACK, executor=executor)
+    assert _fingerprint(outcomes) == serial
+
+
+def test_serial_executor_reports_errors_through_the_future() -> None:
+    future = SerialExecutor().submit(int, "not a number")
+    assert future.done()
+    with pytest.raises(ValueError, match="invalid literal"):
+        future.result()
+    assert SerialExecutor().submit(pow, 2, 10).result() == 1024
+
+
+def test_bad_executor_requests_are_refused_clearly(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert set(EXECUTORS) == {"process", "thread", "serial", "dask"}
+    with pytest.raises(ExecutorUnavailableError, match="unknown executor 'ray'"):
+        open_executor("ray")
+    with pytest.raises(ExecutorUnavailableError, match="--scheduler is for --executor dask"):
+        open_executor("process", 2, "tcp://127.0.0.1:8786")
+    with pytest.raises(ExecutorUnavailableError, match="--workers must be >= 1"):
+        open_executor("thread", 0)
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if it were not installed
+    with pytest.raises(ExecutorUnavailableError, match=r"palpate\[dask\]"), open_executor("dask"):
+        pass
+
+
+def test_palpate_sim_takes_the_executor_flag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["sim", "--campaign", "bench", "--limit", "2", "--seed", "4", "--no-plots", "--json"]
+    code = main([*argv, "--out", str(tmp_path), "--executor", "thread", "--workers", "2"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    trials = campaign_trials(BENCH, STACK, seed=4)[:2]
+    assert [t["trial"] for t in out["trials"]] == [s.trial_id for s in trials]
+    assert all(t["state"] == "done" for t in out["trials"])
+    assert main([*argv, "--out", str(tmp_path), "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    assert "--scheduler is for --executor dask" in capsys.readouterr().err

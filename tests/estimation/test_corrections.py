@@ -1,0 +1,119 @@
+"""Thin-layer and large-indentation corrections against their published limits."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from estimation.contact import hertz_force
+from estimation.corrections import (
+    ContactLaw,
+    dimitriadis_bracket,
+    dimitriadis_coefficients,
+    validity_warnings,
+)
+from sim.tissue import TissueModel
+
+R = 3.5e-3
+DEPTHS = np.array([1e-6, 1e-5, 1e-4, 3e-4, 1e-3])
+
+
+def test_dimitriadis_bonded_incompressible_bracket_is_the_published_one() -> None:
+    # Dimitriadis et al. 2002: 1 + 1.133 chi + 1.283 chi^2 + 0.769 chi^3 - 0.0975 chi^4 (nu = 0.5)
+    k = dimitriadis_coefficients(0.5, bonded=True)
+    assert k == pytest.approx((1.133, 1.283, 0.769, -0.0975), abs=6e-4)
+
+
+def test_dimitriadis_non_bonded_incompressible_bracket_is_the_published_one() -> None:
+    # ... and 1 + 0.884 chi + 0.781 chi^2 + 0.386 chi^3 + 0.0048 chi^4 for a sliding layer
+    k = dimitriadis_coefficients(0.5, bonded=False)
+    assert k == pytest.approx((0.884, 0.781, 0.386, 0.0048), abs=6e-4)
+
+
+def test_bracket_is_one_at_zero_thickness_ratio_and_grows() -> None:
+    k = dimitriadis_coefficients(0.45, bonded=True)
+    b, db = dimitriadis_bracket(np.array([0.0, 0.1, 0.5]), k)
+    assert b[0] == 1.0
+    assert np.all(np.diff(b) > 0)
+    assert db[0] == pytest.approx(k[0])
+
+
+def test_thick_layer_recovers_hertz() -> None:
+    hertz = hertz_force(1.0, DEPTHS, R, 0.45)
+    for h in (1.0, 100.0):  # m: chi = sqrt(R delta)/h -> 0
+        law = ContactLaw(R, 0.45, thickness=h, large_indentation=False)
+        assert law.shape(DEPTHS)[0] == pytest.approx(hertz, rel=2e-3 / h)
+    half_space = ContactLaw(R, 0.45, thickness=None, large_indentation=False)
+    np.testing.assert_allclose(half_space.shape(DEPTHS)[0], hertz, rtol=1e-14)
+
+
+def test_sneddon_tends_to_hertz_for_shallow_indentation_and_is_softer_deeper() -> None:
+    sneddon = ContactLaw(R, 0.3, thickness=None, large_indentation=True)
+    ratio = sneddon.shape(DEPTHS)[0] / hertz_force(1.0, DEPTHS, R, 0.3)
+    assert ratio[0] == pytest.approx(1.0 - 0.1 * DEPTHS[0] / R, abs=2e-6)  # delta/R = 3e-4
+    # about -0.1 delta/R: 1 % softer at delta/R = 0.1, 2.7 % at 0.29
+    assert 0.98 < float(sneddon.shape(0.1 * R)[0] / hertz_force(1.0, 0.1 * R, R, 0.3)) < 0.995
+    assert np.all(np.diff(ratio) < 0)
+
+
+@pytest.mark.parametrize("ratio_from", ["published", "sphere"])
+@pytest.mark.parametrize("large", [True, False])
+def test_shape_derivative_matches_finite_differences(ratio_from: str, large: bool) -> None:
+    law = ContactLaw(R, 0.45, 10e-3, True, large, ratio_from)  # type: ignore[arg-type]
+    d = np.array([2e-5, 3e-4, 1.2e-3])
+    h = 1e-9
+    fd = (law.shape(d + h)[0] - law.shape(d - h)[0]) / (2 * h)
+    np.testing.assert_allclose(law.shape(d)[1], fd, rtol=1e-5)
+
+
+def test_no_force_before_contact_and_inverse_for_modulus() -> None:
+    law = ContactLaw(R, 0.45, 10e-3)
+    f, df = law.shape(np.array([-1e-3, 0.0]))
+    assert np.all(f == 0.0)
+    assert np.all(df == 0.0)
+    F = law.force(250e3, DEPTHS)
+    np.testing.assert_allclose(law.modulus(F, DEPTHS), 250e3, rtol=1e-12)
+    with pytest.raises(ValueError, match="delta"):
+        law.modulus(1.0, 0.0)
+
+
+def test_the_simulator_uses_the_same_published_constants() -> None:
+    for bonded in (True, False):
+        tissue = TissueModel(1e5, 0.45, 10e-3, bonded, R, True, True)
+        assert tissue.layer_coefficients() == dimitriadis_coefficients(0.45, bonded)
+    # the sim's composition (chi = a/h with Sneddon's a) is the estimator's alternative one
+    tissue = TissueModel(1.0, 0.45, 10e-3, True, R, True, True)
+    law = ContactLaw(R, 0.45, 10e-3, True, True, "sphere")
+    np.testing.assert_allclose(law.shape(DEPTHS)[0], tissue.force(DEPTHS), rtol=1e-12)
+    published = ContactLaw(R, 0.45, 10e-3)
+    assert not np.allclose(published.shape(DEPTHS)[0], tissue.force(DEPTHS), rtol=1e-3)
+
+
+def test_validity_warnings() -> None:
+    law = ContactLaw(R, 0.45, 10e-3)
+    assert validity_warnings(law, 1e-5) == ()
+    deep = validity_warnings(law, 1e-3, misalignment=math.radians(8))
+    assert any("Sneddon" in w for w in deep)
+    assert any("Dimitriadis thin-layer correction applied" in w for w in deep)
+    assert any("8.0 deg off the surface normal" in w for w in deep)
+    thin = validity_warnings(ContactLaw(R, 0.45, 1e-3), 1e-3)
+    assert any("beyond the Dimitriadis series' range" in w for w in thin)
+    hertz = validity_warnings(ContactLaw(R, 0.45, None, large_indentation=False), 1e-3)
+    assert any("small-strain" in w and "corrected" not in w for w in hertz)
+
+
+def test_bad_input_is_rejected_by_name() -> None:
+    with pytest.raises(ValueError, match="poisson"):
+        dimitriadis_coefficients(0.6, True)
+    with pytest.raises(ValueError, match="tip_radius"):
+        ContactLaw(0.0, 0.45)
+    with pytest.raises(ValueError, match="thickness"):
+        ContactLaw(R, 0.45, thickness=-1.0)
+    with pytest.raises(ValueError, match="layer_ratio_from"):
+        ContactLaw(R, 0.45, 1e-2, True, True, "paraboloid")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="delta"):
+        ContactLaw(R, 0.45).shape(np.array([np.nan]))
+    with pytest.raises(ValueError, match="misalignment"):
+        validity_warnings(ContactLaw(R, 0.45), 1e-4, misalignment=math.inf)

@@ -1,0 +1,177 @@
+"""Sensor design for a modulus range: Hertz inverse, checks, search, and how it fails."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from estimation.contact import hertz_force
+from estimation.design import (
+    CHECKS,
+    DesignConstraints,
+    DesignSpace,
+    SensorDesign,
+    design_sensor,
+    evaluate_design,
+    hertz_depth,
+    imperfection_state,
+)
+from estimation.section import composite_section, euler_load
+from sim.contact import MODE_SHORTENING
+
+KPA = 1e3
+PAPER = SensorDesign(
+    fiber_radius=0.115e-3,
+    fiber_modulus=67e9,
+    wire_count=4,
+    wire_radius=0.1e-3,
+    wire_modulus=55e9,
+    tip_radius=3.5e-3,
+    exposed_length=42e-3,
+)
+# a smaller grid than the default (fewer tips and a coarser length step) keeps the tests quick
+SMALL = DesignSpace(
+    fiber_radii=(40e-6, 62.5e-6),
+    wire_diameters=(25e-6, 50e-6, 100e-6, 200e-6),
+    tip_radii=tuple(r * 1e-3 for r in (2.0, 3.0, 4.0, 5.0, 6.0, 8.0)),
+    length_step=1e-3,
+)
+
+
+def test_hertz_depth_inverts_hertz_force() -> None:
+    E = np.array([1e3, 6e3, 300e3])
+    depth = hertz_depth(2e-3, E, 4e-3, 0.45)
+    np.testing.assert_allclose(hertz_force(E, depth, 4e-3, 0.45), 2e-3, rtol=1e-12)
+    with pytest.raises(ValueError, match="modulus"):
+        hertz_depth(1e-3, 0.0, 4e-3, 0.45)
+
+
+def test_bow_shortening_matches_the_simulators_imperfect_beam() -> None:
+    """c ((1-x)**-2 - 1) (w0/L)**2 with c derived from the elastica equals sim.contact's c."""
+    w0, x = 1e-3, 0.9
+    _, e_imp = imperfection_state(w0, x)
+    assert e_imp / (w0**2 * ((1 - x) ** -2 - 1)) == pytest.approx(MODE_SHORTENING, rel=1e-4)
+    assert imperfection_state(0.0, x) == (0.0, 0.0)
+
+
+def test_paper_sensor_on_the_papers_range_is_outside_hertz() -> None:
+    c = DesignConstraints(thickness=10e-3)  # the simulated phantoms' 10 mm layers
+    ev = evaluate_design(PAPER, (300 * KPA, 1100 * KPA), c)
+    section = composite_section(0.115e-3, 67e9, 0.1e-3, 55e9, 4)
+    assert ev.critical_load == pytest.approx(euler_load(section.EI, 42e-3), rel=1e-12)
+    assert ev.critical_load == pytest.approx(1.353, abs=1e-3)
+    # the Hertz sphere carries P_cr at both ends; depths scale as E**(-2/3)
+    for E, delta in ((300 * KPA, ev.delta_soft), (1100 * KPA, ev.delta_stiff)):
+        assert float(hertz_force(E, delta, 3.5e-3, 0.45)) == pytest.approx(ev.critical_load)
+    assert ev.delta_soft / ev.delta_stiff == pytest.approx((1100 / 300) ** (2 / 3))
+    assert ev.delta_soft == pytest.approx(1.276e-3, rel=1e-3)
+    checks = {ch.name: ch for ch in ev.checks}
+    assert list(checks) == list(CHECKS)
+    assert checks["hertz_depth"].value == pytest.approx(0.3647, rel=1e-3)
+    assert not checks["hertz_depth"].ok
+    assert not checks["thickness"].ok  # a/h = 0.21
+    assert checks["resolution"].ok  # 0.54 mm is 110 encoder counts
+    assert checks["detection"].ok
+    assert not ev.ok
+    assert ev.worst.name == "hertz_depth"
+
+
+def test_a_design_for_the_papers_range_is_hertz_valid() -> None:
+    result = design_sensor((300 * KPA, 1100 * KPA), DesignConstraints(thickness=10e-3), SMALL)
+    assert result.success, result.message
+    ev = result.evaluation
+    assert ev is not None
+    assert ev.depth_ratio <= 0.1
+    assert ev.contact_ratio <= 0.1
+    assert ev.critical_load < 1.353  # softer than the paper's sensor
+
+
+def test_a_feasible_soft_tissue_design() -> None:
+    c = DesignConstraints(imperfection=5e-4)
+    result = design_sensor((1 * KPA, 10 * KPA), c, SMALL)
+    assert result.success, result.message
+    ev = result.evaluation
+    assert ev is not None
+    assert result.design == ev.design
+    assert ev.ok
+    assert all(ch.margin >= 1.0 for ch in ev.checks)
+    d = ev.design
+    assert d.wire_count >= 1  # a bare fiber has no offset from the neutral axis: no signal
+    # buckling is Hertz-valid at the soft end and measurable at the stiff end
+    assert ev.depth_ratio <= 0.1
+    assert math.sqrt(d.tip_radius * ev.delta_soft) <= 0.1 * 20e-3
+    assert ev.delta_stiff >= 20 * 20e-3 / 4096
+    assert float(hertz_force(1 * KPA, ev.delta_soft, d.tip_radius, 0.45)) == pytest.approx(
+        ev.critical_load
+    )
+    # millinewtons: three orders of magnitude below the paper's sensor
+    assert 1e-4 < ev.critical_load < 1e-2
+    assert ev.threshold is not None
+    assert ev.detection_floor < ev.detection_strain
+    assert 0 < ev.bow_strain <= ev.threshold  # a bowed beam must not trip it before 0.9 P_cr
+    assert ev.threshold >= math.sqrt(ev.detection_floor * ev.detection_strain)
+    assert result.length_window is not None
+    lo, hi = result.length_window
+    assert lo <= d.exposed_length <= hi
+    # the window is where that hardware passes: just outside it, something fails
+    for L in (lo - SMALL.length_step, hi + SMALL.length_step):
+        if SMALL.length_range[0] <= L <= SMALL.length_range[1]:
+            outside = SensorDesign(**{**d.__dict__, "exposed_length": L})
+            assert not evaluate_design(outside, (1 * KPA, 10 * KPA), c).ok
+
+
+def test_softer_tissue_gets_a_more_flexible_sensor() -> None:
+    loads = []
+    for lo in (1.0, 10.0, 100.0):
+        result = design_sensor((lo * KPA, 3 * lo * KPA), space=SMALL)
+        assert result.success, result.message
+        assert result.evaluation is not None
+        loads.append(result.evaluation.critical_load)
+    assert loads[0] < loads[1] < loads[2]
+    # P_cr tracks the modulus: a decade softer, roughly a decade lower buckling load
+    assert 3 < loads[1] / loads[0] < 30
+    assert 3 < loads[2] / loads[1] < 30
+
+
+def test_a_range_too_wide_for_any_sensor_says_why() -> None:
+    result = design_sensor((1 * KPA, 100 * KPA), space=SMALL)
+    assert not result.success
+    assert result.design is None
+    assert result.length_window is None
+    assert "too wide for any sensor" in result.message
+    assert "21.5" in result.message  # (E_max / E_min)**(2/3), the depth ratio it needs
+    assert result.evaluation is not None
+    assert not result.evaluation.ok
+    assert result.feasible == 0
+    assert result.failures["hertz_depth"] > 0
+
+
+def test_a_bowed_sensor_is_rejected_by_the_bias_check() -> None:
+    result = design_sensor((1 * KPA, 10 * KPA), DesignConstraints(imperfection=2e-3), SMALL)
+    assert not result.success
+    assert "too wide" not in result.message  # the depth window alone would allow it
+    assert "delta_bias" in result.message
+
+
+def test_a_bare_fiber_cannot_see_buckling() -> None:
+    space = DesignSpace(fiber_radii=(40e-6,), wire_counts=(0,), length_step=1e-3)
+    result = design_sensor((1 * KPA, 10 * KPA), space=space)
+    assert not result.success
+    assert "detection" in result.message
+    assert result.evaluation is not None
+    assert result.evaluation.detection_strain < result.evaluation.detection_floor
+    assert result.evaluation.threshold is None
+
+
+def test_bad_inputs_raise() -> None:
+    with pytest.raises(ValueError, match="modulus range"):
+        design_sensor((10 * KPA, 1 * KPA), space=SMALL)
+    with pytest.raises(ValueError, match="wire_counts"):
+        DesignSpace(wire_counts=(-1,))
+    with pytest.raises(ValueError, match="poisson"):
+        DesignConstraints(poisson=0.7)
+    short = SensorDesign(**{**PAPER.__dict__, "exposed_length": 20e-3})
+    with pytest.raises(ValueError, match="gratings inside the tube"):
+        evaluate_design(short, (1 * KPA, 10 * KPA))

@@ -1,0 +1,138 @@
+"""Joint fit of modulus and contact position on synthetic loading curves (seeded)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from estimation.corrections import ContactLaw
+from estimation.jointfit import joint_fit
+
+LAW = ContactLaw(3.5e-3, 0.45, 10e-3, bonded=True, large_indentation=True)
+EA = 9.7e3
+L = 44e-3
+SIGMA_P = 0.03  # N
+Q = 20e-3 / 4096  # encoder count
+
+
+def curve(
+    E: float, x0: float, rng: np.random.Generator, n: int = 300, law: ContactLaw = LAW
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stage advance from 0.8 mm before contact to 0.9 mm after, load capped like a buckling
+    beam (the advance beyond goes into shortening), encoder-quantised, load noise SIGMA_P."""
+    u = np.round(np.linspace(x0 - 0.8e-3, x0 + 0.9e-3, n) / Q) * Q
+    delta = np.clip(u - x0, 0.0, None)
+    P = law.force(E, delta)
+    cap = float(law.force(E, 0.6e-3))
+    over = cap < P
+    # past the cap the load stays ~constant and the beam shortens; solve P(delta) = cap there
+    delta_cap = 0.6e-3
+    e = np.where(over, u - x0 - delta_cap, P * L / EA)
+    P = np.where(over, cap, P)
+    return u, P + rng.normal(0.0, SIGMA_P, n), e
+
+
+def fit(u: np.ndarray, P: np.ndarray, e: np.ndarray, guess: float) -> object:
+    return joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, encoder_resolution=Q, contact_guess=guess)
+
+
+def test_recovers_modulus_and_contact() -> None:
+    rng = np.random.default_rng(1)
+    u, P, e = curve(400e3, 10.0e-3, rng)
+    r = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, encoder_resolution=Q, contact_guess=10.2e-3)
+    assert r.success, r.message
+    assert r.modulus == pytest.approx(400e3, rel=0.02)
+    assert r.contact == pytest.approx(10.0e-3, abs=5e-6)
+    assert r.ci_low is not None
+    assert r.ci_high is not None
+    assert r.ci_low < 400e3 < r.ci_high
+    assert r.contact_low is not None
+    assert r.contact_high is not None
+    assert r.contact_low <= 10.0e-3 <= r.contact_high
+    assert r.rms == pytest.approx(1.0, abs=0.15)
+    assert r.n_contact > 100
+
+
+def test_the_contact_guess_only_starts_the_search() -> None:
+    rng = np.random.default_rng(2)
+    u, P, e = curve(700e3, 5e-3, rng)
+    a = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=5.3e-3)
+    b = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=4.7e-3)
+    assert a.success
+    assert b.success
+    assert a.modulus == pytest.approx(b.modulus, rel=1e-5)
+    assert a.contact == pytest.approx(b.contact, abs=1e-8)
+
+
+def test_outliers_do_not_pull_the_robust_fit() -> None:
+    rng = np.random.default_rng(3)
+    u, P, e = curve(300e3, 0.0, rng)
+    P[::25] += 1.0  # 4 % of the samples 30 sigma off
+    r = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0)
+    assert r.success
+    assert r.modulus == pytest.approx(300e3, rel=0.03)
+
+
+def test_interval_coverage_is_about_95_percent() -> None:
+    rng = np.random.default_rng(20240611)
+    trials, hits = 200, 0
+    for _ in range(trials):
+        E = float(rng.uniform(250e3, 1100e3))
+        x0 = float(rng.uniform(-1e-3, 1e-3))
+        u, P, e = curve(E, x0, rng, n=150)
+        r = joint_fit(
+            u,
+            P,
+            e,
+            LAW,
+            sigma_force=SIGMA_P,
+            encoder_resolution=Q,
+            contact_guess=x0 + float(rng.normal(0, 0.2e-3)),
+        )
+        assert r.success, r.message
+        assert r.ci_low is not None
+        assert r.ci_high is not None
+        hits += r.ci_low <= E <= r.ci_high
+    # binomial(200, 0.95): sd 1.5 %; 3 sd band
+    assert 0.90 <= hits / trials <= 0.995
+
+
+def test_model_form_spread_widens_the_interval_on_thin_layers_only() -> None:
+    rng = np.random.default_rng(4)
+    u, P, e = curve(400e3, 0.0, rng)
+    thin = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0)
+    half = ContactLaw(3.5e-3, 0.45, None)
+    u2, P2, e2 = curve(400e3, 0.0, rng, law=half)
+    thick = joint_fit(u2, P2, e2, half, sigma_force=SIGMA_P, contact_guess=0.0)
+    assert thin.model_spread is not None
+    assert thin.model_spread > 0
+    assert thick.model_spread == 0.0
+
+
+def test_too_few_points_is_an_explicit_failure() -> None:
+    rng = np.random.default_rng(5)
+    u, P, e = curve(400e3, 0.0, rng, n=300)
+    r = joint_fit(u[:10], P[:10], e[:10], LAW, sigma_force=SIGMA_P)
+    assert not r.success
+    assert r.modulus is None
+    assert "too few points" in r.message
+
+
+def test_no_contact_is_an_explicit_failure() -> None:
+    rng = np.random.default_rng(6)
+    u = np.linspace(0.0, 1e-3, 200)
+    P = rng.normal(0.0, SIGMA_P, u.size)
+    r = joint_fit(u, P, 0.0, LAW, sigma_force=SIGMA_P, contact_guess=0.5e-3)
+    assert not r.success
+    assert r.modulus is None
+    assert "no contact" in r.message
+
+
+def test_bad_input_raises() -> None:
+    u = np.linspace(0, 1e-3, 50)
+    with pytest.raises(ValueError, match="force"):
+        joint_fit(u, np.zeros(49), 0.0, LAW, sigma_force=SIGMA_P)
+    with pytest.raises(ValueError, match="sigma_force"):
+        joint_fit(u, np.zeros(50), 0.0, LAW, sigma_force=0.0)
+    with pytest.raises(ValueError, match="confidence"):
+        joint_fit(u, np.zeros(50), 0.0, LAW, sigma_force=SIGMA_P, confidence=1.0)
