@@ -22,29 +22,26 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-import numpy as np
-
 from config.bench import BenchTrialConfig, LoadedBench
 from config.loader import ConfigError
-from config.scene import CampaignConfig
 from config.schema import MM, StackConfig, TubeConfig
 from config.targets import TargetConfig, load_targets
 from estimation.section import Section
 from estimation.stiffness import StiffnessEstimate
 from palpate.hardware import Hardware
-from palpate.simtrial import (
-    _estimate_record,
-    estimate_from_marks,
-    exposed_length_at,
+from palpate.simtrial import estimate_from_marks, estimate_record, exposed_length_at
+from palpate.trialsetup import (
+    detector_for,
+    guards_for,
+    position_tolerance,
+    rig_settings,
     sensor_section,
 )
 from robot.drive import JointLimitError, JointState, RollerGearDrive
-from robot.dynamixel.tables import TICKS_PER_REV
-from robot.indentation import BucklingDetector, Guards, State, TrialMarks, TrialPlan
-from robot.rig import RigSettings, ServoFbgRig
+from robot.indentation import State, TrialMarks, TrialPlan
+from robot.rig import ServoFbgRig
 from robot.trial import end_record, run_trial
 from robot.triallog import TrialLogWriter
-from sensor.detect import CusumDetector, NormThreshold
 from sensor.strain import StrainChain
 
 SKIPPED = "skipped"
@@ -107,33 +104,6 @@ class BenchOutcome:
             "duration_s": self.duration,
             "log": self.log_path,
         }
-
-
-def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Guards:
-    """The trial guards of a campaign: travel past contact, fiber strain, stream timeout."""
-    return Guards(
-        max_travel_past_contact=campaign.max_travel_past_contact_mm * MM,
-        strain_limit=stack.fbg.strain_limit,
-        stream_timeout=max(stack.board.stale_timeout_s, 5 * tick),
-    )
-
-
-def rig_settings(
-    campaign: CampaignConfig, stack: StackConfig, tick: float, *, sync_to_clock: bool = False
-) -> RigSettings:
-    """The rig's settings for a campaign at a control period ``tick`` (s). ``sync_to_clock``
-    only for emulators on a virtual clock."""
-    return RigSettings(
-        tick=tick,
-        contact=campaign.contact,
-        sync_to_clock=sync_to_clock,
-        frame_period=1.0 / stack.board.rate_hz,
-    )
-
-
-def position_tolerance(stack: StackConfig) -> float:
-    """The stage encoder's resolution, 1.5 ticks of the translation servo (m)."""
-    return 1.5 * stack.drive.lead / TICKS_PER_REV
 
 
 def _safe(name: str) -> str:
@@ -239,15 +209,6 @@ def plan_bench_trials(loaded: LoadedBench, only: str | None = None) -> list[Benc
     return trials
 
 
-def detector_for(campaign: CampaignConfig, chain: StrainChain) -> BucklingDetector:
-    """The campaign's buckling detector; CUSUM takes its noise from the zeroed baseline (the
-    bench's real noise, not a simulated figure)."""
-    if campaign.detector == "paper":
-        return NormThreshold(campaign.detector_threshold_ue * 1e-6)
-    sigma = float(np.max(chain.strain_noise()))
-    return CusumDetector(sigma=max(sigma, 1e-7))
-
-
 def run_bench_trials(
     hw: Hardware,
     trials: list[BenchTrial],
@@ -266,7 +227,6 @@ def run_bench_trials(
     bench, stack = loaded.bench, loaded.stack
     c = bench.campaign
     tick = 1.0 / bench.control_rate_hz
-    settings = rig_settings(c, stack, tick, sync_to_clock=sync_to_clock)
     guards = guards_for(c, stack, tick)
     section = sensor_section(stack)
     outcomes: list[BenchOutcome] = []
@@ -279,6 +239,9 @@ def run_bench_trials(
         if not torque_on:
             hw.drive.bus.set_torque(True)
             torque_on = True
+        settings = rig_settings(
+            c, stack, tick, sync_to_clock=sync_to_clock, exposed_length=trial.exposed_length
+        )
         rig = ServoFbgRig(
             hw.drive, hw.reader, StrainChain.from_config(stack.fbg), hw.clock, settings
         )
@@ -289,7 +252,7 @@ def run_bench_trials(
                 rig, hw.clock, trial.plan, guards, detector_for(c, chain), log, tick=tick
             )
             estimate, length = _estimate(trial, result.marks, stack, section)
-            log.write(_estimate_record(estimate, length))
+            log.write(estimate_record(estimate, length))
             log.write(end_record(result))
         outcome = BenchOutcome(
             trial,

@@ -8,8 +8,8 @@ already built transports (an SDK ``PortHandler``, a serial-like object) for the 
 so tests run exactly this code. The clock is a parameter too (:class:`SystemClock` on hardware).
 
 When a port cannot be opened the error (:class:`HardwareError`) names the port and says what to
-do: plug it in, join the ``dialout`` group, close the program that holds it. These operator
-hints live here only; the drivers report the bare failure.
+do: plug it in, join the ``dialout`` group (the wording of ``sensor.ports``, which the drivers
+use too), close the program that holds it.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from robot.drive import DriveController
 from robot.dynamixel.driver import DynamixelBus
 from robot.motors import ServoFaultError, ServoTransportError
 from sensor.clock import Clock, SystemClock
+from sensor.ports import DIALOUT_HINT, os_errno
 from sensor.reader import FrameReader, SensorPortError, SerialLike
 
 SIM_PORT = "sim"
@@ -79,10 +80,7 @@ def _hint(code: int | None, port: str, role: str, key: str) -> str:
             f"ports with `{LIST_PORTS}` and set {key}"
         )
     if code in (errno.EACCES, errno.EPERM):
-        return (
-            f"{role} port {port}: permission denied. Add your user to the group that owns it "
-            "(usually dialout): `sudo usermod -aG dialout $USER`, then log out and in again"
-        )
+        return f"{role} port {port}: {DIALOUT_HINT}"
     if code == errno.EBUSY:
         return (
             f"{role} port {port}: busy. Another program holds it (Dynamixel Wizard, a serial "
@@ -91,20 +89,11 @@ def _hint(code: int | None, port: str, role: str, key: str) -> str:
     return f"{role} port {port}: cannot open it"
 
 
-def _errno_of(exc: BaseException) -> int | None:
-    """The OS error number behind a driver's exception (pyserial keeps it on its exception)."""
-    seen: BaseException | None = exc
-    while seen is not None:
-        code = getattr(seen, "errno", None)
-        if isinstance(code, int):
-            return code
-        seen = seen.__cause__ or seen.__context__
-    return None
-
-
 def explain(exc: BaseException, port: str, role: str, key: str) -> HardwareError:
     """A :class:`HardwareError` for a failed open or a silent bus, with the remedy."""
-    code = _errno_of(exc)
+    code = os_errno(exc)
+    if code in (errno.EACCES, errno.EPERM):
+        return HardwareError(_hint(code, port, role, key))  # the driver's text repeats the hint
     if code is not None:
         return HardwareError(f"{_hint(code, port, role, key)} ({exc})")
     if isinstance(exc, ServoTransportError) and not str(exc).startswith("cannot open"):

@@ -21,7 +21,8 @@ import numpy as np
 
 from config.scene import SceneConfig
 from config.schema import StackConfig, TubeConfig
-from palpate.simtrial import sensor_section, tissue_model
+from palpate.simtrial import tissue_model
+from palpate.trialsetup import sensor_section
 from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
 from robot.dynamixel.units import rad_from_ticks

@@ -23,23 +23,28 @@ import numpy as np
 from config.scene import FidelityConfig, SampleConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
 from estimation.beam import Beam
-from estimation.beamstate import onset_mode
 from estimation.jointfit import JointFit
-from estimation.section import Section, composite_section
+from estimation.section import Section
 from estimation.stiffness import StiffnessEstimate, paper_estimate
 from palpate.estimates import EstimatorInputs, joint_estimate, joint_record, loading_rows
+from palpate.trialsetup import (
+    detector_for,
+    guards_for,
+    position_tolerance,
+    rig_settings,
+    sensor_section,
+)
 from robot import kinematics
 from robot.drive import TRANSLATION, DriveController, RollerGearDrive
 from robot.dynamixel.driver import DynamixelBus
 from robot.dynamixel.tables import TICKS_PER_REV
 from robot.dynamixel.units import rad_from_ticks
-from robot.indentation import Guards, State, TrialMarks, TrialPlan
-from robot.rig import RigSettings, ServoFbgRig
+from robot.indentation import State, TrialMarks, TrialPlan
+from robot.rig import ServoFbgRig
 from robot.trial import TrialResult, end_record, run_trial
 from robot.triallog import TrialLogWriter
-from sensor.detect import CusumDetector, NormThreshold
 from sensor.reader import FrameReader, layout_from_config
-from sensor.strain import StrainChain, grating_intervals, strain_noise
+from sensor.strain import StrainChain, grating_intervals
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
@@ -122,13 +127,6 @@ class TrialOutcome:
         }
 
 
-def sensor_section(stack: StackConfig) -> Section:
-    s = stack.sensor
-    return composite_section(
-        s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
-    )
-
-
 def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
     """The simulated tissue's force law for a scene's sample and fidelity switches."""
     return TissueModel(
@@ -206,16 +204,6 @@ def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
         return p.tube_tip, p.tangent, translation - tube.flush_translation
 
     return robot_pose
-
-
-def _detector(scene: SceneConfig, stack: StackConfig) -> NormThreshold | CusumDetector:
-    c = scene.campaign
-    if c.detector == "paper":
-        return NormThreshold(c.detector_threshold_ue * 1e-6)
-    sigma = max(
-        strain_noise(scene.fidelity.fbg_noise_pm, stack.fbg.strain_coefficient_pm_per_ue), 1e-7
-    )
-    return CusumDetector(sigma=sigma)
 
 
 class EmulatorHook(Protocol):
@@ -351,13 +339,9 @@ def run_sim_trial(
         approach_speed=c.approach_speed_mm_per_s * 1e-3,
         indent_speed=c.indent_speed_mm_per_s * 1e-3,
         fast_speed=stack.drive.max_speed,
-        position_tolerance=1.5 * stack.drive.lead / TICKS_PER_REV,  # the encoder's resolution
+        position_tolerance=position_tolerance(stack),
     )
-    guards = Guards(
-        max_travel_past_contact=c.max_travel_past_contact_mm * 1e-3,
-        strain_limit=stack.fbg.strain_limit,
-        stream_timeout=max(stack.board.stale_timeout_s, 5 * tick),
-    )
+    guards = guards_for(c, stack, tick)
     log: TrialLogWriter | None = None
     log_path: str | None = None
     series: dict[str, list[float]] = {"advance": [], "force": [], "s1": [], "s2": [], "s3": []}
@@ -370,18 +354,8 @@ def run_sim_trial(
         holder["bus"] = bus
         driver = DynamixelBus.from_config(stack.servos, port=servo_port)
         reader = FrameReader.from_config(board_port, stack.sensor, stack.board, clock=clock)
-        settings = RigSettings(
-            tick=tick,
-            contact=c.contact,
-            sync_to_clock=True,
-            frame_period=1.0 / stack.board.rate_hz,
-            fbg_bending_mode=tuple(
-                onset_mode(
-                    grating_intervals(stack.sensor, spec.exposed_length),
-                    spec.exposed_length,
-                    section.fiber_offset,
-                ).tolist()
-            ),
+        settings = rig_settings(
+            c, stack, tick, sync_to_clock=True, exposed_length=spec.exposed_length
         )
         if hook is not None and transport == "fast":
             # in-process frames arrive during the clock advance or never: with injected board
@@ -390,7 +364,7 @@ def run_sim_trial(
         with DriveController(driver, drive_cfg) as drive, reader:
             board.start()
             rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
-            rig.zero()
+            chain = rig.zero()
             if log_dir is not None:
                 path = log_dir / f"{spec.trial_id}.jsonl"
                 log_path = str(path)
@@ -413,7 +387,7 @@ def run_sim_trial(
                     clock,
                     plan,
                     guards,
-                    _detector(scene, stack),
+                    detector_for(c, chain),
                     log,
                     tick=tick,
                     on_tick=on_tick,
@@ -425,7 +399,7 @@ def run_sim_trial(
                 )
                 joint_seconds = time.perf_counter() - fit_start
                 if log is not None:
-                    log.write(_estimate_record(estimate, l_b, joint))
+                    log.write(estimate_record(estimate, l_b, joint))
                     log.write(end_record(result))
             finally:
                 if log is not None:
@@ -542,7 +516,7 @@ def joint_from_rows(
     return joint_estimate(advance, strains, inputs, stack.sensor, section)
 
 
-def _estimate_record(
+def estimate_record(
     est: StiffnessEstimate | None, length: float | None, joint: JointFit | None = None
 ) -> dict[str, Any]:
     if est is None:

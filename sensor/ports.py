@@ -23,15 +23,19 @@ def open_failure(device: str, port: str, exc: BaseException) -> str:
     return f"cannot open {device} port {port!r}: {exc}"
 
 
-def _is_permission_error(exc: BaseException) -> bool:
+def os_errno(exc: BaseException) -> int | None:
+    """The OS error number behind an exception, following the chain (pyserial and the drivers
+    wrap the OSError), or None."""
     seen: set[int] = set()
     e: BaseException | None = exc
-    while e is not None and id(e) not in seen:  # pyserial wraps the OSError; follow the chain
+    while e is not None and id(e) not in seen:
         seen.add(id(e))
-        if isinstance(e, PermissionError) or getattr(e, "errno", None) in (
-            errno.EACCES,
-            errno.EPERM,
-        ):
-            return True
+        code = getattr(e, "errno", None)
+        if isinstance(code, int):
+            return code
         e = e.__cause__ or e.__context__
-    return False
+    return None
+
+
+def _is_permission_error(exc: BaseException) -> bool:
+    return isinstance(exc, PermissionError) or os_errno(exc) in (errno.EACCES, errno.EPERM)

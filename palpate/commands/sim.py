@@ -6,12 +6,14 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from tqdm import tqdm
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
+from config.schema import StackConfig
 from palpate.campaign import (
     campaign_trials,
     default_workers,
@@ -21,12 +23,17 @@ from palpate.campaign import (
 )
 from palpate.executors import add_executor_arguments, open_executor
 from palpate.preflight import check_campaign, check_reachable
-from palpate.simtrial import TrialOutcome
+from palpate.simtrial import Transport, TrialOutcome, TrialSpec
+
+CAMPAIGNS = {"robot": ("robot",), "bench": ("bench",), "paper": ("bench", "robot")}
 
 
 def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--campaign", choices=["robot", "bench"], default="robot", help="a shipped scene"
+        "--campaign",
+        choices=sorted(CAMPAIGNS),
+        default="robot",
+        help="a shipped scene; paper: both (bench then robot) through one pool",
     )
     parser.add_argument("--scene", type=Path, help="a scene YAML (overrides --campaign)")
     parser.add_argument("--seed", type=int, default=0, help="makes the run reproducible")
@@ -52,62 +59,115 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
 
 
+@dataclass
+class _Campaign:
+    """One scene's campaign, loaded and checked before anything runs."""
+
+    path: Path
+    scene: SceneConfig
+    stack: StackConfig
+    specs: list[TrialSpec]
+    log_dir: Path
+    transport: Transport
+    outcomes: list[TrialOutcome] = field(default_factory=list)
+    wall: float = 0.0
+
+
 def run(args: argparse.Namespace) -> int:
     if args.faults:
         from palpate.faults import run_command
 
         return run_command(args)
-    scene_path = args.scene if args.scene else resolve(f"scenes/{args.campaign}.yaml")
-    scene = load(SceneConfig, scene_path)
-    stack = load_stack(resolve(scene.robot))
-    check_campaign(scene, stack, str(scene_path), str(resolve(scene.robot)))
-    specs = campaign_trials(scene, stack, args.seed)
-    if args.limit:
-        specs = specs[: args.limit]
-    if not specs:
-        raise ValueError(f"{scene_path}: the campaign has no trials")
-    check_reachable(specs, stack, str(scene_path), str(resolve(scene.robot)))
-    out_dir: Path = args.out / scene.name
-    log_dir = out_dir / "logs"
-    log_dir.mkdir(parents=True, exist_ok=True)
-    for old in log_dir.glob("*.jsonl"):
-        old.unlink()
-    transport = "wire" if args.wire else scene.transport
-    bar = tqdm(total=len(specs), desc=f"{scene.name} campaign", unit="trial", file=sys.stderr)
+    if args.scene:
+        paths = [Path(args.scene)]
+    else:
+        paths = [resolve(f"scenes/{name}.yaml") for name in CAMPAIGNS[args.campaign]]
+    # every scene is loaded and checked first: a bad one stops the run before any trial moves
+    campaigns = [_prepare(path, args) for path in paths]
+    total = sum(len(c.specs) for c in campaigns)
+    bar = tqdm(total=total, desc="campaign", unit="trial", file=sys.stderr)
 
     def progress(o: TrialOutcome) -> None:
         bar.update(1)
         bar.set_postfix_str(o.spec.trial_id)
 
-    t0 = time.perf_counter()
+    t_all = time.perf_counter()
     with open_executor(args.executor, max(1, args.workers), args.scheduler) as executor:
-        outcomes = run_campaign(
-            specs,
-            scene,
-            stack,
-            transport=transport,
-            log_dir=log_dir,
-            executor=executor,
-            series_for=specs[0].trial_id,
-            progress=progress,
-        )
-    wall = time.perf_counter() - t0
+        for c in campaigns:  # one pool for all of them
+            bar.set_description(f"{c.scene.name} campaign")
+            t0 = time.perf_counter()
+            c.outcomes = run_campaign(
+                c.specs,
+                c.scene,
+                c.stack,
+                transport=c.transport,
+                log_dir=c.log_dir,
+                executor=executor,
+                series_for=c.specs[0].trial_id,
+                progress=progress,
+            )
+            c.wall = time.perf_counter() - t0
+    wall_all = time.perf_counter() - t_all
     bar.close()
     if args.compare_methods:
-        from palpate.compare import compare_methods, comparison_payload, print_comparison
-        from palpate.simtrial import sensor_section
-
-        table = compare_methods(outcomes, stack, sensor_section(stack))
-        if args.json:
-            print(json.dumps(comparison_payload(table, scene.name, args.seed), indent=2))
+        return _compare(campaigns, args)
+    payloads = [_report(c, args) for c in campaigns]
+    sim_all = sum(o.sim_time for c in campaigns for o in c.outcomes)
+    if args.json:
+        if len(payloads) == 1:
+            print(json.dumps(payloads[0], indent=2))
         else:
-            print_comparison(table, scene.name)
-        return 0
+            print(json.dumps({"campaigns": payloads, "wall_s": wall_all}, indent=2))
+    elif len(campaigns) > 1:
+        print(
+            f"all {total} trials in {wall_all:.1f} s wall for {sim_all:.1f} s simulated: "
+            f"{sim_all / wall_all:.1f}x real time"
+        )
+    failed_all = all(o.state != "done" for c in campaigns for o in c.outcomes)
+    return 1 if failed_all else 0
+
+
+def _prepare(path: Path, args: argparse.Namespace) -> _Campaign:
+    scene = load(SceneConfig, path)
+    stack = load_stack(resolve(scene.robot))
+    check_campaign(scene, stack, str(path), str(resolve(scene.robot)))
+    specs = campaign_trials(scene, stack, args.seed)
+    if args.limit:
+        specs = specs[: args.limit]
+    if not specs:
+        raise ValueError(f"{path}: the campaign has no trials")
+    check_reachable(specs, stack, str(path), str(resolve(scene.robot)))
+    log_dir = args.out / scene.name / "logs"
+    log_dir.mkdir(parents=True, exist_ok=True)
+    for old in log_dir.glob("*.jsonl"):
+        old.unlink()
+    transport: Transport = "wire" if args.wire else scene.transport
+    return _Campaign(path, scene, stack, specs, log_dir, transport)
+
+
+def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
+    from palpate.compare import compare_methods, comparison_payload, print_comparison
+    from palpate.trialsetup import sensor_section
+
+    for c in campaigns:
+        table = compare_methods(c.outcomes, c.stack, sensor_section(c.stack))
+        if args.json:
+            print(json.dumps(comparison_payload(table, c.scene.name, args.seed), indent=2))
+        else:
+            print_comparison(table, c.scene.name)
+    return 0
+
+
+def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
+    """Print one campaign's table (unless ``--json``) and return its JSON payload."""
+    scene, outcomes, wall = c.scene, c.outcomes, c.wall
     rows = summarize_campaign(outcomes, scene.campaign.outlier_above_kpa * 1e3)
     sim_time = sum(o.sim_time for o in outcomes)
     mare = median_abs_relative_error(outcomes)
+    paper = median_abs_relative_error(outcomes, "paper")
     failed = [o for o in outcomes if o.state != "done"]
     figures: list[str] = []
+    out_dir = c.log_dir.parent
     if not args.no_plots:
         from palpate import plots
 
@@ -117,43 +177,42 @@ def run(args: argparse.Namespace) -> int:
         )
         if outcomes[0].series.get("advance"):
             figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
+    payload: dict[str, object] = {
+        "scene": scene.name,
+        "transport": c.transport,
+        "seed": args.seed,
+        "trials": [o.as_dict() for o in outcomes],
+        "samples": [
+            {"sample": r.sample, "trials": r.trials, **_kpa(r.summary.__dict__)} for r in rows
+        ],
+        "median_abs_relative_error": mare,
+        "method": "joint fit (contact-point-free); paper estimate per trial as estimated_kpa",
+        "median_abs_relative_error_paper": paper,
+        "wall_s": wall,
+        "simulated_s": sim_time,
+        "speedup": sim_time / wall if wall > 0 else None,
+        "figures": figures,
+    }
     if args.json:
-        payload = {
-            "scene": scene.name,
-            "transport": transport,
-            "seed": args.seed,
-            "trials": [o.as_dict() for o in outcomes],
-            "samples": [
-                {"sample": r.sample, "trials": r.trials, **_kpa(r.summary.__dict__)} for r in rows
-            ],
-            "median_abs_relative_error": mare,
-            "method": "joint fit (contact-point-free); paper estimate per trial as estimated_kpa",
-            "median_abs_relative_error_paper": median_abs_relative_error(outcomes, "paper"),
-            "wall_s": wall,
-            "simulated_s": sim_time,
-            "speedup": sim_time / wall if wall > 0 else None,
-            "figures": figures,
-        }
-        print(json.dumps(payload, indent=2))
-    else:
-        _print_table(scene.name, rows)
-        print()
-        if mare is not None:
-            print(f"median |relative error| over trials: {100 * mare:.1f} % (joint fit)")
-        paper = median_abs_relative_error(outcomes, "paper")
-        if paper is not None:
-            print(f"  the paper's single-point estimate on the same trials: {100 * paper:.1f} %")
-        print(
-            f"{len(outcomes)} trials ({transport} path, {args.executor} executor, "
-            f"{args.workers} worker(s)) in {wall:.1f} s "
-            f"wall for {sim_time:.1f} s simulated: {sim_time / wall:.1f}x real time"
-        )
-        for o in failed:
-            print(f"  trial {o.spec.trial_id}: {o.state}: {o.reason}")
-        print(f"logs: {log_dir}")
-        for f in figures:
-            print(f"plot: {f}")
-    return 1 if len(failed) == len(outcomes) else 0
+        return payload
+    _print_table(scene.name, rows)
+    print()
+    if mare is not None:
+        print(f"median |relative error| over trials: {100 * mare:.1f} % (joint fit)")
+    if paper is not None:
+        print(f"  the paper's single-point estimate on the same trials: {100 * paper:.1f} %")
+    print(
+        f"{len(outcomes)} trials ({c.transport} path, {args.executor} executor, "
+        f"{args.workers} worker(s)) in {wall:.1f} s "
+        f"wall for {sim_time:.1f} s simulated: {sim_time / wall:.1f}x real time"
+    )
+    for o in failed:
+        print(f"  trial {o.spec.trial_id}: {o.state}: {o.reason}")
+    print(f"logs: {c.log_dir}")
+    for f in figures:
+        print(f"plot: {f}")
+    print()
+    return payload
 
 
 def _kpa(d: dict[str, object]) -> dict[str, object]:

@@ -26,9 +26,9 @@ from config.bench import load_bench
 from config.scene import CampaignConfig, SceneConfig
 from config.schema import StackConfig
 from config.targets import save_target
-from palpate.benchtrial import detector_for, guards_for, rig_settings
 from palpate.hardware import open_hardware, run_on_hardware
 from palpate.simbench import SimulatedBench
+from palpate.trialsetup import detector_for, guards_for, rig_settings
 from robot.indentation import State
 from robot.rig import ServoFbgRig
 from robot.teleop import Teleop, render

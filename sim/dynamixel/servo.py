@@ -349,6 +349,10 @@ class EmulatedServo:
         if self.memory[64] != 1 or mode not in (*_POSITION_MODES, tables.MODE_VELOCITY):
             self._vel = 0.0
             return
+        if mode in _POSITION_MODES and self._vel == 0.0 and not self._stalled:
+            goal_now = self._get("Goal_Position") - self._get("Homing_Offset")
+            if goal_now == self._pos:
+                return  # at rest on its goal (most servos, most ticks)
         vmax, amax = self._limits()
         if self._stalled:
             self._vel = 0.0

@@ -14,7 +14,8 @@ import math
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.simtrial import TrialSpec, run_sim_trial, sensor_section
+from palpate.simtrial import TrialSpec, run_sim_trial
+from palpate.trialsetup import sensor_section
 from robot.rig import RigSettings
 
 STACK = load_stack()

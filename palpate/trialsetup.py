@@ -1,0 +1,76 @@
+"""What every trial runner builds the same way from a campaign: guards, rig settings, the
+stage's position tolerance and the buckling detector.
+
+One place for the simulated campaign (``palpate.simtrial``), the bench (``palpate.benchtrial``)
+and teleoperation (``palpate teleop``), so a guard or a threshold means the same everywhere.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from config.scene import CampaignConfig
+from config.schema import MM, StackConfig
+from estimation.beamstate import onset_mode
+from estimation.section import Section, composite_section
+from robot.dynamixel.tables import TICKS_PER_REV
+from robot.indentation import BucklingDetector, Guards
+from robot.rig import RigSettings
+from sensor.detect import CusumDetector, NormThreshold
+from sensor.strain import StrainChain, grating_intervals
+
+
+def sensor_section(stack: StackConfig) -> Section:
+    """The sensor's composite section (EI, EA, fiber offset) from the robot configuration."""
+    s = stack.sensor
+    return composite_section(
+        s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
+    )
+
+
+def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Guards:
+    """The trial guards of a campaign: travel past contact, fiber strain, stream timeout."""
+    return Guards(
+        max_travel_past_contact=campaign.max_travel_past_contact_mm * MM,
+        strain_limit=stack.fbg.strain_limit,
+        stream_timeout=max(stack.board.stale_timeout_s, 5 * tick),
+    )
+
+
+def rig_settings(
+    campaign: CampaignConfig,
+    stack: StackConfig,
+    tick: float,
+    *,
+    sync_to_clock: bool = False,
+    exposed_length: float | None = None,
+) -> RigSettings:
+    """The rig's settings for a campaign at a control period ``tick`` (s). ``sync_to_clock``
+    only for emulators on a virtual clock. With ``exposed_length`` (m) FBG contact reads the
+    axial strain with the beam's onset bow taken out (``estimation.beamstate.axial_strain``)."""
+    mode = None
+    if exposed_length is not None:
+        fiber_offset = sensor_section(stack).fiber_offset
+        intervals = grating_intervals(stack.sensor, exposed_length)
+        mode = tuple(onset_mode(intervals, exposed_length, fiber_offset).tolist())
+    return RigSettings(
+        tick=tick,
+        contact=campaign.contact,
+        sync_to_clock=sync_to_clock,
+        frame_period=1.0 / stack.board.rate_hz,
+        fbg_bending_mode=mode,
+    )
+
+
+def position_tolerance(stack: StackConfig) -> float:
+    """The stage encoder's resolution, 1.5 ticks of the translation servo (m)."""
+    return 1.5 * stack.drive.lead / TICKS_PER_REV
+
+
+def detector_for(campaign: CampaignConfig, chain: StrainChain) -> BucklingDetector:
+    """The campaign's buckling detector; CUSUM takes its noise from the zeroed baseline (the
+    stream's real noise, not a configured figure)."""
+    if campaign.detector == "paper":
+        return NormThreshold(campaign.detector_threshold_ue * 1e-6)
+    sigma = float(np.max(chain.strain_noise()))
+    return CusumDetector(sigma=max(sigma, 1e-7))
