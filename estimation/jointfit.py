@@ -6,36 +6,53 @@ AFM tools do, we treat the contact position x0 as a free parameter and fit the w
 record instead: for every sample i (stage advance u_i, axial load P_i and beam shortening e_i
 from the strains, ``estimation.beamstate``)::
 
-    delta_i = u_i - x0 - e_i,        P_i = E f(delta_i)        (f = 0 for delta_i <= 0)
+    delta_i = u_i - x0 - e_i,        P_i = P0 + E f(delta_i)        (f = 0 for delta_i <= 0)
 
 with f the corrected contact law (``estimation.corrections.ContactLaw``). Samples before
-contact (f = 0) pin the baseline; loading samples give the curve's shape (which places x0) and
-its scale (E).
+contact (f = 0) pin the baseline P0; loading samples give the curve's shape (which places x0)
+and its scale (E).
+
+Why P0. The strains are zeroed on a few frames at rest (``robot.rig``: 20), so each grating
+carries the zero's error, sigma/sqrt(20), on every sample of the trial: a load offset common
+to the whole record (about 0.2 sigma_P, i.e. 0.01-0.04 N on the bench). It is not noise the
+per-sample sigma describes: with P0 held at 0 the fit bends E and x0 to absorb it, which on
+the simulated bench campaign scattered E as much as the white noise did, outside the interval
+(the standardised errors had sd 1.4 instead of 1). As AFM tools fit the baseline, P0 is a
+free, linear parameter; the approach samples determine it and the profile carries its
+uncertainty into E's interval (``load_offset=False`` keeps the old model).
 
 Method.
-1. Scan x0 over ``contact_guess +- search`` on a grid; E is linear, so for each x0 it has a
-   closed form (weighted least squares): the global basin without local-minimum trouble.
-2. Refine (log E, x0) with ``scipy.optimize.least_squares`` and a robust loss (``soft_l1``,
+1. Scan x0 over ``contact_guess +- search`` on a grid; E and P0 are linear, so for each x0
+   they have a closed form (weighted least squares): the global basin without local-minimum
+   trouble.
+2. Refine (log E, x0, P0) with ``scipy.optimize.least_squares`` and a robust loss (``soft_l1``,
    ``f_scale`` in noise units) on residuals standardised by the effective variance
    ``sigma_i^2 = sigma_P,i^2 + (E f'(delta_i))^2 (sigma_e,i^2 + q^2/12)``: the load's noise
    plus the depth's (the strain-inferred shortening and the encoder's quantisation q).
 3. Confidence interval for E by profile likelihood over x0: with the weights frozen at the
    solution (robust weights included, i.e. the last IRLS step), for each x0 on a fine grid E
-   has a closed form Ê(x0), the weighted residual RSS(x0) and curvature S(x0); the region
+   has a closed form Ê(x0) (P0 profiled out too), the weighted residual RSS(x0) and curvature
+   S(x0) (the Schur complement of the (E, P0) normal matrix); the region
    ``RSS(x0) + S(x0) (E - Ê(x0))^2 <= RSS_min + q_chi2 s^2`` projected on E is the interval,
    and projected on x0 the contact interval. ``s^2`` inflates the nominal noise by the model
    residual (reduced chi^2 when above 1) and by the residuals' lag-1 autocorrelation rho
    ((1 + rho)/(1 - rho), the effective-sample-size factor for an AR(1) misfit), so a curve the
    model does not follow gets a wider interval rather than a falsely tight one.
 4. Model form: the thin-layer series was derived for a paraboloid; with Sneddon's sphere its
-   layer ratio can be sqrt(R delta)/h (published, used for the estimate) or a/h. The modulus
-   refitted with the other choice (same x0 and weights) differs by ``model_spread``, which is
-   added in quadrature to both sides of the interval.
+   layer ratio can be sqrt(R delta)/h (published, used for the estimate) or a/h, and the data
+   cannot tell them apart (on the simulated bench records their best fits differ by < 0.25 in
+   chi^2, against 3.84 for the interval). Each form is profiled as in 3 (same weights; its own
+   best x0, E and P0), and the interval reported is the envelope of the forms' intervals (and
+   of the estimate): it holds the modulus whichever form the sample follows. ``model_spread``
+   is the difference between the forms' moduli. (Adding the spread in quadrature, as before,
+   treats it as a zero-mean random error; it is a bias of known sign for each form, and with
+   x0 held fixed the spread was also a third too small: on the bench campaign the layer-ratio
+   choice alone moved E by -0.5 to -1.6 %.)
 
-Cost: ~10-40 ms for a 700-sample record (two vectorised law evaluations per least-squares step,
-a 121 x N scan, a 241 x N profile). Failure (too few points, no contact in the record, solver
-not converged, non-finite result) is a :class:`JointFit` with ``success`` False and a message;
-bad input raises ValueError.
+Cost: ~20-50 ms for a 700-sample record (two vectorised law evaluations per least-squares step,
+a 121 x N scan, a 241 x N profile per model form; the law is evaluated only past contact).
+Failure (too few points, no contact in the record, solver not converged, non-finite result) is
+a :class:`JointFit` with ``success`` False and a message; bad input raises ValueError.
 """
 
 from __future__ import annotations
@@ -70,6 +87,7 @@ class JointFit:
         message: "ok" or what failed.
         modulus: E, or None on failure.
         contact: x0, the stage position at contact.
+        load_offset: P0 (N), the fitted constant load offset (0 when not fitted).
         ci_low, ci_high: the confidence interval of E at ``confidence``.
         contact_low, contact_high: the same for x0.
         confidence: the interval's level.
@@ -77,7 +95,8 @@ class JointFit:
         max_depth: the largest fitted indentation delta.
         rms: rms of the standardised residuals (about 1 when the noise model holds).
         noise_scale: s, the factor the nominal noise was inflated by for the interval.
-        model_spread: |E(other layer ratio) - E| (Pa), in the interval (0 for a half-space).
+        model_spread: |E(other layer ratio) - E| (Pa), each form fitted with its own x0 and P0
+            (0 for a half-space); the interval is the envelope of both forms' intervals.
         nfev: residual evaluations of the refinement.
         law: the contact law's name.
         warnings: validity flags and fit diagnostics, one sentence each.
@@ -87,6 +106,7 @@ class JointFit:
     message: str
     modulus: float | None = None
     contact: float | None = None
+    load_offset: float | None = None
     ci_low: float | None = None
     ci_high: float | None = None
     contact_low: float | None = None
@@ -109,6 +129,7 @@ class JointFit:
             "message": self.message,
             "modulus": self.modulus,
             "contact": self.contact,
+            "load_offset": self.load_offset,
             "ci_low": self.ci_low,
             "ci_high": self.ci_high,
             "contact_low": self.contact_low,
@@ -138,19 +159,41 @@ def _vector(name: str, value: ArrayLike, n: int | None) -> FloatArray:
 
 
 def _closed_form(
-    f: FloatArray, P: FloatArray, w: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Per row of f (K, N): Ê = sum w f P / sum w f^2, RSS at Ê, and S = sum w f^2."""
-    S = f * f @ w
-    safe = np.where(S > 0, S, 1.0)
-    E = np.where(S > 0, (f * P) @ w / safe, 0.0)
-    rss = ((P - E[:, None] * f) ** 2) @ w
-    return E, rss, S
+    f: FloatArray, P: FloatArray, w: FloatArray, offset: bool = True
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Per row of f (K, N), the weighted least squares of ``P = P0 + E f`` (P0 = 0 when not
+    ``offset``): Ê, P̂0, the RSS there and the curvature S of RSS in E with P0 profiled out
+    (the Schur complement ``sum w f^2 - (sum w f)^2 / sum w``), so that
+    ``min over P0 of RSS(E, P0) = RSS + S (E - Ê)^2``. S = 0 where f carries no contact."""
+    Sff = f * f @ w
+    if offset:
+        S1 = float(np.sum(w))
+        Sf = f @ w
+        S = Sff - Sf * Sf / S1
+    else:
+        S = Sff
+    floor = 1e-12 * np.maximum(Sff, np.finfo(np.float64).tiny)  # S = 0 up to rounding
+    ok = floor < S
+    safe = np.where(ok, S, 1.0)
+    if offset:
+        Pc = P - float(w @ P) / S1  # centred on the weighted mean: P0 = mean(P) - E mean(f)
+        E = np.where(ok, (f * Pc) @ w / safe, 0.0)
+        P0 = (float(w @ P) - E * Sf) / S1
+    else:
+        E = np.where(ok, (f * P) @ w / safe, 0.0)
+        P0 = np.zeros_like(E)
+    rss = ((P - P0[:, None] - E[:, None] * f) ** 2) @ w
+    return E, P0, rss, np.where(ok, S, 0.0)
 
 
 def _shapes(law: ContactLaw, depth_base: FloatArray, x0: FloatArray) -> FloatArray:
-    """f(u - x0 - e) for each x0 (K,): (K, N)."""
-    return law.shape(depth_base[None, :] - x0[:, None])[0]
+    """f(u - x0 - e) for each x0 (K,): (K, N); the law is evaluated only where the depth is
+    positive (f = 0 elsewhere), which skips the record's approach."""
+    depth = depth_base[None, :] - x0[:, None]
+    touching = depth > 0
+    out = np.zeros_like(depth)
+    out[touching] = law.shape(depth[touching])[0]
+    return out
 
 
 def joint_fit(
@@ -166,6 +209,7 @@ def joint_fit(
     search: float = 1.0e-3,
     confidence: float = 0.95,
     f_scale: float = 3.0,
+    load_offset: bool = True,
     misalignment: float | None = None,
     min_points: int = MIN_POINTS,
     min_contact_points: int = MIN_CONTACT_POINTS,
@@ -187,6 +231,8 @@ def joint_fit(
         search: x0 is searched within contact_guess +- search (m), and within the record.
         confidence: the interval's level, in (0, 1).
         f_scale: the robust loss's soft threshold, in noise units.
+        load_offset: fit a constant load offset P0 (the sensor's zero error) beside E and x0;
+            False: the load is taken as exactly 0 before contact.
         misalignment: angle (rad) between the sensor axis and the surface normal, for the flags.
         min_points, min_contact_points: below these the fit is refused (success False).
         max_nfev: least-squares budget.
@@ -233,12 +279,17 @@ def joint_fit(
         return failed("no contact: the record ends before the contact search window")
     grid = np.linspace(lo, hi, SCAN_POINTS)
     w0 = 1.0 / sig_p**2
-    E_grid, rss_grid, S_grid = _closed_form(_shapes(law, depth_base, grid), P, w0)
+    E_grid, P0_grid, rss_grid, S_grid = _closed_form(
+        _shapes(law, depth_base, grid), P, w0, load_offset
+    )
     usable = (S_grid > 0) & (E_grid > 0)
     if not np.any(usable):
         return failed("no contact: no contact position in the window gives a positive load")
     k = int(np.argmin(np.where(usable, rss_grid, np.inf)))
-    theta0 = np.array([math.log(E_grid[k]), grid[k]])
+    p_scale = float(np.median(sig_p))
+    theta0 = np.array([math.log(E_grid[k]), grid[k], P0_grid[k] / p_scale])
+    if not load_offset:
+        theta0 = theta0[:2]
 
     # 2. robust refinement with the effective variance
     x0_scale = max(1e-6, (hi - lo) / SCAN_POINTS)
@@ -252,16 +303,18 @@ def joint_fit(
     def residuals(theta: FloatArray) -> FloatArray:
         f, df = law.shape(depth_base - theta[1])
         E = math.exp(theta[0])
-        return np.asarray((P - E * f) / np.sqrt(sig_p**2 + (E * df) ** 2 * var_depth))
+        P0 = theta[2] * p_scale if load_offset else 0.0
+        return np.asarray((P - P0 - E * f) / np.sqrt(sig_p**2 + (E * df) ** 2 * var_depth))
 
+    n_par = theta0.size
     try:
         sol = least_squares(
             residuals,
             theta0,
             loss="soft_l1",
             f_scale=f_scale,
-            bounds=([-np.inf, lo], [np.inf, hi]),
-            x_scale=np.array([1.0, x0_scale]),
+            bounds=([-np.inf, lo, -np.inf][:n_par], [np.inf, hi, np.inf][:n_par]),
+            x_scale=np.array([1.0, x0_scale, 1.0][:n_par]),
             max_nfev=max_nfev,
         )
     except (ValueError, FloatingPointError) as exc:
@@ -269,6 +322,7 @@ def joint_fit(
     if sol.status <= 0 or not np.all(np.isfinite(sol.x)):
         return failed(f"least squares did not converge: {sol.message}", nfev=int(sol.nfev))
     E_hat, x0_hat = math.exp(float(sol.x[0])), float(sol.x[1])
+    P0_hat = float(sol.x[2]) * p_scale if load_offset else 0.0
     depth = depth_base - x0_hat
     n_contact = int(np.count_nonzero(depth > 0))
     if n_contact < min_contact_points:
@@ -283,12 +337,15 @@ def joint_fit(
     r = residuals(sol.x)
     robust = 1.0 / np.sqrt(1.0 + (r / f_scale) ** 2)  # soft_l1's IRLS weight
     w = robust / sigma(sol.x) ** 2
-    dof = max(1, n - 2)
+    dof = max(1, n - n_par)
     chi2_red = float(np.sum(robust * r * r)) / dof
     rho = _lag1(r[depth > 0])
     scale2 = max(1.0, chi2_red) * (1.0 + rho) / (1.0 - rho)
     threshold = NormalDist().inv_cdf(0.5 + 0.5 * confidence) ** 2 * scale2  # chi2(1) quantile
-    gain = float(np.sum(w * P * P) - np.sum(w * (P - E_hat * law.shape(depth)[0]) ** 2))
+    # against "no contact at all": a constant load (P0 alone) or none
+    null = P - float(w @ P) / float(np.sum(w)) if load_offset else P
+    fitted = P - P0_hat - E_hat * law.shape(depth)[0]
+    gain = float(np.sum(w * null * null) - np.sum(w * fitted * fitted))
     if gain < MIN_SIGNIFICANCE**2 * scale2:
         return failed(
             f"no contact: the fitted load is not significant (chi^2 gain {gain / scale2:.3g} "
@@ -300,21 +357,30 @@ def joint_fit(
     try:
         cov = np.linalg.inv(jac.T @ jac) * scale2
         sd_x0 = math.sqrt(max(cov[1, 1], 0.0))
+        if not math.isfinite(sd_x0):
+            raise np.linalg.LinAlgError("singular")
     except np.linalg.LinAlgError:
         sd_x0 = search
     span = min(max(8.0 * sd_x0, 2e-6), search)
-    prof = _profile(law, depth_base, P, w, x0_hat, span, threshold, lo, hi)
+    profiles = [
+        _profile(form, depth_base, P, w, x0_hat, span, threshold, lo, hi, load_offset)
+        for form in (law, *_other_forms(law))
+    ]
     warnings = list(validity_warnings(law, float(depth.max()), misalignment))
-    if prof is None:
+    if any(prof is None for prof in profiles):
         return failed(
             "profile likelihood failed: no contact position gives a positive load",
             n_contact,
             int(sol.nfev),
         )
-    ci_low, ci_high, c_low, c_high, edge = prof
-    spread = _model_spread(law, depth_base, P, w, x0_hat)
-    ci_low = E_hat - math.hypot(E_hat - ci_low, spread)
-    ci_high = E_hat + math.hypot(ci_high - E_hat, spread)
+    ok_profiles = [prof for prof in profiles if prof is not None]
+    # the envelope over the model forms (step 4 of the module docstring)
+    ci_low = min(E_hat, *(prof.ci_low for prof in ok_profiles))
+    ci_high = max(E_hat, *(prof.ci_high for prof in ok_profiles))
+    c_low = min(prof.contact_low for prof in ok_profiles)
+    c_high = max(prof.contact_high for prof in ok_profiles)
+    edge = any(prof.edge for prof in ok_profiles)
+    spread = max(abs(prof.modulus - ok_profiles[0].modulus) for prof in ok_profiles)
     if edge:
         warnings.append("the contact position's interval reaches the search window's edge")
     if rho > 0.5:
@@ -329,6 +395,7 @@ def joint_fit(
         message="ok",
         modulus=E_hat,
         contact=x0_hat,
+        load_offset=P0_hat,
         ci_low=ci_low,
         ci_high=ci_high,
         contact_low=c_low,
@@ -346,19 +413,14 @@ def joint_fit(
     )
 
 
-def _model_spread(
-    law: ContactLaw, depth_base: FloatArray, P: FloatArray, w: FloatArray, x0: float
-) -> float:
-    """|E with the other thin-layer ratio - E| at x0 (0 when the choice does not arise)."""
+def _other_forms(law: ContactLaw) -> tuple[ContactLaw, ...]:
+    """The equally defensible variants of ``law`` (the other thin-layer ratio with Sneddon's
+    sphere; none when the choice does not arise)."""
     if law.thickness is None or not law.large_indentation:
-        return 0.0
-    other = dataclasses.replace(
-        law, layer_ratio_from="sphere" if law.layer_ratio_from == "published" else "published"
-    )
-    x = np.array([x0])
-    E0 = _closed_form(_shapes(law, depth_base, x), P, w)[0][0]
-    E1 = _closed_form(_shapes(other, depth_base, x), P, w)[0][0]
-    return abs(float(E1 - E0))
+        return ()
+    if law.layer_ratio_from == "published":
+        return (dataclasses.replace(law, layer_ratio_from="sphere"),)
+    return (dataclasses.replace(law, layer_ratio_from="published"),)
 
 
 def _lag1(r: FloatArray) -> float:
@@ -372,6 +434,18 @@ def _lag1(r: FloatArray) -> float:
     return min(max(float(c[1:] @ c[:-1]) / denom, 0.0), MAX_RHO)
 
 
+@dataclass(frozen=True)
+class _Profile:
+    """One model form's profile: its best E on the grid and the intervals of E and x0."""
+
+    modulus: float
+    ci_low: float
+    ci_high: float
+    contact_low: float
+    contact_high: float
+    edge: bool
+
+
 def _profile(
     law: ContactLaw,
     depth_base: FloatArray,
@@ -382,14 +456,17 @@ def _profile(
     threshold: float,
     lo: float,
     hi: float,
-) -> tuple[float, float, float, float, bool] | None:
+    offset: bool,
+) -> _Profile | None:
     """E and x0 intervals from the profile over x0; widens the grid until the region closes
-    (at most 5 times, x3 each; still open then: reported as reaching the edge)."""
+    (at most 5 times, x3 each; still open then: reported as reaching the edge). The grid is
+    centred on ``x0_hat``; the minimum is searched on it, so ``law`` need not be the law that
+    was fitted (the other model forms are profiled with the same weights)."""
     tries = 6
     for attempt in range(tries):
         a, b = max(lo, x0_hat - span), min(hi, x0_hat + span)
         grid = np.linspace(a, b, PROFILE_POINTS)
-        E, rss, S = _closed_form(_shapes(law, depth_base, grid), P, w)
+        E, _, rss, S = _closed_form(_shapes(law, depth_base, grid), P, w, offset)
         ok = S > 0
         if not np.any(ok):
             return None
@@ -402,11 +479,12 @@ def _profile(
             span *= 3.0
             continue
         h = np.sqrt(np.maximum(best + threshold - rss[idx], 0.0) / S[idx])
-        return (
-            float(np.min(E[idx] - h)),
-            float(np.max(E[idx] + h)),
-            float(grid[idx[0]]),
-            float(grid[idx[-1]]),
-            window_edge or open_grid,
+        return _Profile(
+            modulus=float(E[ok][np.argmin(rss[ok])]),
+            ci_low=float(np.min(E[idx] - h)),
+            ci_high=float(np.max(E[idx] + h)),
+            contact_low=float(grid[idx[0]]),
+            contact_high=float(grid[idx[-1]]),
+            edge=window_edge or open_grid,
         )
     return None

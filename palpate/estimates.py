@@ -9,7 +9,9 @@ the contact event: a late or early event cannot bias it.
 
 The strain noise is measured on the record itself (each row's 3-grating fit has one degree of
 freedom left; the median of its squared residual gives sigma), so nothing about the simulator's
-noise setting leaks in. What the estimator is told about the sample (thickness, bonding, Poisson
+noise setting leaks in. The strains' zero, taken on a few frames at rest, leaves a load offset
+common to the whole record; the joint fit fits it beside E and the contact
+(``JointFit.load_offset``). What the estimator is told about the sample (thickness, bonding, Poisson
 ratio) is written to the log header under ``"estimator"`` so ``palpate replay`` re-runs it with
 the same inputs and reproduces the fit bit for bit.
 """

@@ -49,7 +49,11 @@ class TrialLogWriter:
     def write(self, record: dict[str, Any]) -> None:
         if self._fh is None:
             raise ValueError(f"trial log {self.path} is closed")
-        self._fh.write(json.dumps(_clean(record), separators=(",", ":"), allow_nan=False))
+        try:  # the common case: nothing to clean, one pass
+            line = json.dumps(record, separators=(",", ":"), allow_nan=False)
+        except ValueError:  # a NaN or an infinity somewhere: written as null
+            line = json.dumps(_clean(record), separators=(",", ":"), allow_nan=False)
+        self._fh.write(line)
         self._fh.write("\n")
         self._fh.flush()
         if self._fsync:

@@ -103,10 +103,10 @@ class EmulatedBus:
 
     def servo(self, servo_id: int) -> EmulatedServo:
         """The servo answering to ``servo_id`` (the hook for the simulated world)."""
-        for s in self._servos:
-            if s.id == servo_id:
-                return s
-        raise KeyError(f"no servo with id {servo_id} on the bus")
+        found = self._find(servo_id)
+        if found is None:
+            raise KeyError(f"no servo with id {servo_id} on the bus")
+        return found
 
     @property
     def servos(self) -> tuple[EmulatedServo, ...]:

@@ -55,6 +55,13 @@ def _model_name(model: str | int) -> str:
     return model
 
 
+# name -> (first byte, end byte, signed, value mask): the table looked up once, not per access
+_LAYOUT: Final[dict[str, tuple[int, int, bool, int]]] = {
+    name: (address, address + size, name in tables.SIGNED, (1 << (8 * size)) - 1)
+    for name, (address, size) in tables.X_SERIES_CONTROL_TABLE.items()
+}
+
+
 class EmulatedServo:
     """One X-series servo. Thread-safe: every public method takes the servo's lock."""
 
@@ -93,15 +100,12 @@ class EmulatedServo:
 
     # --- raw item access -------------------------------------------------------------------
     def _get(self, name: str) -> int:
-        address, size = tables.X_SERIES_CONTROL_TABLE[name]
-        return int.from_bytes(
-            self.memory[address : address + size], "little", signed=name in tables.SIGNED
-        )
+        address, end, signed, _ = _LAYOUT[name]
+        return int.from_bytes(self.memory[address:end], "little", signed=signed)
 
     def _set(self, name: str, value: int) -> None:
-        address, size = tables.X_SERIES_CONTROL_TABLE[name]
-        mask = (1 << (8 * size)) - 1
-        self.memory[address : address + size] = (int(value) & mask).to_bytes(size, "little")
+        address, end, _, mask = _LAYOUT[name]
+        self.memory[address:end] = (int(value) & mask).to_bytes(end - address, "little")
 
     def _reset_items(self, *, eeprom: bool, keep: tuple[str, ...]) -> None:
         defaults = tables.MODEL_DEFAULTS[self.model]

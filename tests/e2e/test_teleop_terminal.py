@@ -121,6 +121,12 @@ def terminal(tmp_path: Path, bench: SimulatedBench) -> Iterator[Terminal]:
         term.close()
 
 
+def _goal_mm(text: str) -> float | None:
+    """The advance goal shown on the screen's advance line."""
+    m = re.search(r"^advance\s+[-+]?\d+\.\d+ mm\s+goal\s+([-+]?\d+\.\d+) mm", text, re.MULTILINE)
+    return None if m is None else float(m.group(1))
+
+
 def reading(text: str, label: str) -> float | None:
     """The first number on the screen line that starts with ``label``."""
     m = re.search(rf"^{label}\s+([-+]?\d+\.\d+)", text, re.MULTILINE)
@@ -144,6 +150,10 @@ def test_jog_save_emergency_stop_and_quit_in_a_terminal(
     # ten presses at once: the goal never runs more than one step ahead of the stage
     terminal.keys(*["Up"] * 10)
     text = terminal.wait_for(r"goal\s+2\.\d+ mm", r"state\s+IDLE")
+    goal = _goal_mm(text)
+    assert goal is not None
+    # IDLE means within the position tolerance of the goal: let the stage settle on it
+    text = terminal.wait_for(r"state\s+IDLE", advance=goal, within=0.006)
     stopped = reading(text, "advance")
     assert stopped is not None
     assert 1.99 < stopped < 2.1, text  # one step on, not ten
@@ -152,6 +162,8 @@ def test_jog_save_emergency_stop_and_quit_in_a_terminal(
     terminal.keys("Right")
     terminal.wait_for(r"state\s+IDLE", roll=10.0, within=0.1)
     assert abs(outer.position_ticks - 10.0 * TICKS_PER_DEG) <= 3
+    # the roll drags the stage through the gears' coupling; the drive takes it back out
+    terminal.wait_for(r"state\s+IDLE", advance=stopped)
 
     # store the pose under a name
     terminal.keys("s")

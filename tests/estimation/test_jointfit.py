@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -80,6 +82,7 @@ def test_interval_coverage_is_about_95_percent() -> None:
         E = float(rng.uniform(250e3, 1100e3))
         x0 = float(rng.uniform(-1e-3, 1e-3))
         u, P, e = curve(E, x0, rng, n=150)
+        P += rng.normal(0.0, 0.5 * SIGMA_P)  # each trial's zero error, common to its samples
         r = joint_fit(
             u,
             P,
@@ -95,6 +98,46 @@ def test_interval_coverage_is_about_95_percent() -> None:
         hits += r.ci_low <= E <= r.ci_high
     # binomial(200, 0.95): sd 1.5 %; 3 sd band
     assert 0.90 <= hits / trials <= 0.995
+
+
+def test_a_zero_error_on_the_load_is_fitted_not_absorbed_by_the_modulus() -> None:
+    rng = np.random.default_rng(7)
+    u, P, e = curve(400e3, 0.0, rng)
+    offset = 2.0 * SIGMA_P  # a constant load error on every sample (the strains' zero)
+    with_p0 = joint_fit(u, P + offset, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0)
+    without = joint_fit(
+        u, P + offset, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0, load_offset=False
+    )
+    clean = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0)
+    assert with_p0.success
+    assert without.success
+    assert clean.success
+    assert with_p0.load_offset == pytest.approx(offset, abs=0.3 * SIGMA_P)
+    assert with_p0.modulus == pytest.approx(clean.modulus, rel=2e-3)
+    assert without.load_offset == 0.0
+    # held at zero, the offset moves E by several times the fitted model's own shift
+    assert abs(without.modulus / clean.modulus - 1) > 5 * abs(with_p0.modulus / clean.modulus - 1)
+
+
+def test_interval_holds_the_modulus_whichever_layer_ratio_the_sample_follows() -> None:
+    # the sample follows chi = a/h, the estimate uses the published sqrt(R delta)/h; with little
+    # noise the gap between the two is larger than the noise interval
+    sphere = ContactLaw(3.5e-3, 0.45, 5e-3, bonded=True, layer_ratio_from="sphere")
+    rng = np.random.default_rng(8)
+    u, P, e = curve(400e3, 0.0, rng, law=sphere)
+    P = sphere.force(400e3, np.clip(u - e, 0.0, None)) + rng.normal(0.0, 1e-4, u.size)
+    law = dataclasses.replace(sphere, layer_ratio_from="published")
+    r = joint_fit(u, P, e, law, sigma_force=1e-4, contact_guess=0.0)
+    own = joint_fit(u, P, e, sphere, sigma_force=1e-4, contact_guess=0.0)
+    assert r.success
+    assert own.success
+    assert r.modulus is not None
+    assert r.ci_low is not None
+    assert r.ci_high is not None
+    assert r.model_spread is not None
+    assert abs(r.modulus / 400e3 - 1) > 0.01  # the published form alone misses it
+    assert r.ci_low <= 400e3 <= r.ci_high
+    assert r.model_spread == pytest.approx(abs(float(own.modulus or 0.0) - r.modulus), rel=0.02)
 
 
 def test_model_form_spread_widens_the_interval_on_thin_layers_only() -> None:
