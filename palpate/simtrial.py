@@ -192,16 +192,17 @@ def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
 
         return bench_pose
     tube = stack.tube(tube_name)
-    last: dict[float, kinematics.TipPose] = {}
+    frame_roll = math.nan
+    frame = kinematics.forward(tube, 0.0, 0.0)
 
     def robot_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
         # The tip frame depends on the roll only, which is constant while the stage moves:
         # keep the last one (the board asks for a pose at every sample).
-        p = last.get(roll)
-        if p is None:
-            last.clear()
-            p = last[roll] = kinematics.forward(tube, roll, 0.0)
-        return p.tube_tip, p.tangent, translation - tube.flush_translation
+        nonlocal frame, frame_roll
+        if roll != frame_roll:
+            frame, frame_roll = kinematics.forward(tube, roll, 0.0), roll
+        length = exposed_length_at("robot", translation, 0.0, tube.flush_translation)
+        return frame.tube_tip, frame.tangent, length
 
     return robot_pose
 
@@ -304,17 +305,17 @@ def run_sim_trial(
         TRANSLATION: stack.servos.translation.id,
     }
     holder: dict[str, EmulatedBus] = {}
-    memo: dict[tuple[int, ...], tuple[float, float, int]] = {}
+    last_ticks: dict[str, int] = {}
+    last_joints = (0.0, 0.0, 0)
 
     def joints() -> tuple[float, float, int]:
+        nonlocal last_ticks, last_joints
         bus = holder["bus"]
-        ticks = tuple(bus.servo(i).position_ticks for i in servo_ids.values())
-        known = memo.get(ticks)  # the servos rest for most board samples: keep the last answer
-        if known is None:
-            q = truth.joints({n: rad_from_ticks(t) for n, t in zip(servo_ids, ticks, strict=True)})
-            memo.clear()
-            known = memo[ticks] = (q.roll, q.translation, ticks[2])
-        return known
+        ticks = {n: bus.servo(i).position_ticks for n, i in servo_ids.items()}
+        if ticks != last_ticks:  # the servos rest for most board samples: keep the last answer
+            q = truth.joints({n: rad_from_ticks(t) for n, t in ticks.items()})
+            last_ticks, last_joints = ticks, (q.roll, q.translation, ticks[TRANSLATION])
+        return last_joints
 
     world = World(
         section=section,
