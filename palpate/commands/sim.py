@@ -15,10 +15,11 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from palpate.campaign import (
+    CampaignRun,
     campaign_trials,
     default_workers,
     median_abs_relative_error,
-    run_campaign,
+    run_campaigns,
     summarize_campaign,
 )
 from palpate.executors import add_executor_arguments, open_executor
@@ -92,21 +93,17 @@ def run(args: argparse.Namespace) -> int:
         bar.set_postfix_str(o.spec.trial_id)
 
     t_all = time.perf_counter()
+    runs = [
+        CampaignRun(c.specs, c.scene, c.stack, c.transport, c.log_dir, c.specs[0].trial_id)
+        for c in campaigns
+    ]
+    bar.set_description(" + ".join(c.scene.name for c in campaigns) + " campaign")
     with open_executor(args.executor, max(1, args.workers), args.scheduler) as executor:
-        for c in campaigns:  # one pool for all of them
-            bar.set_description(f"{c.scene.name} campaign")
-            t0 = time.perf_counter()
-            c.outcomes = run_campaign(
-                c.specs,
-                c.scene,
-                c.stack,
-                transport=c.transport,
-                log_dir=c.log_dir,
-                executor=executor,
-                series_for=c.specs[0].trial_id,
-                progress=progress,
-            )
-            c.wall = time.perf_counter() - t0
+        results = run_campaigns(runs, executor=executor, progress=progress)  # one pool for all
+    before = 0.0
+    for c, r in zip(campaigns, results, strict=True):
+        # the pool overlaps campaigns: each is charged the wall time since the previous finished
+        c.outcomes, c.wall, before = r.outcomes, max(r.finished_s - before, 1e-9), r.finished_s
     wall_all = time.perf_counter() - t_all
     bar.close()
     if args.compare_methods:

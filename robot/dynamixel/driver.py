@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import struct
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Self, TypeVar
@@ -43,6 +44,18 @@ _STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
 _STATE_END = sum(tables.X_SERIES_CONTROL_TABLE["Present_Position"])
 _STATE_LEN = _STATE_END - _STATE_START
 _GOAL_ADDR, _GOAL_LEN = tables.X_SERIES_CONTROL_TABLE["Goal_Position"]
+
+
+def _state_format() -> struct.Struct:
+    """Moving (u8), Present_Velocity and Present_Position (s32) out of one sync-read reply."""
+    velocity = tables.X_SERIES_CONTROL_TABLE["Present_Velocity"][0] - _STATE_START
+    position = tables.X_SERIES_CONTROL_TABLE["Present_Position"][0] - _STATE_START
+    return struct.Struct(f"<B{velocity - 1}xi{position - velocity - 4}xi")
+
+
+_STATE = _state_format()  # one unpack per reply instead of slices and int.from_bytes
+# one servo's part of the goals' sync write: its ID, then its Goal_Position (signed)
+_GOAL_PARAM = struct.Struct("<B" + {1: "b", 2: "h", 4: "i"}[_GOAL_LEN])
 
 
 @dataclass(frozen=True)
@@ -90,6 +103,7 @@ class DynamixelBus:
             raise ValueError("retries must be >= 0, timeout and max_goal_step > 0")
         self._motors = {m.name: m for m in motors}
         self._by_id = {m.id: m for m in motors}
+        self._ids = [m.id for m in motors]  # the sync read's parameter (made once, not per tick)
         self._port = _TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
         self._ph = sdk.PacketHandler(2.0)
         self._baudrate = baudrate
@@ -263,39 +277,42 @@ class DynamixelBus:
 
     def read_state(self) -> dict[str, MotorState]:
         """One sync read of Moving .. Present_Position of every servo."""
-        ids = [m.id for m in self._motors.values()]
-
-        def call() -> tuple[dict[int, tuple[list[int], int]], int, int]:
-            result = self._ph.syncReadTx(self._port, _STATE_START, _STATE_LEN, ids, len(ids), False)
-            replies: dict[int, tuple[list[int], int]] = {}
-            if result != sdk.COMM_SUCCESS:
-                return replies, result, 0
-            for servo_id in ids:
-                data, result, error = self._ph.readRx(self._port, servo_id, _STATE_LEN)
-                if result != sdk.COMM_SUCCESS:
-                    return replies, result, 0
-                replies[servo_id] = (data, error)
-            return replies, result, 0
-
-        replies = self._transact("sync read of present state", call, servo_id=None)
+        replies = self._transact("sync read of present state", self._sync_read_state, None)
         out: dict[str, MotorState] = {}
         for servo_id, (data, error) in replies.items():
             self._raise_for_status(servo_id, error)
-            raw = bytes(data)
-            position = int.from_bytes(raw[10:14], "little", signed=True)
+            if len(data) != _STATE_LEN:
+                # the SDK hands over what the status packet had (with its CRC bytes if short)
+                raise ServoTransportError(
+                    f"servo {servo_id}: short reply ({len(data)} of {_STATE_LEN} bytes)"
+                )
+            moving, velocity, position = _STATE.unpack(bytes(data))
             if abs(position) > tables.EXTENDED_POSITION_LIMIT:
                 # Beyond what extended position mode can reach or be commanded to: a corrupt
                 # reply that passed the CRC, never a goal to start the step clamp from.
                 raise ServoTransportError(
                     f"servo {servo_id}: implausible present position {position} ticks"
                 )
-            velocity = int.from_bytes(raw[6:10], "little", signed=True)
             out[self._by_id[servo_id].name] = MotorState(
                 position=units.rad_from_ticks(position),
                 velocity=units.rad_s_from_velocity_units(velocity),
-                moving=bool(raw[0]),
+                moving=bool(moving),
             )
         return out
+
+    def _sync_read_state(self) -> tuple[dict[int, tuple[list[int], int]], int, int]:
+        """One attempt of :meth:`read_state`: the sync read and every servo's reply, by ID."""
+        ids = self._ids
+        result = self._ph.syncReadTx(self._port, _STATE_START, _STATE_LEN, ids, len(ids), False)
+        replies: dict[int, tuple[list[int], int]] = {}
+        if result != sdk.COMM_SUCCESS:
+            return replies, result, 0
+        for servo_id in ids:
+            data, result, error = self._ph.readRx(self._port, servo_id, _STATE_LEN)
+            if result != sdk.COMM_SUCCESS:
+                return replies, result, 0
+            replies[servo_id] = (data, error)
+        return replies, result, 0
 
     def write_goals(self, goals: Mapping[str, float]) -> dict[str, float]:
         """One sync write of shaft-angle goals (rad), each clamped to ``max_goal_step`` from the
@@ -310,7 +327,7 @@ class DynamixelBus:
             step = max(-self.max_goal_step, min(self.max_goal_step, goal - last))
             ticks = units.ticks_from_rad(last + step)
             sent[name] = units.rad_from_ticks(ticks)
-            param += [m.id, *units.to_unsigned(ticks, _GOAL_LEN).to_bytes(_GOAL_LEN, "little")]
+            param += _GOAL_PARAM.pack(m.id, ticks)  # ticks_from_rad keeps it in range
 
         def call() -> tuple[None, int, int]:
             result = self._ph.syncWriteTxOnly(self._port, _GOAL_ADDR, _GOAL_LEN, param, len(param))

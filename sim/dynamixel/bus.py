@@ -42,6 +42,8 @@ _PING, _READ, _OTHER = 0, 1, 2  # reply kinds, compared with Status_Return_Level
 _CLEAR_KEY = bytes([0x01, 0x44, 0x58, 0x4C, 0x22])
 _REALTIME_POLL_S = 0.01
 _ID_ADDRESS = tables.X_SERIES_CONTROL_TABLE["ID"][0]
+_LEVEL_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Status_Return_Level"][0]
+_HW_ERROR_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Hardware_Error_Status"][0]
 
 
 class EmulatedBus:
@@ -64,6 +66,7 @@ class EmulatedBus:
         self._fds: tuple[int, int, int, int] | None = None
         self.port = ""
         self.packets_handled = 0
+        # instructions for the servo(s) the packet's ID addresses
         self._handlers: dict[int, Callable[[protocol.Packet, list[EmulatedServo]], list[bytes]]] = {
             protocol.INST_PING: self._ping,
             protocol.INST_READ: self._read,
@@ -73,6 +76,9 @@ class EmulatedBus:
             protocol.INST_FACTORY_RESET: self._factory_reset,
             protocol.INST_REBOOT: self._reboot,
             protocol.INST_CLEAR: self._clear,
+        }
+        # sync and bulk instructions name their servos in the parameters, not in the ID
+        self._group_handlers: dict[int, Callable[[protocol.Packet], list[bytes]]] = {
             protocol.INST_SYNC_READ: self._sync_read,
             protocol.INST_SYNC_WRITE: self._sync_write,
             protocol.INST_BULK_READ: self._bulk_read,
@@ -146,6 +152,9 @@ class EmulatedBus:
             return self._status(target, tables.ERR_CRC, b"", _OTHER) if target else []
         if packet.is_status:
             return []
+        group_handler = self._group_handlers.get(packet.instruction)
+        if group_handler is not None:
+            return group_handler(packet)
         if packet.servo_id == protocol.BROADCAST_ID:
             targets = sorted(self._servos, key=lambda s: s.id)
         else:
@@ -166,9 +175,10 @@ class EmulatedBus:
 
     @staticmethod
     def _status(servo: EmulatedServo, error: int, params: bytes, kind: int) -> list[bytes]:
-        if kind > servo.item("Status_Return_Level"):
+        memory = servo.memory  # one-byte items: no lock needed
+        if kind > memory[_LEVEL_ADDRESS]:
             return []
-        if servo.hardware_error:
+        if memory[_HW_ERROR_ADDRESS]:
             error |= tables.ALERT_BIT
         fault = servo.take_reply_fault()
         if fault == "drop":
@@ -179,6 +189,7 @@ class EmulatedBus:
         return [raw]
 
     # --- instruction handlers: (packet, addressed servos) -> status packets --------------------
+    # (the sync and bulk handlers at the end take the packet alone)
     def _ping(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
         out: list[bytes] = []
         for s in targets:
@@ -252,7 +263,7 @@ class EmulatedBus:
             return []
         return self._status(targets[0], errors[0], b"", _OTHER)
 
-    def _sync_read(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _sync_read(self, packet: protocol.Packet) -> list[bytes]:
         if packet.servo_id != protocol.BROADCAST_ID or len(packet.params) < 5:
             return []
         address, length = _word(packet.params, 0), _word(packet.params, 2)
@@ -264,7 +275,7 @@ class EmulatedBus:
                 out += self._status(s, error, data, _READ)
         return out
 
-    def _sync_write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _sync_write(self, packet: protocol.Packet) -> list[bytes]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID or len(params) < 4:
             return []
@@ -275,10 +286,10 @@ class EmulatedBus:
         for i in range(4, len(params), chunk):
             s = self._find(params[i])
             if s is not None:
-                s.write(address, params[i + 1 : i + chunk])
+                s.write_unanswered(address, params[i + 1 : i + chunk])
         return []
 
-    def _bulk_read(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _bulk_read(self, packet: protocol.Packet) -> list[bytes]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID or not params or len(params) % 5:
             return []
@@ -290,7 +301,7 @@ class EmulatedBus:
                 out += self._status(s, error, data, _READ)
         return out
 
-    def _bulk_write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _bulk_write(self, packet: protocol.Packet) -> list[bytes]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID:
             return []
@@ -302,7 +313,7 @@ class EmulatedBus:
                 break
             s = self._find(params[i])
             if s is not None:
-                s.write(_word(params, i + 1), data)
+                s.write_unanswered(_word(params, i + 1), data)
             i += 5 + length
         return []
 

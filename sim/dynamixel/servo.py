@@ -32,7 +32,9 @@ from __future__ import annotations
 
 import bisect
 import math
+import struct
 import threading
+from collections.abc import Callable
 from typing import Final
 
 from robot.dynamixel import tables
@@ -43,6 +45,7 @@ _MAX_STEP_S: Final = 1e-3
 _POSITION_MODES: Final = frozenset(
     {tables.MODE_POSITION, tables.MODE_EXTENDED_POSITION, tables.MODE_CURRENT_POSITION}
 )
+_DRIVEN_MODES: Final = _POSITION_MODES | {tables.MODE_VELOCITY}  # the modes that move the shaft
 
 
 def _model_name(model: str | int) -> str:
@@ -55,11 +58,56 @@ def _model_name(model: str | int) -> str:
     return model
 
 
-# name -> (first byte, end byte, signed, value mask): the table looked up once, not per access
-_LAYOUT: Final[dict[str, tuple[int, int, bool, int]]] = {
-    name: (address, address + size, name in tables.SIGNED, (1 << (8 * size)) - 1)
+_Unpack = Callable[[bytes | bytearray, int], tuple[int]]
+_Pack = Callable[[bytearray, int, int], None]
+_UNSIGNED_FORMATS: Final = {1: "<B", 2: "<H", 4: "<I"}
+
+
+def _unpacker(name: str, size: int) -> _Unpack:
+    """Reads an item's value, signed where the hardware is (``struct``: no slice, no copy)."""
+    fmt = _UNSIGNED_FORMATS[size]
+    return struct.Struct(fmt.lower() if name in tables.SIGNED else fmt).unpack_from
+
+
+# The table looked up once, not per access (tens of item accesses per control tick):
+# name -> (address, reader); name -> (address, writer of the value masked to its size, mask).
+_READERS: Final[dict[str, tuple[int, _Unpack]]] = {
+    name: (address, _unpacker(name, size))
     for name, (address, size) in tables.X_SERIES_CONTROL_TABLE.items()
 }
+_WRITERS: Final[dict[str, tuple[int, _Pack, int]]] = {
+    name: (address, struct.Struct(_UNSIGNED_FORMATS[size]).pack_into, (1 << (8 * size)) - 1)
+    for name, (address, size) in tables.X_SERIES_CONTROL_TABLE.items()
+}
+
+
+def profile_motion(
+    pos: float, vel: float, goal: float, vmax: float, amax: float, dt: float
+) -> tuple[float, float]:
+    """Shaft position (ticks) and velocity (ticks/s) after ``dt`` s of moving toward ``goal``.
+
+    The profile of position mode: the speed is at most ``vmax`` and, with a finite ``amax``, at
+    most the speed from which the shaft can still stop at the goal (``sqrt(2 amax |e|)``); the
+    velocity changes by at most ``amax`` per second (at once if ``amax`` is infinite). Explicit
+    Euler in steps of at most 1 ms; a step that reaches or crosses the goal ends exactly on it
+    with zero velocity. Pure (the servo's hot path, about one call per moving servo per tick).
+    """
+    unlimited_acceleration = math.isinf(amax)
+    remaining = dt
+    while remaining > 0:
+        h = min(remaining, _MAX_STEP_S)
+        remaining -= h
+        e = goal - pos
+        if e == 0.0 and vel == 0.0:
+            break
+        speed = vmax if unlimited_acceleration else min(vmax, math.sqrt(2.0 * amax * abs(e)))
+        v_des = math.copysign(speed, e)
+        v = v_des if unlimited_acceleration else vel + max(-amax * h, min(amax * h, v_des - vel))
+        new_pos = pos + v * h
+        if abs(e) < 1e-6 or (e > 0 and new_pos >= goal) or (e < 0 and new_pos <= goal):
+            return goal, 0.0  # arrived: the profile ends with zero velocity
+        pos, vel = new_pos, v
+    return pos, vel
 
 
 class EmulatedServo:
@@ -80,6 +128,9 @@ class EmulatedServo:
         self._table = tables.control_table(self.model)
         self._items = sorted((a, s, n) for n, (a, s) in self._table.items())
         self._starts = [a for a, _, _ in self._items]
+        # (address, size) of a whole item -> the item: a write of exactly one item, the usual
+        # case, needs no search for the items it overlaps
+        self._whole = {(a, size): (a, size, n) for a, size, n in self._items}
         self._covered = bytearray(tables.TABLE_SIZE)  # 1 where an item of the table lives
         for a, size, _ in self._items:
             self._covered[a : a + size] = b"\x01" * size
@@ -100,12 +151,12 @@ class EmulatedServo:
 
     # --- raw item access -------------------------------------------------------------------
     def _get(self, name: str) -> int:
-        address, end, signed, _ = _LAYOUT[name]
-        return int.from_bytes(self.memory[address:end], "little", signed=signed)
+        address, unpack = _READERS[name]
+        return unpack(self.memory, address)[0]
 
     def _set(self, name: str, value: int) -> None:
-        address, end, _, mask = _LAYOUT[name]
-        self.memory[address:end] = (int(value) & mask).to_bytes(end - address, "little")
+        address, pack, mask = _WRITERS[name]
+        pack(self.memory, address, int(value) & mask)
 
     def _reset_items(self, *, eeprom: bool, keep: tuple[str, ...]) -> None:
         defaults = tables.MODEL_DEFAULTS[self.model]
@@ -212,11 +263,7 @@ class EmulatedServo:
                     return tables.ERR_DATA_LENGTH
                 if name in tables.READ_ONLY or (a < tables.EEPROM_END and torque_on):
                     return tables.ERR_ACCESS
-                value = int.from_bytes(data[a - address : a - address + size], "little")
-                if name in tables.SIGNED:
-                    value = int.from_bytes(
-                        data[a - address : a - address + size], "little", signed=True
-                    )
+                value = _READERS[name][1](data, a - address)[0]  # signed where the item is
                 error = self._check_value(name, value)
                 if error:
                     return error
@@ -226,6 +273,9 @@ class EmulatedServo:
 
     def _overlapping(self, address: int, end: int) -> list[tuple[int, int, str]]:
         """The items that share a byte with ``[address, end)``, in address order."""
+        whole = self._whole.get((address, end - address))
+        if whole is not None:
+            return [whole]
         i = max(bisect.bisect_right(self._starts, address) - 1, 0)
         j = bisect.bisect_left(self._starts, end, lo=i)
         return [it for it in self._items[i:j] if it[0] + it[1] > address]
@@ -236,8 +286,11 @@ class EmulatedServo:
             return tables.ERR_DATA_RANGE
         if name == "Operating_Mode" and value not in tables.OPERATING_MODES[self.model]:
             return tables.ERR_DATA_RANGE
-        shut_down = self._get("Hardware_Error_Status") & self._get("Shutdown")
-        if name == "Torque_Enable" and value == 1 and shut_down:
+        if (
+            name == "Torque_Enable"
+            and value == 1
+            and self._get("Hardware_Error_Status") & self._get("Shutdown")
+        ):
             return tables.ERR_RESULT_FAIL
         if name == "Goal_Position":
             mode = self._get("Operating_Mode")
@@ -272,6 +325,16 @@ class EmulatedServo:
                 self._pos = self._pos % tables.TICKS_PER_REV
             self._refresh()
             return 0
+
+    def write_unanswered(self, address: int, data: bytes) -> None:
+        """A write whose error number no one receives (Sync Write, Bulk Write).
+
+        Bytes equal to those in memory change nothing whether or not :meth:`write` would allow
+        them, so they skip its checks: a goal streamed at 250 Hz to a servo at rest.
+        """
+        with self._lock:
+            if self.memory[address : address + len(data)] != data:
+                self.write(address, data)
 
     def reg_write(self, address: int, data: bytes) -> int:
         """Store a write for the next Action; returns the error number."""
@@ -350,7 +413,7 @@ class EmulatedServo:
 
     def _integrate(self, dt: float) -> None:
         mode = self.memory[11]
-        if self.memory[64] != 1 or mode not in (*_POSITION_MODES, tables.MODE_VELOCITY):
+        if self.memory[64] != 1 or mode not in _DRIVEN_MODES:
             self._vel = 0.0
             return
         if mode in _POSITION_MODES and self._vel == 0.0 and not self._stalled:
@@ -376,26 +439,7 @@ class EmulatedServo:
             self._pos += self._vel * dt
             return
         goal_f = float(self._get("Goal_Position") - self._get("Homing_Offset"))
-        remaining = dt
-        while remaining > 0:
-            h = min(remaining, _MAX_STEP_S)
-            remaining -= h
-            e = goal_f - self._pos
-            if e == 0.0 and self._vel == 0.0:
-                break
-            speed = vmax if math.isinf(amax) else min(vmax, math.sqrt(2.0 * amax * abs(e)))
-            v_des = math.copysign(speed, e)
-            if math.isinf(amax):
-                v = v_des
-            else:
-                v = self._vel + max(-amax * h, min(amax * h, v_des - self._vel))
-            new_pos = self._pos + v * h
-            if abs(e) < 1e-6 or (e > 0 and new_pos >= goal_f) or (e < 0 and new_pos <= goal_f):
-                self._pos = goal_f  # arrive; the profile ends with zero velocity
-                self._vel = 0.0
-            else:
-                self._pos = new_pos
-                self._vel = v
+        self._pos, self._vel = profile_motion(self._pos, self._vel, goal_f, vmax, amax, dt)
 
     def _refresh(self) -> None:
         present = round(self._pos) + self._get("Homing_Offset")

@@ -12,6 +12,9 @@ from estimation.corrections import (
     ContactLaw,
     dimitriadis_bracket,
     dimitriadis_coefficients,
+    shape_values,
+    sneddon_y,
+    sneddon_y_at,
     validity_warnings,
 )
 from sim.tissue import TissueModel
@@ -66,6 +69,51 @@ def test_shape_derivative_matches_finite_differences(ratio_from: str, large: boo
     h = 1e-9
     fd = (law.shape(d + h)[0] - law.shape(d - h)[0]) / (2 * h)
     np.testing.assert_allclose(law.shape(d)[1], fd, rtol=1e-5)
+
+
+def test_sneddon_y_is_the_root_to_rounding_over_the_whole_range() -> None:
+    # the fixed three Newton steps against the guarded scalar iteration (itself within 1 ulp of
+    # the root): at most 1 ulp each way, so 2 ulp apart; and y tanh y = d to rounding
+    rng = np.random.default_rng(11)
+    d = np.concatenate([np.geomspace(1e-12, 1e3, 4001), 10 ** rng.uniform(-12, 3, 4000)])
+    y = sneddon_y(d)
+    twin = np.array([sneddon_y_at(float(x)) for x in d])
+    assert np.max(np.abs(y - twin) / np.spacing(twin)) <= 2.0
+    assert np.max(np.abs(y * np.tanh(y) - d) / d) <= 3 * np.finfo(np.float64).eps
+    # the limits: y ~ sqrt(d) (1 + d/6) near 0, y = d once tanh(y) rounds to 1
+    np.testing.assert_allclose(sneddon_y(np.array([1e-12])), 1e-6 * (1 + 1e-12 / 6), rtol=1e-15)
+    assert sneddon_y(np.array([50.0, 1e200]))[1] == 1e200
+
+
+def test_sneddon_y_at_and_below_zero_is_zero_without_warnings() -> None:
+    y = sneddon_y(np.array([0.0, -1.0, 5e-324]))  # numpy warnings are errors in the test run
+    assert y[0] == 0.0
+    assert y[1] == 0.0
+    assert y[2] == pytest.approx(np.sqrt(5e-324), rel=1e-15)
+
+
+@pytest.mark.parametrize("large", [True, False])
+def test_shape_values_are_the_shape_bit_for_bit_for_every_form(large: bool) -> None:
+    d = np.concatenate([np.linspace(-1e-3, 2e-3, 301), [0.0]])
+    laws = [
+        ContactLaw(R, 0.45, h, bonded, large, ratio)
+        for h in (None, 5e-3)
+        for bonded in (True, False)
+        for ratio in ("published", "sphere")
+    ]
+    for law, values in zip(laws, shape_values(laws, d), strict=True):
+        np.testing.assert_array_equal(values, law.shape(d)[0])
+    block = d[:300].reshape(3, 100)  # any shape
+    np.testing.assert_array_equal(shape_values(laws[:1], block)[0], laws[0].shape(block)[0])
+
+
+def test_shape_values_refuses_laws_that_share_no_half_space() -> None:
+    with pytest.raises(ValueError, match="at least one law"):
+        shape_values([], DEPTHS)
+    with pytest.raises(ValueError, match="share"):
+        shape_values([ContactLaw(R, 0.45), ContactLaw(R, 0.3)], DEPTHS)
+    with pytest.raises(ValueError, match="share"):
+        shape_values([ContactLaw(R, 0.45), ContactLaw(R, 0.45, large_indentation=False)], DEPTHS)
 
 
 def test_no_force_before_contact_and_inverse_for_modulus() -> None:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from estimation.corrections import ContactLaw
-from estimation.jointfit import joint_fit
+from estimation.jointfit import _closed_form, _grid_fits, _profiles, joint_fit
 
 LAW = ContactLaw(3.5e-3, 0.45, 10e-3, bonded=True, large_indentation=True)
 EA = 9.7e3
@@ -116,6 +116,9 @@ def test_a_zero_error_on_the_load_is_fitted_not_absorbed_by_the_modulus() -> Non
     assert with_p0.modulus == pytest.approx(clean.modulus, rel=2e-3)
     assert without.load_offset == 0.0
     # held at zero, the offset moves E by several times the fitted model's own shift
+    assert without.modulus is not None
+    assert clean.modulus is not None
+    assert with_p0.modulus is not None
     assert abs(without.modulus / clean.modulus - 1) > 5 * abs(with_p0.modulus / clean.modulus - 1)
 
 
@@ -179,3 +182,37 @@ def test_bad_input_raises() -> None:
         joint_fit(u, np.zeros(50), 0.0, LAW, sigma_force=0.0)
     with pytest.raises(ValueError, match="confidence"):
         joint_fit(u, np.zeros(50), 0.0, LAW, sigma_force=SIGMA_P, confidence=1.0)
+
+
+def test_grid_fits_in_blocks_match_the_whole_matrix_closed_form() -> None:
+    # the blocked, depth-sorted evaluation against the plain (K, N) one it replaced
+    rng = np.random.default_rng(9)
+    u, P, e = curve(400e3, 0.0, rng, n=600)  # 600 samples: 27 rows a block, 5 blocks
+    depth_base = u - e
+    w = np.full(u.size, SIGMA_P**-2)
+    grid = np.linspace(-0.5e-3, 0.4e-3, 121)
+    laws = [LAW, dataclasses.replace(LAW, layer_ratio_from="sphere")]
+    for offset in (True, False):
+        fits = _grid_fits(laws, depth_base, P, w, grid, offset)
+        for law, fit in zip(laws, fits, strict=True):
+            depth = depth_base[None, :] - grid[:, None]
+            f = np.where(depth > 0, law.shape(np.maximum(depth, 0.0))[0], 0.0)
+            for got, want in zip(fit, _closed_form(f, P, w, offset), strict=True):
+                np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.max(np.abs(want)))
+
+
+def test_profiles_in_lockstep_are_each_forms_own_profile() -> None:
+    # a start span far inside the interval makes the grids widen; profiled together, each form
+    # must get what it gets alone
+    rng = np.random.default_rng(10)
+    u, P, e = curve(400e3, 0.0, rng)
+    w = np.full(u.size, SIGMA_P**-2)
+    laws = [LAW, dataclasses.replace(LAW, layer_ratio_from="sphere")]
+    span = 2e-7
+    args = (u - e, P, w, 0.0, span, 3.84, -1e-3, 1e-3, True)
+    together = _profiles(laws, *args)
+    alone = [_profiles([law], *args)[0] for law in laws]
+    assert together == alone
+    for prof in together:
+        assert prof is not None
+        assert prof.contact_high - prof.contact_low > 2 * span  # it did widen

@@ -14,7 +14,10 @@ from robot.dynamixel import tables
 from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
 from sim.clock import VirtualClock
+from sim.dynamixel import protocol
 from sim.dynamixel.bus import EmulatedBus
+from sim.dynamixel.faults import FaultyBus
+from sim.inprocess import InProcessPort
 
 CFG = ServoBusConfig(retries=2, timeout_ms=50.0)
 NAMES = ("outer_roll", "inner_roll", "translation")
@@ -163,6 +166,19 @@ def test_a_stall_becomes_an_overload_fault(
         driver.read_state()
     assert info.value.servo_id == 3
     assert not emulator.servo(3).torque_enabled
+
+
+def test_a_short_state_reply_is_a_transport_error(clock: VirtualClock) -> None:
+    emulator = FaultyBus.from_config(CFG, clock=clock)
+    with DynamixelBus.from_config(CFG, port=InProcessPort(emulator)) as driver:
+        driver.set_torque(True)
+        # well-formed status packets (valid CRC) with 2 of the 14 bytes asked for
+        emulator.reply_filter = lambda _: b"".join(
+            protocol.encode_status(i, 0, b"\x01\x02") for i in (1, 2, 3)
+        )
+        with pytest.raises(ServoTransportError, match="short reply"):
+            driver.read_state()
+        emulator.reply_filter = None
 
 
 def test_access_error_is_a_fault_with_its_number(driver: DynamixelBus) -> None:

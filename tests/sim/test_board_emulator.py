@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from sensor.frame import FrameLayout, Status
@@ -153,3 +154,45 @@ def test_overrun_flag_when_the_transmit_buffer_is_full() -> None:
 def test_faults_validate() -> None:
     with pytest.raises(ValueError, match="bitflip"):
         BoardFaults(bitflip_probability=0.7, truncate_probability=0.7).validate()
+
+
+def test_without_faults_the_fault_generator_is_never_drawn() -> None:
+    """With every fault off the board sends each frame without drawing: the draws would decide
+    nothing, and a fault-free stream costs no random numbers."""
+    clock = VirtualClock()
+    sink = _Sink()
+    emu = BoardEmulator(constant_source(WAVELENGTHS), LAYOUT, clock=clock, sink=sink)
+    before = emu._rng.bit_generator.state
+    with emu:
+        clock.advance(0.1)
+    assert emu._rng.bit_generator.state == before
+    assert emu.stats.frames_sent == emu.stats.samples == 100
+    assert len(sink.data) == 100 * LAYOUT.size
+    assert not BoardFaults().random
+    assert BoardFaults(drop_probability=0.01).random
+
+
+def test_wavelengths_may_be_any_sequence() -> None:
+    sent = []
+    for wavelengths in (list(WAVELENGTHS), WAVELENGTHS, np.asarray(WAVELENGTHS)):
+        sample = BoardSample(wavelengths=wavelengths)
+
+        def source(t: float, sample: BoardSample = sample) -> BoardSample:
+            return sample
+
+        clock, sink = VirtualClock(), _Sink()
+        with BoardEmulator(source, LAYOUT, clock=clock, sink=sink):
+            clock.advance(0.01)
+        sent.append(sink.data)
+    assert sent[0] == sent[1] == sent[2] != b""
+
+
+class _Sink:
+    name = "memory://test"
+
+    def __init__(self) -> None:
+        self.data = b""
+
+    def write(self, data: bytes) -> int:
+        self.data += data
+        return len(data)

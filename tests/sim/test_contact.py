@@ -16,6 +16,7 @@ from sim.contact import (
     AxialLaw,
     ContactEffects,
     ContactState,
+    _Recall,
     solve_contact,
 )
 from sim.tissue import TissueModel
@@ -310,3 +311,53 @@ def test_scalar_path_reports_failures() -> None:
     assert not short.success
     assert short.status == 1
     assert np.isfinite(short.P)
+
+
+GRIDS = {
+    "pre-onset": np.linspace(0.0, 2e-5, 51),
+    "mixed": np.linspace(0.0, 2.5e-4, 51),
+    "post-onset": np.linspace(5e-4, 7.5e-4, 51),
+}
+
+
+@pytest.mark.parametrize("grid", list(GRIDS))
+@pytest.mark.parametrize("fx", EFFECTS)
+def test_recalled_evaluations_change_no_bit(
+    grid: str, fx: ContactEffects, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The solver recalls its last law evaluations for its outputs; evaluating every call
+    afresh must give the same arrays bit for bit (pre-onset, mixed and post-onset grids)."""
+    beam_mod = pytest.importorskip("estimation.beam")
+    beam = beam_mod.Beam(EI=EI, EA=EA, fiber_offset=1.5e-4, length=0.042)
+    tissue = TISSUES[1]
+    u = GRIDS[grid]
+    recalled = solve_contact(u, beam, tissue, fx)
+    calls = []
+
+    def evaluate(self: _Recall[object], x: np.ndarray) -> object:
+        calls.append(1)
+        return self._fn(x)
+
+    monkeypatch.setattr(_Recall, "__call__", evaluate)
+    fresh = solve_contact(u, beam, tissue, fx)
+    assert calls
+    assert recalled.success, recalled.message
+    for name in ("delta", "e", "P", "R", "buckled", "converged"):
+        assert getattr(recalled, name).tobytes() == getattr(fresh, name).tobytes(), name
+
+
+def test_recall_returns_the_last_result_only_for_the_same_bits() -> None:
+    seen: list[np.ndarray] = []
+
+    def law(x: np.ndarray) -> np.ndarray:
+        seen.append(x)
+        return 2.0 * x
+
+    f = _Recall(law)
+    x = np.array([1.0, 2.0])
+    first = f(x)
+    assert f(x.copy()) is first
+    assert len(seen) == 1
+    f(np.array([1.0, -0.0 + 2.0 * 1.0000000000000002]))  # one ulp away: evaluated
+    f(np.array([[1.0, 2.0]]))  # same bytes, another shape: evaluated
+    assert len(seen) == 3

@@ -105,3 +105,39 @@ def test_decode_rejects_malformed_packets() -> None:
         p.decode(b"\x00" + good[1:])
     with pytest.raises(ValueError, match="servo id"):
         p.encode(300, p.INST_PING)
+
+
+_packets = st.builds(
+    p.encode,
+    st.integers(0, 0xFE),
+    st.sampled_from([p.INST_PING, p.INST_READ, p.INST_SYNC_READ, p.INST_SYNC_WRITE, p.INST_STATUS]),
+    wire_bytes.filter(lambda b: len(b) <= 20),
+)
+
+
+@given(st.lists(_packets | wire_bytes, max_size=4))
+def test_a_whole_feed_and_a_byte_wise_feed_agree(chunks: list[bytes]) -> None:
+    # the reader's shortcut for one whole packet must give what the stream splitter gives
+    data = b"".join(chunks)
+    reader = p.PacketReader()
+    byte_wise: list[p.Packet | p.BadPacket] = []
+    for i in range(len(data)):
+        byte_wise += reader.feed(data[i : i + 1])
+    assert p.PacketReader().feed(data) == byte_wise
+
+
+def test_a_corrupt_copy_of_a_remembered_packet_is_still_rejected() -> None:
+    good = p.encode(p.BROADCAST_ID, p.INST_SYNC_READ, p.u16(122) + p.u16(14) + bytes([1, 2, 3]))
+    reader = p.PacketReader()
+    assert reader.feed(good) == reader.feed(good) == [p.decode(good)]
+    bad = bytearray(good)
+    bad[-1] ^= 0xFF
+    assert reader.feed(bytes(bad)) == [p.BadPacket(p.BROADCAST_ID, p.INST_SYNC_READ)]
+    with pytest.raises(p.ProtocolError):
+        p.decode_cached(bytes(bad))
+
+
+def test_status_encoding_takes_any_bytes_like_params_and_masks_the_error() -> None:
+    expected = p.encode(1, p.INST_STATUS, b"\x80\x01\x02")
+    assert p.encode_status(1, 0x180, bytearray(b"\x01\x02")) == expected
+    assert p.encode_status(1, 0x80, b"\x01\x02") == expected

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
 
 from robot.dynamixel import tables
-from sim.dynamixel.servo import EmulatedServo
+from sim.dynamixel.servo import EmulatedServo, profile_motion
 
 GOAL = tables.X_SERIES_CONTROL_TABLE["Goal_Position"][0]
 TICKS_PER_S_PER_UNIT = 0.229 * 4096 / 60
@@ -202,3 +203,32 @@ def test_unknown_models_are_rejected() -> None:
         EmulatedServo(1, 29)
     assert EmulatedServo(1, 1060).model == "XL430-W250"
     assert math.isfinite(EmulatedServo().velocity_ticks_per_s)
+
+
+def test_control_table_items_do_not_overlap() -> None:
+    # the servo finds the item of a whole-item write by its address alone
+    items = sorted(tables.X_SERIES_CONTROL_TABLE.values())
+    for (a, size), (b, _) in itertools.pairwise(items):
+        assert a + size <= b
+
+
+def test_an_unanswered_write_of_the_bytes_already_there_changes_nothing() -> None:
+    s = _servo()  # torque on: EEPROM refuses writes
+    s.write_unanswered(GOAL, _le(100, 4))
+    assert s.item("Goal_Position") == 100
+    before = bytes(s.memory)
+    s.write_unanswered(11, bytes([4]))  # refused, but the same byte: skipped
+    s.write_unanswered(11, bytes([3]))  # refused: nothing written
+    s.write_unanswered(GOAL, _le(100, 4))
+    assert bytes(s.memory) == before
+
+
+def test_profile_motion_cruises_then_arrives_exactly_at_rest() -> None:
+    vmax = 1000.0  # ticks/s, no acceleration limit: constant speed
+    assert profile_motion(0.0, 0.0, 100.0, vmax, math.inf, 0.05) == pytest.approx((50.0, vmax))
+    assert profile_motion(0.0, 0.0, -100.0, vmax, math.inf, 0.5) == (-100.0, 0.0)
+    assert profile_motion(7.0, 0.0, 7.0, vmax, 10.0, 1.0) == (7.0, 0.0)
+    # with an acceleration limit a: from rest, v = a t for the first steps
+    pos, vel = profile_motion(0.0, 0.0, 1e6, vmax, 2000.0, 0.004)
+    assert vel == pytest.approx(8.0)
+    assert pos == pytest.approx((2.0 + 4.0 + 6.0 + 8.0) * 1e-3)  # explicit Euler, 1 ms steps
