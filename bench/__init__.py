@@ -10,5 +10,6 @@ SECTIONS: dict[str, str] = {
     "mechanics": "bench.mechanics",
     "sensor": "bench.sensor",
     "robot": "bench.robot",
+    "campaign": "bench.campaign",
     "fuzz": "bench.fuzz",
 }

@@ -260,7 +260,6 @@ class TubeConfig:
     tip_angle_deg: float = field(default=0.0, metadata=limits(ge=0, le=180))
     straight_length_mm: float = field(default=40.0, metadata=limits(ge=0, le=1000))
     arc_length_mm: float = field(default=40.0, metadata=limits(ge=0, le=1000))
-    tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
     flush_translation_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
 
     def validate(self) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -100,3 +101,20 @@ def test_cli_bad_scene_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str
     bad.write_text("campaign: {kind: sideways}\n", encoding="utf-8")
     assert main(["sim", "--scene", str(bad), "--out", str(tmp_path)]) == 2
     assert "campaign.kind" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("rate_hz", [100.0, 500.0])
+def test_other_control_rates_run_the_same_trial(rate_hz: float) -> None:
+    """``palpate bench --only campaign`` varies the control (and board) rate; a trial at another
+    rate must follow the same protocol: it completes, its tick count scales with the rate and
+    the joint fit stays close to the sample's modulus."""
+    base = run_sim_trial(bench_spec(), BENCH, STACK)
+    scene = dataclasses.replace(BENCH, control_rate_hz=rate_hz, board_rate_hz=rate_hz)
+    other = run_sim_trial(bench_spec(), scene, STACK)
+    assert base.state == other.state == "done"
+    ratio = other.ticks / base.ticks
+    assert ratio == pytest.approx(rate_hz / BENCH.control_rate_hz, rel=0.15)
+    assert other.sim_time == pytest.approx(base.sim_time, rel=0.1)
+    assert other.joint is not None
+    assert other.joint.modulus is not None
+    assert other.joint.modulus == pytest.approx(other.spec.modulus, rel=0.05)
