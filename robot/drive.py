@@ -52,10 +52,7 @@ class RollerGearDrive:
         if offsets is not None:
             self.offsets.update({name: float(offsets[name]) for name in SERVOS})
         self._rev_per_m = 2.0 * math.pi / cfg.lead
-
-    @property
-    def home(self) -> JointState:
-        return JointState(self.cfg.home_roll, self.cfg.home_translation)
+        self.home = JointState(cfg.home_roll, cfg.home_translation)  # read at every command
 
     def check(self, q: JointState) -> None:
         """Raise JointLimitError if ``q`` is outside the roll or translation limits."""
