@@ -25,6 +25,7 @@ from palpate.simtrial import tissue_model
 from palpate.trialsetup import sensor_section
 from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
+from robot.dynamixel.tables import TICKS_PER_REV
 from robot.dynamixel.units import rad_from_ticks
 from sensor.reader import layout_from_config
 from sim.board import BoardEmulator, BoardSample
@@ -133,6 +134,7 @@ class SimulatedBench:
             rng=self._rng,
             has_force=self.stack.board.has_force,
             length_grows=True,
+            encoder_step=self.stack.drive.lead / TICKS_PER_REV,
         )
 
     def _sample(self, t: float) -> BoardSample:

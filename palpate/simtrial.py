@@ -329,6 +329,7 @@ def run_sim_trial(
         rng=rng,
         has_force=stack.board.has_force,
         length_grows=spec.kind == "robot",
+        encoder_step=stack.drive.lead / TICKS_PER_REV,
     )
     tick = 1.0 / scene.control_rate_hz
     plan = TrialPlan(

@@ -161,7 +161,11 @@ class World:
         rng: np.random.Generator,
         has_force: bool = True,
         length_grows: bool = True,
+        encoder_step: float | None = None,
     ) -> None:
+        """``encoder_step``: the stage advance per encoder count (m). The stage stops only on
+        whole counts, so every sample in contact lies on that lattice; the contact table is
+        then solved on it and needs no interpolation in the advance (None: a 5 um grid)."""
         self.section = section
         self.sensor = sensor
         self.fbg = fbg
@@ -190,6 +194,7 @@ class World:
         self._tip_radius = sensor.tip_radius
         self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
+        self.encoder_step = encoder_step
         self._table: ContactTable | None = None
         self._surface = surface
         self._joints: tuple[float, float, int] | None = None  # the reading _physics belongs to
@@ -228,9 +233,18 @@ class World:
         delta = e = P = R = 0.0
         if past > 0.0 and length > 0.0:
             if self._table is None:
-                self._table = ContactTable(self, length - past, self.length_grows)
+                self._table = ContactTable(
+                    self, length - past, self.length_grows, lattice=self._lattice(past)
+                )
             delta, e, P, R, strains = self._table.at(past)
         return length, past, delta, e, P, R, strains
+
+    def _lattice(self, past: float) -> tuple[float, float] | None:
+        """(step, origin) of the encoder lattice in the advance past contact, from the first
+        sample in contact; None without an encoder step."""
+        if self.encoder_step is None:
+            return None
+        return self.encoder_step, past % self.encoder_step
 
     def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
         """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R|, strains
@@ -303,16 +317,19 @@ class ContactTable:
     """Equilibrium tabulated over the advance past contact ``u``, solved lazily in bins.
 
     A trial visits one path through (u, L): L = L_contact + u on the robot (the sensor slides
-    out of the tube), L fixed on the bench. Each bin of ``bin_width`` in u is solved in one
-    vectorised call per bin edge length, and values are interpolated linearly in u on a
-    ``step`` grid and linearly in L between the edges (error O(dL^2 / L^2) ~ 4e-5 for 0.25 mm
-    bins at L = 42 mm). Why: a vectorised solve costs ~4 ms of numpy call overhead plus ~30 us
-    per point (2 points: 4.0 ms, 51: 5.6 ms, 101: 6.8 ms), so one call per sample would make a
-    trial take a minute. A trial touches 3-5 bins and visits every grid interval of each but
-    the last (~140 samples per bin at 0.5 mm/s and 250 Hz), so solving part of a bin would
-    save little; 0.5 mm bins (half the calls, 101 points) saved ~15 % on the bench, nothing
-    on the robot, and moved the joint estimates by up to 0.25 %. The tables are kept as plain
-    floats: a lookup is ~20 float operations.
+    out of the tube), L fixed on the bench. The grid in u is the encoder lattice when the world
+    knows it (``lattice`` = (step, origin): every sample in contact is at origin + j step, so a
+    lookup lands on a solved point and the linear interpolation in u is exact; it was not on a
+    fixed 5 um grid, whose strains near the buckling knee were off by up to 2.4 ue, about one
+    noise sd). Each bin of ``bin_counts`` steps is solved in one vectorised call per bin edge
+    length, and values are interpolated linearly in L between the edges (error
+    O(dL^2 / L^2) ~ 4e-5 for 0.25 mm bins at L = 42 mm). Why bins: a vectorised solve costs
+    ~4 ms of numpy call overhead plus ~30 us per point (2 points: 4.0 ms, 51: 5.6 ms, 101:
+    6.8 ms), so one call per sample would make a trial take a minute. A trial touches 3-5 bins
+    and visits most of each but the last (~140 samples per bin at 0.5 mm/s and 250 Hz), so
+    solving part of a bin would save little; 0.5 mm bins (half the calls, 101 points) saved
+    ~15 % on the bench and nothing on the robot. The tables are kept as plain floats: a lookup
+    is ~20 float operations.
     """
 
     def __init__(
@@ -321,40 +338,41 @@ class ContactTable:
         contact_length: float,
         grows: bool,
         *,
+        lattice: tuple[float, float] | None = None,
         bin_width: float = 0.25e-3,
-        step: float = 5e-6,
     ) -> None:
         self.world = world
         self.contact_length = contact_length
         self.grows = grows
-        self.bin_width = bin_width
-        self.n = max(2, round(bin_width / step)) + 1
+        self.step, self.origin = lattice if lattice is not None else (5e-6, 0.0)
+        self.n = max(2, round(bin_width / self.step))  # grid intervals per bin
+        self.bin_width = self.n * self.step
         self._bins: dict[int, _Bin] = {}
 
     def _bin(self, k: int) -> _Bin:
-        """Bin ``k``: its u grid and, per edge length, the rows on that grid."""
+        """Bin ``k``: its u grid (lattice points k n .. (k + 1) n) and, per edge length, the
+        rows on that grid."""
         if k not in self._bins:
-            u = np.linspace(k * self.bin_width, (k + 1) * self.bin_width, self.n)
-            edges = (k, k + 1) if self.grows else (k,)
+            j = np.arange(k * self.n, (k + 1) * self.n + 1, dtype=np.float64)
+            u = self.origin + j * self.step  # the same value for a point two bins share
+            edges = (u[0], u[-1]) if self.grows else (0.0,)
             rows = [
-                np.column_stack(
-                    self.world.solve_on_grid(
-                        u, self.contact_length + j * self.bin_width * self.grows
-                    )
-                ).tolist()
-                for j in edges
+                np.column_stack(self.world.solve_on_grid(u, self.contact_length + edge)).tolist()
+                for edge in edges
             ]
             self._bins[k] = _Bin(u.tolist(), rows)
         return self._bins[k]
 
     def at(self, u: float) -> tuple[float, float, float, float, tuple[float, ...]]:
         """(delta, e, P, |R|, strains) at advance ``u`` past contact."""
-        k = int(u // self.bin_width)
+        pos = (u - self.origin) / self.step  # lattice index, whole on the lattice
+        k = max(0, int(pos // self.n))
+        local = pos - k * self.n
+        i = min(max(int(local), 0), self.n - 1)
+        w_u = local - i
         grid, rows = self._bin(k)
-        i = min(int((u - grid[0]) / (grid[1] - grid[0])), self.n - 2)
-        w_u = (u - grid[i]) / (grid[i + 1] - grid[i])
         row = _lerp(rows[0][i], rows[0][i + 1], w_u)
         if self.grows:
-            w_l = (u - grid[0]) / self.bin_width
+            w_l = (u - grid[0]) / (grid[-1] - grid[0])
             row = _lerp(row, _lerp(rows[1][i], rows[1][i + 1], w_u), w_l)
         return row[0], row[1], row[2], row[3], tuple(row[4:])

@@ -111,23 +111,42 @@ def test_kept_physics_is_what_a_fresh_evaluation_gives(grows: bool) -> None:
 def test_table_lookup_is_the_array_interpolation(grows: bool) -> None:
     w = world(Stage(PATH))
     table = ContactTable(w, L, grows)
+    step = table.step
     for u in np.random.default_rng(3).uniform(0.0, 0.6e-3, 25).tolist():
         # the lookup as numpy rows, which the plain-float lookup replaces
         k = int(u // table.bin_width)
-        grid = np.linspace(k * table.bin_width, (k + 1) * table.bin_width, table.n)
-        edges = (k, k + 1) if grows else (k,)
-        values = [
-            np.column_stack(w.solve_on_grid(grid, L + j * table.bin_width * grows)) for j in edges
-        ]
-        i = min(int((u - grid[0]) / (grid[1] - grid[0])), table.n - 2)
-        w_u = (u - grid[i]) / (grid[i + 1] - grid[i])
+        grid = table.origin + np.arange(k * table.n, (k + 1) * table.n + 1) * step
+        edges = (grid[0], grid[-1]) if grows else (0.0,)
+        values = [np.column_stack(w.solve_on_grid(grid, L + edge)) for edge in edges]
+        local = u / step - k * table.n
+        i = min(int(local), table.n - 1)
+        w_u = local - i
         row = values[0][i] * (1 - w_u) + values[0][i + 1] * w_u
         if grows:
-            w_l = (u - grid[0]) / table.bin_width
+            w_l = (u - grid[0]) / (grid[-1] - grid[0])
             row = row * (1 - w_l) + (values[1][i] * (1 - w_u) + values[1][i + 1] * w_u) * w_l
         delta, e, P, R, strains = table.at(u)
         assert (delta, e, P, R) == tuple(row[:4].tolist())
         assert strains == tuple(row[4:].tolist())
+
+
+def test_on_the_encoder_lattice_a_lookup_is_the_solved_equilibrium() -> None:
+    """With the encoder step known, samples in contact (whole counts from the first) land on
+    solved points: no interpolation error in the advance, even at the buckling knee where a
+    fixed 5 um grid was off by ~2 ue."""
+    step = 20e-3 / 4096
+    w = world(Stage(PATH), grows=False)
+    w.encoder_step = step
+    first = 0.7 * step
+    table = ContactTable(w, L, False, lattice=w._lattice(first))
+    assert table.origin == pytest.approx(first)
+    us = first + np.arange(0, 130, 3) * step  # across the knee (P_cr at ~0.3 mm here)
+    exact = np.column_stack(w.solve_on_grid(us, L))
+    looked_up = np.array([[*table.at(u)[:4], *table.at(u)[4]] for u in us.tolist()])
+    assert np.allclose(looked_up, exact, rtol=1e-9, atol=1e-15)
+    off = ContactTable(w, L, False)  # the fixed 5 um grid, for contrast
+    off_grid = np.array([[*off.at(u)[:4], *off.at(u)[4]] for u in us.tolist()])
+    assert np.max(np.abs(off_grid[:, 4:] - exact[:, 4:])) > 1e-8
 
 
 def test_peaks_are_the_array_expression_with_the_same_noise() -> None:
