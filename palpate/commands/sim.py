@@ -118,7 +118,8 @@ def run(args: argparse.Namespace) -> int:
     elif len(campaigns) > 1:
         print(
             f"all {total} trials in {wall_all:.1f} s wall for {sim_all:.1f} s simulated: "
-            f"{sim_all / wall_all:.1f}x real time"
+            f"{sim_all / wall_all:.1f}x real time (one pool for all: each campaign's wall time "
+            "above runs from the previous campaign's last trial)"
         )
     failed_all = all(o.state != "done" for c in campaigns for o in c.outcomes)
     return 1 if failed_all else 0
