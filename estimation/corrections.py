@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal, TypeVar
+from typing import Literal, NamedTuple, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -168,6 +168,26 @@ def sneddon_y_at(d: float) -> float:
     return y
 
 
+class _HalfSpace(NamedTuple):
+    """The sphere's half-space law at depths delta >= 0: what every layer form shares."""
+
+    root: FloatArray  # sqrt(R delta): Hertz's contact radius, the published layer ratio's
+    a: FloatArray  # the contact radius: Sneddon's R tanh y, or root for Hertz
+    f0: FloatArray  # F / E* on a half-space (m^2)
+    y: FloatArray | None  # Sneddon's y (None for Hertz)
+    t: FloatArray | None  # tanh y
+
+
+def _half_space(R: float, dp: FloatArray, large_indentation: bool) -> _HalfSpace:
+    """:class:`_HalfSpace` at depths ``dp`` >= 0 for tip radius R (Sneddon's sphere, or Hertz)."""
+    root = np.sqrt(R * dp)
+    if not large_indentation:
+        return _HalfSpace(root, root, 4.0 / 3.0 * root * root * root / R, None, None)
+    y = sneddon_y(dp / R)
+    t = np.tanh(y)
+    return _HalfSpace(root, R * t, R * R * sneddon_bracket(y, t), y, t)
+
+
 # --------------------------------------------------------------------------- the estimator's law
 @dataclass(frozen=True)
 class ContactLaw:
@@ -224,20 +244,14 @@ class ContactLaw:
             raise ValueError("delta must be finite")
         R = self.tip_radius
         dp = np.maximum(d, 0.0)
-        root = np.sqrt(R * dp)
+        half = _half_space(R, dp, self.large_indentation)
+        root, a, f0 = half.root, half.a, half.f0
         da = np.where(dp > 0, 0.5 * R / np.where(root > 0, root, 1.0), 0.0)  # d sqrt(R d)/dd
-        if self.large_indentation:
-            y = sneddon_y(dp / R)
-            t = np.tanh(y)
-            a = R * t
-            f0 = R * R * sneddon_bracket(y, t)
-            if self.layer_ratio_from == "sphere":
-                sech2 = 1.0 - t * t
-                da = sech2 / (t + y * sech2 + (y == 0))
-                root = a
-        else:
-            a = root
-            f0 = 4.0 / 3.0 * a * a * a / R
+        if self.layer_ratio_from == "sphere" and half.y is not None and half.t is not None:
+            y, t = half.y, half.t
+            sech2 = 1.0 - t * t
+            da = sech2 / (t + y * sech2 + (y == 0))
+            root = a
         df0 = 2.0 * a  # dF/ddelta = 2 E* a for any axisymmetric frictionless indenter
         scale = 1.0 / (1.0 - self.poisson**2)
         if self.thickness is None:
@@ -286,24 +300,15 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
     half_space = (first.tip_radius, first.poisson, first.large_indentation)
     if any((law.tip_radius, law.poisson, law.large_indentation) != half_space for law in laws):
         raise ValueError("shape_values: the laws must share tip_radius, poisson, large_indentation")
-    R = first.tip_radius
-    dp = np.maximum(delta, 0.0)
-    root = np.sqrt(R * dp)  # sqrt(R delta): the published layer ratio's radius (Hertz's a)
-    sphere_radius = root
-    if first.large_indentation:
-        y = sneddon_y(dp / R)
-        t = np.tanh(y)
-        sphere_radius = R * t
-        f0 = R * R * sneddon_bracket(y, t)
-    else:
-        f0 = 4.0 / 3.0 * root * root * root / R
+    half = _half_space(first.tip_radius, np.maximum(delta, 0.0), first.large_indentation)
+    f0 = half.f0
     scale = 1.0 / (1.0 - first.poisson**2)
     out: list[FloatArray] = []
     for law in laws:
         if law.thickness is None:
             out.append(np.asarray(scale * f0))
             continue
-        radius = sphere_radius if law.layer_ratio_from == "sphere" else root
+        radius = half.a if law.layer_ratio_from == "sphere" else half.root
         k = dimitriadis_coefficients(law.poisson, law.bonded)
         b, _ = dimitriadis_bracket(radius / law.thickness, k)
         out.append(np.asarray(scale * f0 * b))
