@@ -59,15 +59,7 @@ def _rate_row(rate_hz: float, ctx: BenchContext) -> RateRow:
         for o in outcomes
         if (m := o.modulus("joint")) is not None
     ]
-    fits = [o.joint for o in outcomes if o.joint is not None and o.joint.ci_low is not None]
-    covered = sum(
-        1
-        for o in outcomes
-        if o.joint is not None
-        and o.joint.ci_low is not None
-        and o.joint.ci_high is not None
-        and o.joint.ci_low <= o.spec.modulus <= o.joint.ci_high
-    )
+    covered = [o.joint is not None and o.joint.covers(o.spec.modulus) for o in outcomes]
     return RateRow(
         rate_hz=rate_hz,
         trials=len(outcomes),
@@ -75,7 +67,7 @@ def _rate_row(rate_hz: float, ctx: BenchContext) -> RateRow:
         speedup=sum(o.sim_time for o in outcomes) / (stamps[-1] - stamps[0]),
         joint_median=median_abs_relative_error(outcomes),
         joint_worst=max(errors, default=None),
-        coverage=covered / len(fits) if fits else None,
+        coverage=sum(covered) / len(covered) if covered else None,  # as palpate.compare
         paper_median=median_abs_relative_error(outcomes, "paper"),
     )
 

@@ -127,6 +127,14 @@ class JointFit:
     law: str = ""
     warnings: tuple[str, ...] = field(default=())
 
+    def covers(self, modulus: float) -> bool:
+        """Whether the interval [ci_low, ci_high] holds ``modulus`` (Pa); False without one."""
+        return (
+            self.ci_low is not None
+            and self.ci_high is not None
+            and (self.ci_low <= modulus <= self.ci_high)
+        )
+
     def as_dict(self) -> dict[str, object]:
         """JSON-ready fields (SI units, as named)."""
         return {

@@ -93,11 +93,7 @@ def compare_methods(
         f is not None and any(not any(c in w for c in CORRECTED) for w in f.warnings) for f in fits
     ]
     covered = [
-        f is not None
-        and f.ci_low is not None
-        and f.ci_high is not None
-        and f.ci_low <= o.spec.modulus <= f.ci_high
-        for o, f in zip(outcomes, fits, strict=True)
+        f is not None and f.covers(o.spec.modulus) for o, f in zip(outcomes, fits, strict=True)
     ]
     joint_seconds = [o.joint_seconds for o in outcomes if o.joint_seconds is not None]
     for error_mm in contact_errors_mm:

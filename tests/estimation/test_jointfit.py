@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from estimation.corrections import ContactLaw
-from estimation.jointfit import _closed_form, _grid_fits, _profiles, joint_fit
+from estimation.jointfit import JointFit, _closed_form, _grid_fits, _profiles, joint_fit
 
 LAW = ContactLaw(3.5e-3, 0.45, 10e-3, bonded=True, large_indentation=True)
 EA = 9.7e3
@@ -216,3 +216,11 @@ def test_profiles_in_lockstep_are_each_forms_own_profile() -> None:
     for prof in together:
         assert prof is not None
         assert prof.contact_high - prof.contact_low > 2 * span  # it did widen
+
+
+def test_covers_reads_the_interval() -> None:
+    fit = JointFit(True, "ok", modulus=1.0e5, ci_low=0.9e5, ci_high=1.1e5)
+    assert fit.covers(1.0e5)
+    assert fit.covers(0.9e5)
+    assert not fit.covers(1.2e5)
+    assert not JointFit(False, "no contact").covers(1.0e5)
