@@ -322,12 +322,12 @@ class ContactTable:
     lookup lands on a solved point and the linear interpolation in u is exact; it was not on a
     fixed 5 um grid, whose strains near the buckling knee were off by up to 2.4 ue, about one
     noise sd). Each bin of about ``bin_width`` (a whole number of steps) is solved in one
-    vectorised call per bin edge length, and values are interpolated linearly in L between the edges (error
-    O(dL^2 / L^2) ~ 4e-5 for 0.25 mm bins at L = 42 mm). Why bins: a vectorised solve costs
-    ~4 ms of numpy call overhead plus ~30 us per point (2 points: 4.0 ms, 51: 5.6 ms, 101:
-    6.8 ms), so one call per sample would make a trial take a minute. A trial touches 3-5 bins
-    and visits most of each but the last (~140 samples per bin at 0.5 mm/s and 250 Hz), so
-    solving part of a bin would save little; 0.5 mm bins (half the calls, 101 points) saved
+    vectorised call per bin edge length, and values are interpolated linearly in L between the
+    edges (error O(dL^2 / L^2) ~ 4e-5 for 0.25 mm bins at L = 42 mm). Why bins: a vectorised
+    solve costs ~4 ms of numpy call overhead plus ~30 us per point (2 points: 4.0 ms, 51: 5.6
+    ms, 101: 6.8 ms), so one call per sample would make a trial take a minute. A trial touches
+    3-5 bins and visits most of each but the last (~140 samples per bin at 0.5 mm/s and 250 Hz),
+    so solving part of a bin would save little; 0.5 mm bins (half the calls, 101 points) saved
     ~15 % on the bench and nothing on the robot. The tables are kept as plain floats: a lookup
     is ~20 float operations.
     """
