@@ -19,7 +19,7 @@ from typing import Any, Literal
 from config.loader import limits
 
 ServoName = Literal["outer_roll", "inner_roll", "translation"]
-# Hardware Error Status bits by name (robot.dynamixel.tables.HW_*).
+# Hardware Error Status bits by name (wire.dynamixel.HW_*).
 HardwareError = Literal["input_voltage", "overheating", "encoder", "electrical_shock", "overload"]
 
 

@@ -43,7 +43,7 @@ from typing import Literal, NamedTuple, TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from estimation.contact import hertz_validity
+from estimation.hertz import hertz_validity
 
 FloatArray = NDArray[np.float64]
 Coefficients = tuple[float, float, float, float]
@@ -321,7 +321,7 @@ def validity_warnings(
     """Warnings (one sentence each) on using ``law`` up to depth ``delta_max`` (m).
 
     - Hertz's small-strain range delta/R and the half-space condition a/h
-      (``estimation.contact.hertz_validity``), said as corrected when the law corrects them;
+      (``estimation.hertz.hertz_validity``), said as corrected when the law corrects them;
     - chi beyond the Dimitriadis series' range (CHI_MAX);
     - ``misalignment`` (rad, e.g. the inverse kinematics' residual angle) above MAX_MISALIGNMENT.
     """

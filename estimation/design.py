@@ -47,9 +47,9 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from estimation.contact import MAX_CONTACT_RATIO, MAX_DEPTH_RATIO
 from estimation.elastica import fast
 from estimation.elastica.constants import E_OVER_L_MAX, P_CRIT
+from estimation.hertz import MAX_CONTACT_RATIO, MAX_DEPTH_RATIO
 from estimation.section import Section, composite_section, euler_load
 
 FloatArray = NDArray[np.float64]
@@ -128,7 +128,7 @@ class DesignConstraints:
         thickness: tissue layer thickness h (m); None for a half-space (no a/h check).
         encoder_resolution: stage travel per encoder count (m): lead / 4096 for the lead screw.
         resolution_multiple: the smallest indentation, in encoder counts.
-        max_depth_ratio, max_contact_ratio: Hertz validity limits (``estimation.contact``).
+        max_depth_ratio, max_contact_ratio: Hertz validity limits (``estimation.hertz``).
         strain_limit: the fiber's strain limit (dimensionless).
         strain_noise: FBG strain noise per grating, 1 sigma (dimensionless): sigma_pm / k'_eps.
         noise_sigmas: detection floor above the pre-load, in units of ``strain_noise``.
@@ -342,7 +342,7 @@ def hertz_depth(
     force: ArrayLike, modulus: ArrayLike, tip_radius: ArrayLike, nu: float
 ) -> FloatArray:
     """Depth (m) at which a Hertz sphere of radius ``tip_radius`` carries ``force`` on ``modulus``:
-    the inverse of ``estimation.contact.hertz_force``, (3/4 P (1 - nu**2) / (E sqrt(R)))**(2/3)."""
+    the inverse of ``estimation.hertz.hertz_force``, (3/4 P (1 - nu**2) / (E sqrt(R)))**(2/3)."""
     P = np.asarray(force, dtype=float)
     E = np.asarray(modulus, dtype=float)
     R = np.asarray(tip_radius, dtype=float)

@@ -275,7 +275,7 @@ def joint_fit(
         encoder_resolution: one encoder count of stage advance (m); adds q^2/12 to the depth
             variance.
         contact_guess: first guess of x0 (m), e.g. the contact event or
-            ``estimation.contactpoint``; None: the middle of the record's advance range.
+            ``estimation.detect_contact``; None: the middle of the record's advance range.
         search: x0 is searched within contact_guess +- search (m), and within the record.
         confidence: the interval's level, in (0, 1).
         f_scale: the robust loss's soft threshold, in noise units.

@@ -23,7 +23,7 @@ from typing import Protocol
 
 import numpy as np
 
-from estimation.contact import hertz_modulus
+from estimation.hertz import hertz_modulus
 from estimation.section import P_CRIT, euler_load
 
 EULER_FIXED_PINNED = P_CRIT  # kept as a name the tests and callers use

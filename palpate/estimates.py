@@ -3,7 +3,7 @@
 A trial's record is one row per control tick: state, stage advance (encoder, m) and grating
 strains. The joint fit uses the loading rows (approach to the end of the post-buckling travel):
 ``estimation.beamstate`` turns each row's strains into the axial load and the beam's end
-shortening, ``estimation.contactpoint`` gives a model-independent first guess of the contact,
+shortening, ``estimation.detect_contact`` gives a model-independent first guess of the contact,
 and ``estimation.jointfit`` fits the modulus and the contact position together. It never uses
 the contact event: a late or early event cannot bias it.
 
@@ -29,8 +29,8 @@ from numpy.typing import NDArray
 
 from config.schema import SensorConfig
 from estimation.beamstate import infer_states
-from estimation.contactpoint import baseline_deviation
 from estimation.corrections import ContactLaw
+from estimation.detect_contact import baseline_deviation
 from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from estimation.section import Section
 from sensor.strain import grating_intervals

@@ -52,13 +52,13 @@ from palpate.campaign import campaign_trials
 from palpate.commands.replay import replay
 from palpate.preflight import check_campaign, check_reachable
 from palpate.simtrial import TrialOutcome, TrialSpec, run_sim_trial
-from robot.dynamixel import tables
 from robot.triallog import TrialLogWriter, read_log
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 from sim.dynamixel.faults import FaultyBus, PacketFaults
 from sim.world import Surface, World
+from wire import dynamixel as tables
 
 TRAVEL_SLACK = 0.1e-3  # m past the travel guard: a tick or two at approach speed, tracking lag
 KILL_STOP_SLACK = 0.1e-3  # m a held servo may still travel toward its last goal after a kill

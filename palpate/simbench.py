@@ -25,7 +25,6 @@ from palpate.simtrial import tissue_model
 from palpate.trialsetup import sensor_section
 from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
-from robot.dynamixel.tables import TICKS_PER_REV
 from robot.dynamixel.units import rad_from_ticks
 from sensor.reader import layout_from_config
 from sim.board import BoardEmulator, BoardSample
@@ -33,6 +32,7 @@ from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 from sim.inprocess import InProcessPort, MemorySerial
 from sim.world import Surface, World
+from wire.dynamixel import TICKS_PER_REV
 
 
 def surface_at(tube: TubeConfig, roll: float, translation: float, tip_radius: float) -> Surface:

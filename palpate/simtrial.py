@@ -37,7 +37,6 @@ from palpate.trialsetup import (
 from robot import kinematics
 from robot.drive import TRANSLATION, DriveController, RollerGearDrive
 from robot.dynamixel.driver import DynamixelBus
-from robot.dynamixel.tables import TICKS_PER_REV
 from robot.dynamixel.units import rad_from_ticks
 from robot.indentation import State, TrialMarks, TrialPlan
 from robot.rig import ServoFbgRig
@@ -51,6 +50,7 @@ from sim.dynamixel.bus import EmulatedBus
 from sim.inprocess import InProcessPort, MemorySerial
 from sim.tissue import TissueModel
 from sim.world import Surface, World
+from wire.dynamixel import TICKS_PER_REV
 
 Transport = Literal["fast", "wire"]
 BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample

@@ -12,12 +12,12 @@ import numpy as np
 from config.scene import CampaignConfig
 from config.schema import MM, StackConfig
 from estimation.beamstate import onset_mode
+from estimation.detect_buckling import CusumDetector, NormThreshold
 from estimation.section import Section, composite_section
-from robot.dynamixel.tables import TICKS_PER_REV
 from robot.indentation import BucklingDetector, Guards
 from robot.rig import RigSettings
-from sensor.detect import CusumDetector, NormThreshold
 from sensor.strain import StrainChain, grating_intervals
+from wire.dynamixel import TICKS_PER_REV
 
 
 def sensor_section(stack: StackConfig) -> Section:

@@ -120,7 +120,7 @@ def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -
 
 class BucklingDetector(Protocol):
     """Anything that decides from the grating strains that the beam has buckled
-    (``sensor.detect.NormThreshold`` and ``sensor.detect.CusumDetector`` satisfy it)."""
+    (``NormThreshold`` and ``CusumDetector`` of :mod:`estimation.detect_buckling` satisfy it)."""
 
     def reset(self) -> None: ...
 

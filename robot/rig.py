@@ -26,9 +26,9 @@ from robot.drive import DriveController, JointState
 from robot.indentation import Command, Observation
 from robot.motors import ServoFaultError, ServoTransportError
 from sensor.clock import Clock
-from sensor.frame import Frame, Status
 from sensor.reader import FrameReader, SensorPortError
 from sensor.strain import StrainChain
+from wire.frame import Frame, Status
 
 ContactMode = Literal["event", "fbg"]
 

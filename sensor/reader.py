@@ -30,8 +30,8 @@ import serial
 
 from config.schema import BoardConfig, SensorConfig
 from sensor.clock import Clock, SystemClock
-from sensor.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
 from sensor.ports import open_failure
+from wire.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
 
 SEQ_MOD = 2**32
 

@@ -20,7 +20,7 @@ one flipped bit, truncated frames, dropped frames (the sequence number still adv
 (the master is closed). Garbage bytes never contain the sync byte 0xA5, so the reader's expected
 counters follow exactly from :class:`BoardStats`; sync-looking garbage is a parser unit test.
 
-Import note: this module imports ``sensor.frame``, the pure wire codec, as protocol data. It is the
+Import note: this module imports ``wire.frame``, the pure wire codec, as protocol data. It is the
 one accepted exception to "sim/ never imports sensor/": the frame layout is shared by both ends of
 the wire and must not be copied.
 """
@@ -45,8 +45,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from config.loader import limits
-from sensor.frame import Frame, FrameLayout, Status, encode, frame_from_si
 from sim.clock import VirtualClock
+from wire.frame import Frame, FrameLayout, Status, encode, frame_from_si
 
 SYNC_BYTE = 0xA5
 

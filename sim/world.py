@@ -3,7 +3,7 @@
 Each board sample asks the world for its state at time ``t``. The world reads the servos' present
 positions (through injected callables, so ``sim/`` never imports the control code), places the
 sensor with the injected forward kinematics, and solves the quasi-static contact along the sensor
-axis (:mod:`sim.contact`) with the tissue's own force law (:mod:`sim.tissue`), which is not the
+axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.tissue`), which is not the
 estimator's Hertz model. From the beam state it makes what the hardware would send: peak
 wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and temperature drift), the force scale
 reading and the contact event.
@@ -33,10 +33,10 @@ from config.schema import FbgConfig, SensorConfig
 from estimation.beam import Beam
 from estimation.elastica import post_buckling
 from estimation.section import Section
-from sensor.frame import Status
 from sim.board import BoardSample
-from sim.contact import ContactEffects, solve_contact
+from sim.equilibrium import ContactEffects, solve_contact
 from sim.tissue import TissueModel
+from wire.frame import Status
 
 Vector = NDArray[np.float64]
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)

@@ -8,8 +8,8 @@ import json
 import sys
 from pathlib import Path
 
-from bench import SECTIONS
-from bench.report import BenchContext, BenchSection
+from palpate.benchmarks import SECTIONS
+from palpate.benchmarks.report import BenchContext, BenchSection
 
 
 def register(parser: argparse.ArgumentParser) -> None:

@@ -39,8 +39,8 @@ from palpate.campaign import (
 )
 from palpate.executors import add_executor_arguments, open_executor
 from palpate.simtrial import TrialOutcome
-from robot.dynamixel.tables import TICKS_PER_REV
 from sensor.strain import strain_noise
+from wire.dynamixel import TICKS_PER_REV
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}
 EXIT_NO_DESIGN = 2

@@ -29,7 +29,7 @@ from typing import Any, Self, TypeVar
 import dynamixel_sdk as sdk
 
 from config.schema import ServoBusConfig
-from robot.dynamixel import tables, units
+from robot.dynamixel import units
 from robot.motors import (
     MotorState,
     ServoFaultError,
@@ -37,6 +37,7 @@ from robot.motors import (
     ServoTransportError,
 )
 from sensor.ports import open_failure
+from wire import dynamixel as tables
 
 R = TypeVar("R")
 

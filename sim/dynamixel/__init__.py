@@ -5,7 +5,7 @@ gives a port path the unmodified ``dynamixel_sdk`` can drive. Modules: :mod:`.pr
 framing), :mod:`.servo` (one servo's state and motion), :mod:`.bus` (the pty server thread).
 
 Layering: nothing here imports ``robot/`` control code; the pure-data control table
-:mod:`robot.dynamixel.tables` is the one shared module (a hardware fact, kept in one place).
+:mod:`wire.dynamixel` is the one shared module (a hardware fact, kept in one place).
 """
 
 from sim.dynamixel.bus import EmulatedBus

@@ -19,7 +19,7 @@ servo gets CRC Error; an unknown instruction gets Instruction Error. Fast sync/b
 emulated (Instruction Error).
 
 Layering: ``sim/`` never imports ``robot/`` control code; the one exception is the pure-data
-control table :mod:`robot.dynamixel.tables`, used through :mod:`sim.dynamixel.servo`.
+control table :mod:`wire.dynamixel`, used through :mod:`sim.dynamixel.servo`.
 """
 
 from __future__ import annotations
@@ -33,10 +33,10 @@ from collections.abc import Callable, Iterable
 from typing import Self
 
 from config.schema import ServoBusConfig
-from robot.dynamixel import tables
 from sim.clock import VirtualClock
 from sim.dynamixel import protocol
 from sim.dynamixel.servo import EmulatedServo
+from wire import dynamixel as tables
 
 _PING, _READ, _OTHER = 0, 1, 2  # reply kinds, compared with Status_Return_Level
 _CLEAR_KEY = bytes([0x01, 0x44, 0x58, 0x4C, 0x22])

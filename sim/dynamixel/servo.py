@@ -5,7 +5,7 @@ on the simulator's time: :meth:`EmulatedServo.advance_to` integrates the motion 
 seconds, called from the bus on every ``VirtualClock`` advance or, in real-time mode, with wall
 time before every packet.
 
-What it models (addresses and defaults from :mod:`robot.dynamixel.tables`, the one module of
+What it models (addresses and defaults from :mod:`wire.dynamixel`, the one module of
 ``robot/`` that ``sim/`` may import: a pure-data hardware fact shared with the driver):
 
 * every item of the X-series table, little-endian, signed where the hardware is signed;
@@ -37,7 +37,7 @@ import threading
 from collections.abc import Callable
 from typing import Final
 
-from robot.dynamixel import tables
+from wire import dynamixel as tables
 
 _TICKS_PER_S_PER_VEL_UNIT: Final = tables.VELOCITY_UNIT_RPM * tables.TICKS_PER_REV / 60.0
 _TICKS_PER_S2_PER_ACC_UNIT: Final = tables.ACCELERATION_UNIT_RPM2 * tables.TICKS_PER_REV / 3600.0

@@ -16,10 +16,10 @@ from config import resolve
 from palpate.cli import main
 from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoTransportError
-from sensor.frame import layout_of
 from sensor.ports import open_failure
 from sensor.reader import FrameReader, SensorPortError
 from sim.dynamixel.bus import EmulatedBus
+from wire.frame import layout_of
 
 ROBOT = resolve("robot.yaml").read_text(encoding="utf-8")
 SCENE = resolve("scenes/robot.yaml").read_text(encoding="utf-8")

@@ -28,7 +28,7 @@ from config.scene import SceneConfig
 from config.targets import load_targets
 from palpate.cli import main
 from palpate.simbench import SimulatedBench
-from robot.dynamixel.tables import TICKS_PER_REV
+from wire.dynamixel import TICKS_PER_REV
 
 needs_tmux = pytest.mark.skipif(
     shutil.which("tmux") is None, reason="tmux is not installed: the terminal tests need it"

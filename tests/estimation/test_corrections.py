@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from estimation.contact import hertz_force
 from estimation.corrections import (
     ContactLaw,
     dimitriadis_bracket,
@@ -17,6 +16,7 @@ from estimation.corrections import (
     sneddon_y_at,
     validity_warnings,
 )
+from estimation.hertz import hertz_force
 from sim.tissue import TissueModel
 
 R = 3.5e-3

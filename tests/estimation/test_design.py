@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from estimation.contact import hertz_force
 from estimation.design import (
     CHECKS,
     DesignConstraints,
@@ -18,8 +17,9 @@ from estimation.design import (
     hertz_depth,
     imperfection_state,
 )
+from estimation.hertz import hertz_force
 from estimation.section import composite_section, euler_load
-from sim.contact import MODE_SHORTENING
+from sim.equilibrium import MODE_SHORTENING
 
 KPA = 1e3
 PAPER = SensorDesign(
@@ -49,7 +49,7 @@ def test_hertz_depth_inverts_hertz_force() -> None:
 
 
 def test_bow_shortening_matches_the_simulators_imperfect_beam() -> None:
-    """c ((1-x)**-2 - 1) (w0/L)**2 with c derived from the elastica equals sim.contact's c."""
+    """c ((1-x)**-2 - 1) (w0/L)**2 with c derived from the elastica equals sim.equilibrium's c."""
     w0, x = 1e-3, 0.9
     _, e_imp = imperfection_state(w0, x)
     assert e_imp / (w0**2 * ((1 - x) ** -2 - 1)) == pytest.approx(MODE_SHORTENING, rel=1e-4)

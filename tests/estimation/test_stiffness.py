@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from estimation.contact import hertz_modulus
+from estimation.hertz import hertz_modulus
 from estimation.section import euler_load
 from estimation.stiffness import (
     EULER_FIXED_PINNED,

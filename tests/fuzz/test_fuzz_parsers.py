@@ -14,9 +14,9 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from bench import fuzz
 from config.scene import SceneConfig
 from config.schema import StackConfig
+from palpate.benchmarks import fuzz
 from sim.dynamixel import protocol
 
 seeds = st.integers(0, 2**32 - 1)

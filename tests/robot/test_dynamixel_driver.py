@@ -10,7 +10,6 @@ import dynamixel_sdk as sdk
 import pytest
 
 from config.schema import ServoBusConfig, ServoConfig
-from robot.dynamixel import tables
 from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
 from sim.clock import VirtualClock
@@ -18,6 +17,7 @@ from sim.dynamixel import protocol
 from sim.dynamixel.bus import EmulatedBus
 from sim.dynamixel.faults import FaultyBus
 from sim.inprocess import InProcessPort
+from wire import dynamixel as tables
 
 CFG = ServoBusConfig(retries=2, timeout_ms=50.0)
 NAMES = ("outer_roll", "inner_roll", "translation")

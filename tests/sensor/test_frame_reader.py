@@ -6,9 +6,9 @@ import pytest
 import serial
 
 from config.schema import BoardConfig, SensorConfig
-from sensor.frame import Frame, FrameLayout, encode
 from sensor.reader import FrameReader, SensorPortError, layout_from_config
 from sim.clock import VirtualClock
+from wire.frame import Frame, FrameLayout, encode
 
 LAYOUT = FrameLayout(3)
 

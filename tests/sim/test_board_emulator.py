@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sensor.frame import FrameLayout, Status
 from sensor.reader import FrameReader, SensorPortError
 from sim.board import BoardEmulator, BoardFaults, BoardSample, constant_source
 from sim.clock import VirtualClock
+from wire.frame import FrameLayout, Status
 
 LAYOUT = FrameLayout(3)
 WAVELENGTHS = (1530e-9, 1535e-9, 1540e-9)

@@ -10,11 +10,11 @@ from collections.abc import Iterator
 import dynamixel_sdk as sdk
 import pytest
 
-from robot.dynamixel import tables
 from sim.clock import VirtualClock
 from sim.dynamixel import protocol as p
 from sim.dynamixel.bus import EmulatedBus
 from sim.dynamixel.servo import EmulatedServo
+from wire import dynamixel as tables
 
 PH = sdk.PacketHandler(2.0)
 

@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from robot.dynamixel import tables
 from sim.dynamixel.servo import EmulatedServo, profile_motion
+from wire import dynamixel as tables
 
 GOAL = tables.X_SERIES_CONTROL_TABLE["Goal_Position"][0]
 TICKS_PER_S_PER_UNIT = 0.229 * 4096 / 60

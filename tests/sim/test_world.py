@@ -11,7 +11,7 @@ from config import load_stack
 from config.scene import FidelityConfig
 from estimation.beam import Beam
 from estimation.section import composite_section
-from sim.contact import solve_contact
+from sim.equilibrium import solve_contact
 from sim.tissue import TissueModel
 from sim.world import ContactTable, Surface, World, equilibrium_on_grid
 

@@ -6,7 +6,7 @@ the code under test misbehaves:
 - ``frame parser``: :class:`sensor.reader.FrameParser` on valid frames mixed with garbage, bit
   flips and cuts, fed in random chunks; it must never raise, must find every intact frame, and
   must account for every byte (``bytes_received == frames * size + discarded + pending``);
-  :func:`sensor.frame.decode` on the same bytes raises only ``FrameError``;
+  :func:`wire.frame.decode` on the same bytes raises only ``FrameError``;
 - ``servo packets``: :meth:`sim.dynamixel.bus.EmulatedBus.handle` on random and mutated
   Protocol 2.0 packets; it must never raise, and every reply must be a well-formed status packet;
 - ``driver replies``: :class:`robot.dynamixel.driver.DynamixelBus` (the real dynamixel-sdk)
@@ -35,18 +35,18 @@ from typing import Any
 import numpy as np
 import yaml
 
-from bench.report import BenchContext, BenchSection, Table
 from config.loader import ConfigError, from_mapping, read_yaml
 from config.scene import SceneConfig
 from config.schema import StackConfig
+from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoFaultError, ServoTransportError
-from sensor.frame import Frame, FrameError, FrameLayout, decode, encode, layout_of
 from sensor.reader import FrameParser
 from sim.dynamixel import protocol
 from sim.dynamixel.faults import FaultyBus
 from sim.dynamixel.servo import EmulatedServo
 from sim.inprocess import InProcessPort
+from wire.frame import Frame, FrameError, FrameLayout, decode, encode, layout_of
 
 Rng = np.random.Generator
 

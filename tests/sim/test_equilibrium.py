@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sim.contact import (
+from sim.equilibrium import (
     DEFAULT_MAX_E_OVER_L,
     MODE_REACTION,
     MODE_SHORTENING,

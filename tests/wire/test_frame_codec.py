@@ -9,21 +9,18 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sensor.frame import (
+from wire.frame import (
     MARKER,
     Frame,
-    FrameBlock,
     FrameError,
     FrameLayout,
     Status,
-    crc32_rows,
     decode,
-    decode_block,
     encode,
-    encode_block,
     frame_from_si,
     parse_header,
 )
+from wire.frameblock import FrameBlock, crc32_rows, decode_block, encode_block
 
 # A frame written out by hand from the table in docs/frame-protocol.md.
 GOLDEN = Frame(seq=1, timestamp_us=2, encoder=-3, flags=4, peak_fm=(1_530_000_000, 2, 3))

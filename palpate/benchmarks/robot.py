@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from bench.report import BenchContext, BenchSection, Table, median_time
 from config.schema import DEFAULT_TUBES, ServoBusConfig
+from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
 from robot.dynamixel.driver import DynamixelBus
 from robot.kinematics import forward, inverse
 from sim.dynamixel.bus import EmulatedBus

@@ -7,9 +7,9 @@ lists them in the order they print. Benchmarks measure; tests never assert timin
 from __future__ import annotations
 
 SECTIONS: dict[str, str] = {
-    "mechanics": "bench.mechanics",
-    "sensor": "bench.sensor",
-    "robot": "bench.robot",
-    "campaign": "bench.campaign",
-    "fuzz": "bench.fuzz",
+    "mechanics": "palpate.benchmarks.mechanics",
+    "sensor": "palpate.benchmarks.sensor",
+    "robot": "palpate.benchmarks.robot",
+    "campaign": "palpate.benchmarks.campaign",
+    "fuzz": "palpate.benchmarks.fuzz",
 }

@@ -25,10 +25,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from bench.report import BenchContext, BenchSection, Table
 from config.schema import SensorConfig
-from sensor.clock import SystemClock
-from sensor.detect import (
+from estimation.detect_buckling import (
     BETA,
     CusumDetector,
     Detector,
@@ -36,11 +34,14 @@ from sensor.detect import (
     first_mode_pattern,
     first_mode_strains,
 )
-from sensor.frame import FrameBlock, FrameLayout, decode_block, encode_block
+from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from sensor.clock import SystemClock
 from sensor.reader import FrameParser, FrameReader
 from sensor.strain import grating_intervals, strain_noise
 from sim.board import BoardEmulator, BoardFaults, BoardSample
 from sim.clock import VirtualClock
+from wire.frame import FrameLayout
+from wire.frameblock import FrameBlock, decode_block, encode_block
 
 LAYOUT = FrameLayout(3)
 BASE = np.array([1530e-9, 1535e-9, 1540e-9])

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from config.schema import SensorConfig
-from sensor.detect import (
+from estimation.detect_buckling import (
     BETA,
     MODE_J,
     CusumDetector,

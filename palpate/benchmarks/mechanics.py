@@ -23,12 +23,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from bench.report import BenchContext, BenchSection, Table, median_time
 from config.schema import SensorConfig
 from estimation.beam import Beam
 from estimation.elastica import E_OVER_L_MAX, accurate, fast, shooting
 from estimation.elastica._scipy import solve_ivp
 from estimation.section import composite_section
+from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
 
 FloatArray = NDArray[np.float64]
 L_PAPER = 0.042

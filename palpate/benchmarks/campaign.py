@@ -19,9 +19,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from bench.report import BenchContext, BenchSection, Table
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
+from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaign import campaign_trials, median_abs_relative_error, run_campaign, warm_up
 from palpate.simtrial import TrialOutcome
 
