@@ -42,13 +42,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from estimation.elastica import fast
-from estimation.elastica.constants import E_OVER_L_MAX, P_CRIT
+from estimation.elastica.constants import E_OVER_L_MAX, MODE_SHORTENING, P_CRIT
 from estimation.hertz import MAX_CONTACT_RATIO, MAX_DEPTH_RATIO
 from estimation.section import Section, composite_section, euler_load
 
@@ -391,33 +390,19 @@ def _grating_strains(
     return np.asarray(fiber_offset[:, None] * sol.mean_curvature(s0, s1) / L[:, None])
 
 
-MODE_REACTION = math.sqrt(P_CRIT) ** 3 / (2.0 * math.pi)
-"""Pin reaction of the clamped-pinned first mode per unit lateral amplitude (A - w0)/L, in units
-of EI/L**2: mu**3 / (2 pi) with mu**2 = P_CRIT (the simulator's imperfect-beam model uses the
-same mode)."""
-
-
-@lru_cache(maxsize=1)
-def _onset_slope() -> float:
-    """|r| / sqrt(e/L) of the elastica at onset (8.987): r grows like sqrt(e/L) there."""
-    g = 1e-12
-    return float(abs(fast.reaction(np.array(g))) / math.sqrt(g))
-
-
 def imperfection_state(w0_over_L: float, load_fraction: float) -> tuple[float, float]:
     """A beam bowed by ``w0_over_L`` in its first mode, loaded to ``load_fraction`` P_cr.
 
     Linear theory amplifies the bow to A = w0 / (1 - x). Returns (e_equiv/L, e_imp/L):
     the shortening of the perfect elastica with the same pin reaction (the same bending, for the
-    grating strains), and the bending shortening the stage has travelled to get there,
-    c ((A/L)**2 - (w0/L)**2) with c = (MODE_REACTION / onset slope)**2 = 2.5816.
+    grating strains), c ((A - w0)/L)**2, and the bending shortening the stage has travelled to
+    get there, c ((A/L)**2 - (w0/L)**2), with c = ``MODE_SHORTENING`` (the elastica's onset
+    slope |r| / sqrt(e/L) is MODE_REACTION / sqrt(c)).
     """
     x = load_fraction
-    slope = _onset_slope()
     amplitude = w0_over_L * x / (1.0 - x)  # (A - w0) / L
-    e_equiv = (MODE_REACTION * amplitude / slope) ** 2
-    c = (MODE_REACTION / slope) ** 2
-    e_imp = c * w0_over_L**2 * ((1.0 - x) ** -2 - 1.0)
+    e_equiv = MODE_SHORTENING * amplitude**2
+    e_imp = MODE_SHORTENING * w0_over_L**2 * ((1.0 - x) ** -2 - 1.0)
     return e_equiv, e_imp
 
 

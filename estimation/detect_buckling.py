@@ -29,31 +29,20 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-FloatArray = NDArray[np.float64]
+from estimation.elastica.constants import MODE_SLOPE_INTEGRAL, X1
 
-BETA = 4.493409457909064
-"""First root of tan(x) = x: k L of the clamped-pinned Euler mode (P_cr = BETA^2 EI/L^2 = 20.19)."""
+FloatArray = NDArray[np.float64]
 
 
 # ---------------------------------------------------------------------------------------------
 # The first buckling mode, linearised: an analytic test problem and the CUSUM's template.
 
 
-def _mode_slope_integral() -> float:
-    """J = int_0^1 (cos(b x) + b sin(b x) - 1)^2 dx, with e/L = a^2 J / 2 for slope amplitude a."""
-    x = np.linspace(0.0, 1.0, 20001)
-    g = (np.cos(BETA * x) + BETA * np.sin(BETA * x) - 1.0) ** 2
-    return float(np.sum((g[1:] + g[:-1]) * 0.5) * (x[1] - x[0]))
-
-
-MODE_J = _mode_slope_integral()
-
-
 def first_mode_pattern(intervals: ArrayLike, length: float) -> FloatArray:
     """Grating averages of L * curvature of the clamped-pinned first mode, unit slope amplitude.
 
     Small-deflection mode: theta(xi) = a (cos(b xi) + b sin(b xi) - 1), L kappa = a b (b cos(b xi)
-    - sin(b xi)), xi = s / L, b = BETA; averaged over each row ``(s0, s1)`` of ``intervals``
+    - sin(b xi)), xi = s / L, b = X1; averaged over each row ``(s0, s1)`` of ``intervals``
     (shape (N, 2), m) with the exact antiderivative. Returns shape (N,) for a = 1.
     """
     iv = np.asarray(intervals, dtype=np.float64)
@@ -63,7 +52,7 @@ def first_mode_pattern(intervals: ArrayLike, length: float) -> FloatArray:
     width = xi[:, 1] - xi[:, 0]
     if np.any(width <= 0):
         raise ValueError("each interval must have s0 < s1")
-    anti = BETA * np.sin(BETA * xi) + np.cos(BETA * xi)
+    anti = X1 * np.sin(X1 * xi) + np.cos(X1 * xi)
     return np.asarray((anti[:, 1] - anti[:, 0]) / width, dtype=np.float64)
 
 
@@ -79,7 +68,7 @@ def first_mode_strains(
     e = np.asarray(e_over_L, dtype=np.float64)
     if np.any(e < 0):
         raise ValueError("e_over_L must be >= 0")
-    a = np.sqrt(2.0 * e / MODE_J)
+    a = np.sqrt(2.0 * e / MODE_SLOPE_INTEGRAL)
     pattern = first_mode_pattern(intervals, length)
     return np.asarray(fiber_offset / length * a[..., None] * pattern, dtype=np.float64)
 

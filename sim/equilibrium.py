@@ -62,16 +62,13 @@ from typing import Generic, Protocol, TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
 from sim.tissue import TissueModel
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 ForceLaw = Callable[[FloatArray], ArrayLike]
 
-MODE_SHORTENING = 2.5815720613163022
-"""c in e_geom = c (A^2 - w0^2)/L for the clamped-pinned first mode (see module docstring)."""
-MODE_REACTION = 14.439365739379578
-"""mu^3 / (2 pi): pin reaction per unit (A - w0)/L, in units of EI/L^2."""
 DEFAULT_MAX_E_OVER_L = 0.2
 """Largest e/L the solver searches when the beam law does not say (trials visit <= 1e-2)."""
 
@@ -421,7 +418,7 @@ class _BeamSide:
         # The imperfect part is carried by P_imp = P - excess; for e <= e_cr that is all of P.
         p_imp = np.minimum(self.imperfect_force(e), self.p_cr * (1.0 - 1e-15))
         amp = self.w0 / (1.0 - p_imp / self.p_cr)
-        ei_over_l2 = self.p_cr / (4.493409457909064**2)
+        ei_over_l2 = self.p_cr / P_CRIT
         r_imp = ei_over_l2 * MODE_REACTION * (amp - self.w0) / self.L
         sign = self.law.reaction_sign
         return sign * np.maximum(r_imp, sign * r_perf)
@@ -626,7 +623,7 @@ def _solve_scalar(
         R = float(np.asarray(law.lateral_force(np.asarray(e))).reshape(()))
     if imperfect:
         amp = fx.imperfection * L / (1.0 - min(p_imp(e), p_cr * (1.0 - 1e-15)) / p_cr)
-        r_imp = p_cr / 4.493409457909064**2 * MODE_REACTION * (amp - fx.imperfection * L) / L
+        r_imp = p_cr / P_CRIT * MODE_REACTION * (amp - fx.imperfection * L) / L
         R = law.reaction_sign * max(r_imp, law.reaction_sign * R)
     message = STATUS_MESSAGES[status] + ("" if converged else " (1 of 1 stage positions)")
 

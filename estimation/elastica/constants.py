@@ -74,8 +74,37 @@ def _modulus_at_tip_normal() -> float:
 
 
 X1: float = _first_root_tan_x_equals_x()
+"""First root of tan(x) = x: k L of the clamped-pinned Euler mode (4.4934...)."""
 P_CRIT: float = X1 * X1
 """Euler load factor of the clamped-pinned column: P_cr = P_CRIT EI / L**2 (20.1907...)."""
+
+
+def _mode_slope_integral(mu: float) -> float:
+    """J = int_0^1 (cos(mu xi) + mu sin(mu xi) - 1)**2 dxi in closed form (the first mode's
+    slope theta(xi) = a (cos + mu sin - 1) shortens the beam by e/L = a**2 J / 2)."""
+    s2 = math.sin(2.0 * mu)
+    total = (
+        mu / 2.0
+        + s2 / 4.0
+        + mu**2 * (mu / 2.0 - s2 / 4.0)
+        + mu
+        + mu * math.sin(mu) ** 2
+        - 2.0 * math.sin(mu)
+        + 2.0 * mu * (math.cos(mu) - 1.0)
+    )
+    return total / mu
+
+
+# The clamped-pinned first mode phi(xi) = mu (1 - cos mu xi) - mu xi + sin mu xi, mu = X1: its
+# maximum is exactly 2 pi (at mu sin xi + cos xi = 1), which fixes the amplitude-based constants.
+MODE_SLOPE_INTEGRAL: float = _mode_slope_integral(X1)
+"""J of :func:`_mode_slope_integral` (10.0954), e/L = a**2 J / 2 for slope amplitude a."""
+MODE_REACTION: float = X1**3 / (2.0 * math.pi)
+"""Pin reaction per unit lateral amplitude A/L of the first mode, in EI/L**2: mu**3 / max(phi)
+= mu**3 / (2 pi) (14.4394)."""
+MODE_SHORTENING: float = P_CRIT * MODE_SLOPE_INTEGRAL / (8.0 * math.pi**2)
+"""c in the bending shortening e = c A**2 / L of the first mode with amplitude A:
+(1/2) int phi'**2 dxi / max(phi)**2 = mu**2 J / (8 pi**2) (2.58157)."""
 
 K_MAX: float = _modulus_at_zero_load()
 _END = _state_at(K_MAX)

@@ -17,9 +17,10 @@ from estimation.design import (
     hertz_depth,
     imperfection_state,
 )
+from estimation.elastica import fast
+from estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING
 from estimation.hertz import hertz_force
 from estimation.section import composite_section, euler_load
-from sim.equilibrium import MODE_SHORTENING
 
 KPA = 1e3
 PAPER = SensorDesign(
@@ -48,11 +49,21 @@ def test_hertz_depth_inverts_hertz_force() -> None:
         hertz_depth(1e-3, 0.0, 4e-3, 0.45)
 
 
-def test_bow_shortening_matches_the_simulators_imperfect_beam() -> None:
-    """c ((1-x)**-2 - 1) (w0/L)**2 with c derived from the elastica equals sim.equilibrium's c."""
+def test_first_mode_constants_match_the_elastica_at_onset() -> None:
+    """The mode constants are consistent with the elastica: near onset |r| = MODE_REACTION A/L
+    and e/L = MODE_SHORTENING (A/L)**2, so |r| / sqrt(e/L) = MODE_REACTION / sqrt(c)."""
+    g = 1e-10
+    slope = float(abs(fast.reaction(np.array(g)))) / math.sqrt(g)
+    assert slope == pytest.approx(MODE_REACTION / math.sqrt(MODE_SHORTENING), rel=1e-4)
+    assert pytest.approx(2.581572061251422, rel=1e-14) == MODE_SHORTENING  # mpmath, 40 digits
+    assert pytest.approx(14.439365739198137, rel=1e-14) == MODE_REACTION
+
+
+def test_bow_shortening_is_the_first_modes() -> None:
     w0, x = 1e-3, 0.9
-    _, e_imp = imperfection_state(w0, x)
-    assert e_imp / (w0**2 * ((1 - x) ** -2 - 1)) == pytest.approx(MODE_SHORTENING, rel=1e-4)
+    e_equiv, e_imp = imperfection_state(w0, x)
+    assert e_imp == pytest.approx(MODE_SHORTENING * w0**2 * ((1 - x) ** -2 - 1), rel=1e-14)
+    assert e_equiv == pytest.approx(MODE_SHORTENING * (w0 * x / (1 - x)) ** 2, rel=1e-14)
     assert imperfection_state(0.0, x) == (0.0, 0.0)
 
 

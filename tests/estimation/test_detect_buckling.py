@@ -7,14 +7,13 @@ import pytest
 
 from config.schema import SensorConfig
 from estimation.detect_buckling import (
-    BETA,
-    MODE_J,
     CusumDetector,
     NormThreshold,
     cusum,
     first_mode_pattern,
     first_mode_strains,
 )
+from estimation.elastica.constants import MODE_SLOPE_INTEGRAL, X1
 from sensor.strain import grating_intervals, strain_noise
 
 L = 0.042
@@ -23,13 +22,13 @@ IV = grating_intervals(SensorConfig())
 
 
 def test_beta_is_the_clamped_pinned_root() -> None:
-    assert np.tan(BETA) == pytest.approx(BETA, rel=1e-9)
-    assert pytest.approx(20.19, abs=0.005) == BETA**2
+    assert np.tan(X1) == pytest.approx(X1, rel=1e-9)
+    assert pytest.approx(20.19, abs=0.005) == X1**2
 
 
 def test_mode_pattern_matches_quadrature_of_the_curvature() -> None:
     def curvature(xi: np.ndarray) -> np.ndarray:
-        return BETA * (BETA * np.cos(BETA * xi) - np.sin(BETA * xi))
+        return X1 * (X1 * np.cos(X1 * xi) - np.sin(X1 * xi))
 
     for s0, s1 in IV:
         xi = np.linspace(s0 / L, s1 / L, 2001)
@@ -39,8 +38,8 @@ def test_mode_pattern_matches_quadrature_of_the_curvature() -> None:
 
 def test_mode_energy_integral_and_sqrt_growth() -> None:
     xi = np.linspace(0, 1, 200001)
-    g = (np.cos(BETA * xi) + BETA * np.sin(BETA * xi) - 1) ** 2
-    assert pytest.approx(np.trapezoid(g, xi), rel=1e-8) == MODE_J
+    g = (np.cos(X1 * xi) + X1 * np.sin(X1 * xi) - 1) ** 2
+    assert pytest.approx(np.trapezoid(g, xi), rel=1e-8) == MODE_SLOPE_INTEGRAL
     e = np.array([1e-4, 4e-4])
     s = first_mode_strains(e, IV, L, DY)
     np.testing.assert_allclose(s[1] / s[0], 2.0)  # strain ~ sqrt(e/L)
@@ -141,7 +140,7 @@ def test_first_mode_agrees_with_the_elastica_and_the_adapter_fits_it() -> None:
 
     EI, EA = 1.18e-4, 9696.0
     beam = beam_mod.Beam(EI, EA, DY, L)
-    e_axial = BETA**2 * EI / L**2 / EA  # pre-buckling shortening ratio at P_cr
+    e_axial = X1**2 * EI / L**2 / EA  # pre-buckling shortening ratio at P_cr
     e_over_L = 2e-3
     full = np.asarray(beam.grating_strains(e_over_L * L, IV))
     linear = first_mode_strains(e_over_L - e_axial, IV, L, DY)
@@ -149,6 +148,6 @@ def test_first_mode_agrees_with_the_elastica_and_the_adapter_fits_it() -> None:
     fit = beam_state(beam, full, IV, sigma=1e-6)
     assert fit.success
     assert fit.e == pytest.approx(e_over_L * L, rel=1e-3)
-    p_cr = BETA**2 * EI / L**2
+    p_cr = X1**2 * EI / L**2
     p_fit = float(fit.P)
     assert p_fit == pytest.approx(p_cr, rel=0.01)

@@ -9,10 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
 from sim.equilibrium import (
     DEFAULT_MAX_E_OVER_L,
-    MODE_REACTION,
-    MODE_SHORTENING,
     AxialLaw,
     ContactEffects,
     ContactState,
@@ -23,7 +22,6 @@ from sim.tissue import TissueModel
 
 EI = 1.18e-4
 EA = 9.7e3
-P_CRIT = 4.493409457909064**2
 
 
 def stand_in(length: float | np.ndarray = 0.045, slope: float = 0.5) -> AxialLaw:
