@@ -27,13 +27,13 @@ from numpy.typing import NDArray
 
 from config.schema import SensorConfig
 from estimation.detect_buckling import (
-    BETA,
     CusumDetector,
     Detector,
     NormThreshold,
     first_mode_pattern,
     first_mode_strains,
 )
+from estimation.elastica.constants import P_CRIT
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from sensor.clock import SystemClock
 from sensor.reader import FrameParser, FrameReader
@@ -276,7 +276,7 @@ def _trials(
     du = 0.05e-6  # 0.05 mm/s stage at 1 kHz: fine enough to resolve sub-micrometre delays
     rest, pre, post = 300, 1200, 2000
     u = (np.arange(pre + post) - pre) * du  # advance relative to onset
-    p_cr = BETA**2 * EI / L**2
+    p_cr = P_CRIT * EI / L**2
     eps_cr = p_cr / EA
     ramp = np.clip((u + pre * du) / (pre * du), 0.0, 1.0) ** 1.5  # Hertz-like P / P_cr
     axial = -eps_cr * ramp[:, None] * np.ones(intervals.shape[0])
@@ -308,7 +308,7 @@ def _detection(ctx: BenchContext) -> tuple[Table, dict[str, float]]:
     trials = 60 if ctx.quick else 200
     EI, EA, _ = _section(sensor)
     L = sensor.exposed_length
-    eps_cr_norm = BETA**2 * EI / L**2 / EA * np.sqrt(len(sensor.used_gratings))
+    eps_cr_norm = P_CRIT * EI / L**2 / EA * np.sqrt(len(sensor.used_gratings))
     pattern = first_mode_pattern(grating_intervals(sensor), L)
     rows: list[Sequence[Any]] = []
     summary: dict[str, float] = {}
