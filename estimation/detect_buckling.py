@@ -77,14 +77,26 @@ def first_mode_strains(
 # Detectors
 
 
-class Detector(Protocol):
-    """A streaming buckling detector: feed strains (N,), read ``alarm``; ``reset`` to re-arm."""
+class BucklingDetector(Protocol):
+    """What the indentation state machine (``robot.indentation``) needs of a detector: decide,
+    one sample of grating strains at a time, that the beam has buckled."""
+
+    def reset(self) -> None:
+        """Re-arm: forget every sample seen."""
+        ...
+
+    def update(self, strains: tuple[float, ...]) -> bool:
+        """Feed one sample of grating strains (N,); True once buckling is detected."""
+        ...
+
+
+class Detector(BucklingDetector, Protocol):
+    """A streaming buckling detector that also reads a recorded series (benchmarks, tests): feed
+    strains (N,), read ``alarm``; ``first_alarm`` on (n, N) gives the streaming answer at once."""
 
     alarm: bool
 
     def update(self, strains: ArrayLike) -> bool: ...
-
-    def reset(self) -> None: ...
 
     def first_alarm(self, strains: ArrayLike) -> int | None: ...
 

@@ -12,9 +12,9 @@ import numpy as np
 from config.scene import CampaignConfig
 from config.schema import MM, StackConfig
 from estimation.beamstate import onset_mode
-from estimation.detect_buckling import CusumDetector, NormThreshold
+from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
 from estimation.section import Section, composite_section
-from robot.indentation import BucklingDetector, Guards
+from robot.indentation import Guards
 from robot.rig import RigSettings
 from sensor.strain import StrainChain, grating_intervals
 from wire.dynamixel import TICKS_PER_REV

@@ -21,7 +21,8 @@ import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+
+from estimation.detect_buckling import BucklingDetector
 
 
 class State(enum.Enum):
@@ -116,17 +117,6 @@ def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -
         if past > guards.max_travel_past_contact:
             return f"travel past contact {past * 1e3:.2f} mm over the limit"
     return None
-
-
-class BucklingDetector(Protocol):
-    """Anything that decides from the grating strains that the beam has buckled
-    (``NormThreshold`` and ``CusumDetector`` of :mod:`estimation.detect_buckling` satisfy it)."""
-
-    def reset(self) -> None: ...
-
-    def update(self, strains: tuple[float, ...]) -> bool:
-        """Feed one sample of grating strains; True once buckling is detected."""
-        ...
 
 
 @dataclass

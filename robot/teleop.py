@@ -35,10 +35,10 @@ from typing import Literal
 
 from config.schema import DriveConfig, TubeConfig
 from config.targets import TargetConfig
+from estimation.detect_buckling import BucklingDetector
 from robot import kinematics
 from robot.drive import JointState, RollerGearDrive
 from robot.indentation import (
-    BucklingDetector,
     Command,
     Guards,
     Observation,

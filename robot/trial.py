@@ -14,8 +14,8 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
+from estimation.detect_buckling import BucklingDetector
 from robot.indentation import (
-    BucklingDetector,
     Command,
     Guards,
     IndentationMachine,
