@@ -20,7 +20,7 @@ from typing import Literal
 
 from config.loader import ConfigError, limits, load, resolve
 from config.scene import CampaignConfig
-from config.schema import MM, StackConfig
+from config.schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
 
 SIMULATION_ONLY = ("samples", "exposed_lengths_mm", "exposed_length_mm", "tubes", "orientations")
 
@@ -69,7 +69,7 @@ class BenchConfig:
     robot: str = "robot.yaml"
     targets: str = "targets.yaml"
     log_dir: str = "out/trial"
-    control_rate_hz: float = field(default=250.0, metadata=limits(gt=0, le=2000))
+    control_rate_hz: float = field(default=DEFAULT_CONTROL_RATE_HZ, metadata=limits(gt=0, le=2000))
     after_trial: Literal["hold", "release"] = "hold"  # torque between trials
     stop_on_fault: bool = True
     retract_mm: float | None = field(default=None, metadata=limits(gt=0, le=500))

@@ -13,7 +13,7 @@ from typing import Literal
 
 from config.faults import FaultsConfig
 from config.loader import limits
-from config.schema import MM
+from config.schema import DEFAULT_CONTROL_RATE_HZ, MM
 
 KPA = 1e3
 
@@ -100,7 +100,7 @@ class SceneConfig:
     name: str = "scene"
     robot: str = "robot.yaml"
     transport: Literal["fast", "wire"] = "fast"
-    control_rate_hz: float = field(default=500.0, metadata=limits(gt=0, le=10000))
+    control_rate_hz: float = field(default=DEFAULT_CONTROL_RATE_HZ, metadata=limits(gt=0, le=10000))
     # The acquisition board's frame rate in this scene; null: the robot configuration's. The
     # control loop uses the newest frame of each tick, so frames beyond the control rate are
     # computed, sent and parsed only to be dropped: a campaign scene streams at its control rate.

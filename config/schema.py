@@ -19,6 +19,10 @@ UE = 1e-6
 PM = 1e-12
 NM = 1e-9
 
+# Control ticks per second when a scene or a bench file does not say (``control_rate_hz``): one
+# default for the simulator and the bench, the rate the shipped files use.
+DEFAULT_CONTROL_RATE_HZ = 250.0
+
 
 @dataclass(frozen=True)
 class SensorConfig:

@@ -248,9 +248,7 @@ def run_bench_trials(
         chain = rig.zero()
         path = log_dir / f"{trial.trial_id}.jsonl"
         with TrialLogWriter(path, _header(trial, loaded, section)) as log:
-            result = run_trial(
-                rig, hw.clock, trial.plan, guards, detector_for(c, chain), log, tick=tick
-            )
+            result = run_trial(rig, hw.clock, trial.plan, guards, detector_for(c, chain), log)
             estimate, length = _estimate(trial, result.marks, stack, section)
             log.write(estimate_record(estimate, length))
             log.write(end_record(result))

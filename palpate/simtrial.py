@@ -391,7 +391,6 @@ def run_sim_trial(
                     guards,
                     detector_for(c, chain),
                     log,
-                    tick=tick,
                     on_tick=on_tick,
                 )
                 estimate, l_b = _estimate(result, spec, stack, section, sample.poisson)

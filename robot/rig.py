@@ -21,6 +21,7 @@ from typing import Literal
 
 import numpy as np
 
+from config.schema import DEFAULT_CONTROL_RATE_HZ
 from estimation.beamstate import axial_strain
 from robot.drive import DriveController, JointState
 from robot.indentation import Command, Observation
@@ -35,7 +36,7 @@ ContactMode = Literal["event", "fbg"]
 
 @dataclass(frozen=True)
 class RigSettings:
-    tick: float = 2e-3  # s, control period
+    tick: float = 1.0 / DEFAULT_CONTROL_RATE_HZ  # s, control period (the one place it is kept)
     contact: ContactMode = "event"
     fbg_contact_strain: float = 20e-6  # compressive axial strain P/EA that means contact (FBG)
     # The gratings' onset bending shape (estimation.beamstate.onset_mode) at the exposed length:
@@ -69,6 +70,11 @@ class ServoFbgRig:
         self._frame: Frame | None = None
         self._frame_t = -math.inf
         self.frames: list[Frame] = []  # every frame received, for the trial log and plots
+
+    @property
+    def tick(self) -> float:
+        """The control period (s), from the settings."""
+        return self.settings.tick
 
     # -- set-up ------------------------------------------------------------------------------
     def zero(self, samples: int = 20) -> StrainChain:

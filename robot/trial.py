@@ -32,6 +32,11 @@ from sensor.clock import Clock
 class Rig(Protocol):
     """What a trial needs from the hardware (or its emulation)."""
 
+    @property
+    def tick(self) -> float:
+        """The control period (s): the loop lets this much time pass between ticks."""
+        ...
+
     def observe(self, t: float) -> Observation:
         """Read encoders and the newest strains; never raises on a servo or stream fault
         (it reports them in the observation)."""
@@ -75,11 +80,13 @@ def run_trial(
     detector: BucklingDetector,
     log: TrialLogWriter | None = None,
     *,
-    tick: float = 2e-3,
     max_ticks: int = 200_000,
     on_tick: Callable[[Observation, State], None] | None = None,
 ) -> TrialResult:
-    """Run one trial to DONE, FAULT or ABORTED; the rig is left retracted or torque-free."""
+    """Run one trial to DONE, FAULT or ABORTED; the rig is left retracted or torque-free.
+
+    One tick every ``rig.tick`` seconds of ``clock``; after ``max_ticks`` the trial is aborted
+    (and retracts). Every transition and every tick is written to ``log`` as it happens."""
     transitions: list[Transition] = []
     record: list[tuple[str, float, tuple[float, ...]]] = []
 
@@ -123,7 +130,7 @@ def run_trial(
                 on_tick(obs, machine.state)
             ticks += 1
             if not machine.finished:
-                clock.sleep(tick)
+                clock.sleep(rig.tick)
     except BaseException as exc:
         machine.marks.reason = f"crash: {type(exc).__name__}: {exc}"
         rig.release()

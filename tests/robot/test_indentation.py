@@ -42,6 +42,7 @@ class ThresholdDetector:
 @dataclass
 class ScriptedRig:
     clock: VirtualClock
+    tick: float = 2e-3  # s, the control period
     x_contact: float = 10e-3
     x_buckle: float = 10.3e-3
     advance: float = 3e-3
