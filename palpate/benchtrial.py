@@ -3,9 +3,9 @@
 :func:`plan_bench_trials` turns the bench file's trial list and the stored targets into
 :class:`robot.indentation.TrialPlan` s, checked against the drive's limits before anything moves.
 :func:`run_bench_trials` runs them in order on opened interfaces (:mod:`palpate.hardware`) with
-:func:`robot.trial.run_trial` and the :class:`robot.rig.ServoFbgRig`, writes one crash-safe log
-per trial as it goes (readable by ``palpate replay``) and estimates the modulus with the same
-functions as ``palpate sim``.
+:func:`robot.trial.run.run_trial` and the :class:`robot.rig.ServoFbgRig`, writes one crash-safe
+log per trial as it goes (readable by ``palpate replay``) and estimates the modulus with the same
+trial core (:mod:`robot.trial`) as ``palpate sim``.
 
 A stored pose is the stand-off pose: the trial rolls there with the sensor back, advances to it,
 approaches the expected surface ``standoff_mm`` further on at the approach speed, indents until
@@ -24,24 +24,19 @@ from typing import Any, Literal
 
 from config.bench import BenchTrialConfig, LoadedBench
 from config.loader import ConfigError
-from config.schema import MM, StackConfig, TubeConfig
-from config.targets import TargetConfig, load_targets
+from config.schema import MM, TubeConfig
+from config.targets import TargetConfig, TargetsFile, load_targets
 from estimation.section import Section
 from estimation.stiffness import StiffnessEstimate
 from palpate.hardware import Hardware
-from palpate.simtrial import estimate_from_marks, estimate_record, exposed_length_at
-from palpate.trialsetup import (
-    detector_for,
-    guards_for,
-    position_tolerance,
-    rig_settings,
-    sensor_section,
-)
 from robot.drive import JointLimitError, JointState, RollerGearDrive
-from robot.indentation import State, TrialMarks, TrialPlan
+from robot.indentation import State, TrialPlan
 from robot.rig import ServoFbgRig
-from robot.trial import end_record, run_trial
-from robot.triallog import TrialLogWriter
+from robot.trial.estimate import estimate_trial
+from robot.trial.log import TrialLogWriter
+from robot.trial.record import end_record, estimate_record, header_common
+from robot.trial.run import run_trial
+from robot.trial.setup import detector_for, guards_for, rig_settings, sensor_section, trial_plan
 from sensor.strain import StrainChain
 
 SKIPPED = "skipped"
@@ -116,9 +111,26 @@ def plan_bench_trials(loaded: LoadedBench, only: str | None = None) -> list[Benc
     Raises ConfigError naming the file and key when a target, a tube or a limit is wrong.
     """
     bench, stack = loaded.bench, loaded.stack
-    c = bench.campaign
     stored = load_targets(loaded.targets_path)
-    entries = list(enumerate(bench.trials))
+    drive = RollerGearDrive(stack.drive)
+    trials: list[BenchTrial] = []
+    for i, entry in _entries(loaded, stored, only):
+        target, tube, where = _target_and_tube(loaded, stored, i, entry)
+        contact = target.translation + bench.campaign.standoff_mm * MM
+        home = bench.retract_translation(target.translation, drive.home.translation)
+        plan = trial_plan(bench.campaign, stack, roll=target.roll, contact=contact, home=home)
+        length = _exposed_length(loaded, entry, tube, contact, where)
+        _check_reach(loaded, drive, target, plan, where)
+        trials += _repeats(loaded, len(trials), entry, target, tube, length, plan)
+    return trials
+
+
+def _entries(
+    loaded: LoadedBench, stored: TargetsFile, only: str | None
+) -> list[tuple[int, BenchTrialConfig]]:
+    """(index in ``trials``, entry) of the bench file's trials to plan; index -1 for a stored
+    pose that ``only`` names and the list omits."""
+    entries = list(enumerate(loaded.bench.trials))
     if only is not None:
         entries = [(i, e) for i, e in entries if e.target == only]
         if not entries:
@@ -130,82 +142,100 @@ def plan_bench_trials(loaded: LoadedBench, only: str | None = None) -> list[Benc
             entries = [(-1, BenchTrialConfig(target=only))]  # a stored pose the list omits
     if not entries:
         raise ConfigError(str(loaded.path), "trials", "no trials listed")
-    drive = RollerGearDrive(stack.drive)
-    trials: list[BenchTrial] = []
-    for i, entry in entries:
-        key = f"trials[{i}].target" if i >= 0 else "--target"
-        try:
-            target = stored.get(entry.target)
-        except KeyError as exc:
-            raise ConfigError(
-                str(loaded.path), key, f"{exc.args[0]} in {loaded.targets_path}"
-            ) from None
-        where = f"targets[{[t.name for t in stored.targets].index(target.name)}]"
-        try:
-            tube = stack.tube(target.tube)
-        except KeyError as exc:
-            raise ConfigError(str(loaded.targets_path), f"{where}.tube", exc.args[0]) from None
-        standoff = c.standoff_mm * MM
-        contact = target.translation + standoff
-        home = bench.retract_translation(target.translation, drive.home.translation)
-        plan = TrialPlan(
-            roll=target.roll,
-            contact_advance=contact,
-            home_advance=home,
-            standoff=standoff,
-            post_buckling_travel=c.post_buckling_mm * MM,
-            fast_speed=stack.drive.max_speed,
-            approach_speed=c.approach_speed_mm_per_s * MM,
-            indent_speed=c.indent_speed_mm_per_s * MM,
-            position_tolerance=position_tolerance(stack),
+    return entries
+
+
+def _target_and_tube(
+    loaded: LoadedBench, stored: TargetsFile, i: int, entry: BenchTrialConfig
+) -> tuple[TargetConfig, TubeConfig, str]:
+    """The entry's stored pose, its tube, and the pose's key in the targets file."""
+    key = f"trials[{i}].target" if i >= 0 else "--target"
+    try:
+        target = stored.get(entry.target)
+    except KeyError as exc:
+        raise ConfigError(
+            str(loaded.path), key, f"{exc.args[0]} in {loaded.targets_path}"
+        ) from None
+    where = f"targets[{[t.name for t in stored.targets].index(target.name)}]"
+    try:
+        tube = loaded.stack.tube(target.tube)
+    except KeyError as exc:
+        raise ConfigError(str(loaded.targets_path), f"{where}.tube", exc.args[0]) from None
+    return target, tube, where
+
+
+def _exposed_length(
+    loaded: LoadedBench, entry: BenchTrialConfig, tube: TubeConfig, contact: float, where: str
+) -> float:
+    """The sensor's exposed length at the expected contact (m): the entry's (or the sensor's) on
+    the bench stage, the advance past the tube's flush translation on the robot."""
+    if loaded.bench.campaign.kind == "bench":
+        return (entry.exposed_length_mm or loaded.stack.sensor.exposed_length_mm) * MM
+    length = contact - tube.flush_translation
+    if length <= 0:
+        raise ConfigError(
+            str(loaded.targets_path),
+            f"{where}.translation_mm",
+            f"the sensor would still be inside tube {tube.name!r} at contact "
+            f"(exposed length {length / MM:.2f} mm)",
         )
-        if c.kind == "bench":
-            length = (entry.exposed_length_mm or stack.sensor.exposed_length_mm) * MM
-        else:
-            length = contact - tube.flush_translation
-            if length <= 0:
-                raise ConfigError(
-                    str(loaded.targets_path),
-                    f"{where}.translation_mm",
-                    f"the sensor would still be inside tube {tube.name!r} at contact "
-                    f"(exposed length {length / MM:.2f} mm)",
-                )
-        # The farthest a trial may drive: no contact until the approach window ends, then the
-        # travel past contact; both must be inside the drive's limits before anything moves.
-        farthest = contact + plan.approach_window + c.max_travel_past_contact_mm * MM
-        try:
-            for q in (
-                JointState(target.roll, home),
-                JointState(target.roll, target.translation),
-                JointState(target.roll, farthest),
-            ):
-                drive.check(q)
-        except JointLimitError as exc:
-            raise ConfigError(
-                str(loaded.targets_path),
-                f"{where}.translation_mm",
-                f"target {target.name!r}: the trial may reach {farthest / MM:.2f} mm "
-                f"(contact + approach window + travel past contact): {exc}",
-            ) from None
-        for rep in range(c.repeats):
-            parts = [f"{len(trials) + 1:02d}", target.name]
-            if entry.sample:
-                parts.append(entry.sample)
-            if c.repeats > 1:
-                parts.append(f"r{rep}")
-            trials.append(
-                BenchTrial(
-                    trial_id=_safe("-".join(parts)),
-                    kind=c.kind,
-                    target=target,
-                    tube=tube,
-                    sample=entry.label,
-                    modulus=entry.modulus,
-                    poisson=entry.poisson,
-                    exposed_length=length,
-                    plan=plan,
-                )
+    return length
+
+
+def _check_reach(
+    loaded: LoadedBench, drive: RollerGearDrive, target: TargetConfig, plan: TrialPlan, where: str
+) -> None:
+    """The farthest a trial may drive: no contact until the approach window ends, then the
+    travel past contact; both must be inside the drive's limits before anything moves."""
+    past = loaded.bench.campaign.max_travel_past_contact_mm * MM
+    farthest = plan.contact_advance + plan.approach_window + past
+    try:
+        for q in (
+            JointState(target.roll, plan.home_advance),
+            JointState(target.roll, target.translation),
+            JointState(target.roll, farthest),
+        ):
+            drive.check(q)
+    except JointLimitError as exc:
+        raise ConfigError(
+            str(loaded.targets_path),
+            f"{where}.translation_mm",
+            f"target {target.name!r}: the trial may reach {farthest / MM:.2f} mm "
+            f"(contact + approach window + travel past contact): {exc}",
+        ) from None
+
+
+def _repeats(
+    loaded: LoadedBench,
+    planned: int,
+    entry: BenchTrialConfig,
+    target: TargetConfig,
+    tube: TubeConfig,
+    length: float,
+    plan: TrialPlan,
+) -> list[BenchTrial]:
+    """The entry's ``campaign.repeats`` trials, numbered after the ``planned`` ones."""
+    c = loaded.bench.campaign
+    trials: list[BenchTrial] = []
+    for rep in range(c.repeats):
+        parts = [f"{planned + len(trials) + 1:02d}", target.name]
+        if entry.sample:
+            parts.append(entry.sample)
+        if c.repeats > 1:
+            parts.append(f"r{rep}")
+        trials.append(
+            BenchTrial(
+                trial_id=_safe("-".join(parts)),
+                kind=c.kind,
+                target=target,
+                tube=tube,
+                sample=entry.label,
+                modulus=entry.modulus,
+                poisson=entry.poisson,
+                exposed_length=length,
+                plan=plan,
             )
+        )
     return trials
 
 
@@ -224,11 +254,7 @@ def run_bench_trials(
     hardware it stays False. With ``stop_on_fault`` a trial that does not complete ends the
     session: the rest are reported as skipped, torque is off.
     """
-    bench, stack = loaded.bench, loaded.stack
-    c = bench.campaign
-    tick = 1.0 / bench.control_rate_hz
-    guards = guards_for(c, stack, tick)
-    section = sensor_section(stack)
+    bench = loaded.bench
     outcomes: list[BenchOutcome] = []
     torque_on = True  # DriveController.start() turned it on
     stopped = False
@@ -239,32 +265,11 @@ def run_bench_trials(
         if not torque_on:
             hw.drive.bus.set_torque(True)
             torque_on = True
-        settings = rig_settings(
-            c, stack, tick, sync_to_clock=sync_to_clock, exposed_length=trial.exposed_length
-        )
-        rig = ServoFbgRig(
-            hw.drive, hw.reader, StrainChain.from_config(stack.fbg), hw.clock, settings
-        )
-        chain = rig.zero()
-        path = log_dir / f"{trial.trial_id}.jsonl"
-        with TrialLogWriter(path, _header(trial, loaded, section)) as log:
-            result = run_trial(rig, hw.clock, trial.plan, guards, detector_for(c, chain), log)
-            estimate, length = _estimate(trial, result.marks, stack, section)
-            log.write(estimate_record(estimate, length))
-            log.write(end_record(result))
-        outcome = BenchOutcome(
-            trial,
-            result.state.value,
-            result.reason,
-            estimate,
-            length,
-            result.duration,
-            str(path),
-        )
+        outcome, rig = _run_one(hw, trial, loaded, log_dir, sync_to_clock)
         outcomes.append(outcome)
         if progress is not None:
             progress(outcome)
-        if result.state is not State.DONE:
+        if outcome.state != State.DONE.value:
             torque_on = False  # run_trial released the servos
             stopped = bench.stop_on_fault
         elif bench.after_trial == "release":
@@ -273,29 +278,49 @@ def run_bench_trials(
     return outcomes
 
 
-def _estimate(
-    trial: BenchTrial, marks: TrialMarks, stack: StackConfig, section: Section
-) -> tuple[StiffnessEstimate | None, float | None]:
-    if marks.x_buckling is None:
-        return None, None
-    length = exposed_length_at(
-        trial.kind, marks.x_buckling, trial.exposed_length, trial.tube.flush_translation
+def _run_one(
+    hw: Hardware, trial: BenchTrial, loaded: LoadedBench, log_dir: Path, sync_to_clock: bool
+) -> tuple[BenchOutcome, ServoFbgRig]:
+    """Zero the strains, run one trial with its log, estimate; the outcome and the rig."""
+    stack, c = loaded.stack, loaded.bench.campaign
+    tick = 1.0 / loaded.bench.control_rate_hz
+    settings = rig_settings(
+        c, stack, tick, sync_to_clock=sync_to_clock, exposed_length=trial.exposed_length
     )
-    est = estimate_from_marks(
-        marks.x_contact,
-        marks.x_buckling,
-        marks.strains_at_buckling,
-        length,
-        stack,
-        section,
-        trial.poisson,
+    rig = ServoFbgRig(hw.drive, hw.reader, StrainChain.from_config(stack.fbg), hw.clock, settings)
+    chain = rig.zero()
+    section = sensor_section(stack)
+    path = log_dir / f"{trial.trial_id}.jsonl"
+    with TrialLogWriter(path, _header(trial, loaded, section)) as log:
+        guards = guards_for(c, stack, rig.tick)
+        result = run_trial(rig, hw.clock, trial.plan, guards, detector_for(c, chain), log)
+        estimate = estimate_trial(
+            result,
+            kind=trial.kind,
+            exposed_length=trial.exposed_length,
+            flush_translation=trial.tube.flush_translation,
+            stack=stack,
+            section=section,
+            poisson=trial.poisson,
+        )
+        log.write(estimate_record(estimate))
+        log.write(end_record(result))
+    outcome = BenchOutcome(
+        trial,
+        result.state.value,
+        result.reason,
+        estimate.paper,
+        estimate.exposed_length_at_buckling,
+        result.duration,
+        str(path),
     )
-    return est, length
+    return outcome, rig
 
 
 def _header(trial: BenchTrial, loaded: LoadedBench, section: Section) -> dict[str, Any]:
     """The log header; the keys ``palpate replay`` reads are those of a simulated trial."""
     stack = loaded.stack
+    tube = trial.tube if trial.kind == "robot" else None
     return {
         "trial": trial.trial_id,
         "source": "bench",
@@ -311,10 +336,5 @@ def _header(trial: BenchTrial, loaded: LoadedBench, section: Section) -> dict[st
             "roll": trial.plan.roll,
             "exposed_length": trial.exposed_length,
         },
-        "plan": dataclasses.asdict(trial.plan),
-        "section": dataclasses.asdict(section),
-        "sensor": dataclasses.asdict(stack.sensor),
-        "tube": dataclasses.asdict(trial.tube) if trial.kind == "robot" else None,
-        "poisson": trial.poisson,
-        "units": "SI (m, N, Pa, rad, s); strains dimensionless",
+        **header_common(trial.plan, section, stack.sensor, tube, trial.poisson),
     }

@@ -52,7 +52,7 @@ from palpate.campaign import campaign_trials
 from palpate.commands.replay import replay
 from palpate.preflight import check_campaign, check_reachable
 from palpate.simtrial import TrialOutcome, TrialSpec, run_sim_trial
-from robot.triallog import TrialLogWriter, read_log
+from robot.trial.log import TrialLogWriter, read_log
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus

@@ -21,11 +21,11 @@ import numpy as np
 
 from config.scene import SceneConfig
 from config.schema import StackConfig, TubeConfig
-from palpate.simtrial import tissue_model
-from palpate.trialsetup import sensor_section
+from palpate.simworld import tissue_model
 from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
 from robot.dynamixel.units import rad_from_ticks
+from robot.trial.setup import sensor_section
 from sensor.reader import layout_from_config
 from sim.board import BoardEmulator, BoardSample
 from sim.clock import VirtualClock

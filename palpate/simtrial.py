@@ -1,8 +1,9 @@
 """One simulated trial, wired exactly like the bench: emulators in, control stack on top.
 
-The world (``sim.world``) feeds the servo emulator and the board emulator on one virtual clock;
-the control stack drives the servos through dynamixel-sdk and reads FBG frames through the frame
-reader, then the paper's estimator runs on the trial's marks. ``transport="wire"`` puts both
+The world (``sim.world``, built by :mod:`palpate.simworld`) feeds the servo emulator and the
+board emulator on one virtual clock; the control stack drives the servos through dynamixel-sdk
+and reads FBG frames through the frame reader, and the trial core (:mod:`robot.trial`, the same
+as on the bench) plans, runs, estimates and records the trial. ``transport="wire"`` puts both
 emulators on pseudo-terminals; ``"fast"`` keeps the same SDK, driver, reader and parser and only
 replaces the ptys by in-process transports (``sim.inprocess``).
 """
@@ -12,65 +13,55 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
-import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
-import numpy as np
-
-from config.scene import FidelityConfig, SampleConfig, SceneConfig
+from config.scene import SceneConfig
 from config.schema import ServoBusConfig, StackConfig
-from estimation.beam import Beam
 from estimation.jointfit import JointFit
-from estimation.section import Section
-from estimation.stiffness import StiffnessEstimate, paper_estimate
-from palpate.estimates import EstimatorInputs, joint_estimate, joint_record, loading_rows
-from palpate.trialsetup import (
-    detector_for,
-    guards_for,
-    position_tolerance,
-    rig_settings,
-    sensor_section,
+from estimation.stiffness import StiffnessEstimate
+from palpate.simworld import (
+    ServoJoints,
+    TrialGeometry,
+    TrialSpec,
+    tissue_model,
+    trial_geometry,
+    trial_sample,
+    trial_stack,
+    trial_world,
 )
-from robot import kinematics
-from robot.drive import TRANSLATION, DriveController, RollerGearDrive
+from robot.drive import DriveController
 from robot.dynamixel.driver import DynamixelBus
-from robot.dynamixel.units import rad_from_ticks
-from robot.indentation import State, TrialMarks, TrialPlan
-from robot.rig import ServoFbgRig
-from robot.trial import TrialResult, end_record, run_trial
-from robot.triallog import TrialLogWriter
+from robot.indentation import Observation, State, TrialMarks, TrialPlan
+from robot.rig import RigSettings, ServoFbgRig
+from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from robot.trial.log import TrialLogWriter
+from robot.trial.record import end_record, estimate_record, header_common
+from robot.trial.run import TrialResult, run_trial
+from robot.trial.setup import detector_for, guards_for, rig_settings, sensor_section, trial_plan
 from sensor.reader import FrameReader, layout_from_config
-from sensor.strain import StrainChain, grating_intervals
+from sensor.strain import StrainChain
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 from sim.inprocess import InProcessPort, MemorySerial
-from sim.tissue import TissueModel
-from sim.world import Surface, World
+from sim.world import World
 from wire.dynamixel import TICKS_PER_REV
 
+# The simulated trial's public names; the spec, the geometry and the tissue are simworld's.
+__all__ = [
+    "EmulatorHook",
+    "Transport",
+    "TrialOutcome",
+    "TrialSpec",
+    "run_sim_trial",
+    "tissue_model",
+    "trial_geometry",
+]
+
 Transport = Literal["fast", "wire"]
-BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
-VERTICAL = np.array([0.0, 0.0, -1.0])
-
-
-@dataclass(frozen=True)
-class TrialSpec:
-    """One trial of a campaign."""
-
-    trial_id: str
-    kind: Literal["bench", "robot"]
-    sample: str
-    modulus: float  # Pa, the ground truth
-    poisson: float
-    tube: str
-    orientation: str
-    roll: float  # rad
-    exposed_length: float  # m at contact
-    seed: int
 
 
 @dataclass
@@ -86,7 +77,7 @@ class TrialOutcome:
     log_path: str | None
     series: dict[str, list[float]] = field(default_factory=dict)
     marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
-    joint: JointFit | None = None  # the contact-point-free estimate (palpate.estimates)
+    joint: JointFit | None = None  # the contact-point-free estimate (robot.trial.estimate)
     joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
 
     def modulus(self, method: str = "joint") -> float | None:
@@ -125,86 +116,6 @@ class TrialOutcome:
             "sim_time_s": self.sim_time,
             "log": self.log_path,
         }
-
-
-def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
-    """The simulated tissue's force law for a scene's sample and fidelity switches."""
-    return TissueModel(
-        modulus=sample.modulus,
-        poisson=sample.poisson,
-        thickness=(
-            sample.thickness if (sample.thickness and fidelity.finite_thickness) else math.inf
-        ),
-        bonded=sample.bonded,
-        tip_radius=tip_radius,
-        finite_thickness=fidelity.finite_thickness,
-        large_indentation=fidelity.large_indentation,
-    )
-
-
-@dataclass(frozen=True)
-class _Geometry:
-    plan_roll: float
-    contact_translation: float
-    surface: Surface
-    residual: float
-    tube: str
-
-
-def _robot_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
-    """Place the sample where the campaign wants it, then let the IK find the way back to it."""
-    tube = stack.tube(spec.tube)
-    nominal = kinematics.forward(tube, spec.roll, tube.flush_translation + spec.exposed_length)
-    r_tip = stack.sensor.tip_radius
-    target = nominal.sensor_tip + r_tip * nominal.tangent
-    normal = -nominal.tangent
-    ik = kinematics.inverse(
-        stack.tubes,
-        target,
-        normal,
-        tip_radius=r_tip,
-        translation_limits=stack.drive.translation_limits,
-        roll_limits=stack.drive.roll_limits,
-    )
-    if not ik.reachable:
-        raise ValueError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
-    surface = Surface(point=target, normal=normal)
-    return _Geometry(ik.roll, ik.advance, surface, ik.residual, ik.tube)
-
-
-def _bench_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
-    depth = BENCH_CONTACT_TRANSLATION + spec.exposed_length + stack.sensor.tip_radius
-    surface = Surface(point=depth * VERTICAL, normal=-VERTICAL)
-    return _Geometry(0.0, BENCH_CONTACT_TRANSLATION, surface, 0.0, "bench-stage")
-
-
-def trial_geometry(stack: StackConfig, spec: TrialSpec) -> _Geometry:
-    """Where the sample is and how the robot reaches it; ValueError if it cannot."""
-    return _bench_geometry(stack, spec) if spec.kind == "bench" else _robot_geometry(stack, spec)
-
-
-def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
-    if spec.kind == "bench":
-        length = spec.exposed_length
-
-        def bench_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
-            return translation * VERTICAL, VERTICAL, length
-
-        return bench_pose
-    tube = stack.tube(tube_name)
-    frame_roll = math.nan
-    frame = kinematics.forward(tube, 0.0, 0.0)
-
-    def robot_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
-        # The tip frame depends on the roll only, which is constant while the stage moves:
-        # keep the last one (the board asks for a pose at every sample).
-        nonlocal frame, frame_roll
-        if roll != frame_roll:
-            frame, frame_roll = kinematics.forward(tube, roll, 0.0), roll
-        length = exposed_length_at("robot", translation, 0.0, tube.flush_translation)
-        return frame.tube_tip, frame.tangent, length
-
-    return robot_pose
 
 
 class EmulatorHook(Protocol):
@@ -284,188 +195,129 @@ def run_sim_trial(
     c = scene.campaign
     geo = trial_geometry(stack, spec)
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
-    drive_cfg = dataclasses.replace(
-        stack.drive, home_translation_mm=retract * 1e3, home_roll_deg=math.degrees(geo.plan_roll)
-    )
-    board_cfg = stack.board
-    if scene.board_rate_hz is not None:
-        board_cfg = dataclasses.replace(board_cfg, rate_hz=scene.board_rate_hz)
-    stack = dataclasses.replace(stack, drive=drive_cfg, board=board_cfg)
-    section = sensor_section(stack)
-    sample = next(s for s in scene.samples if s.name == spec.sample)
-    fid = scene.fidelity
-    tissue = tissue_model(sample, fid, stack.sensor.tip_radius)
-    rng = np.random.default_rng(spec.seed)
+    stack = trial_stack(scene, stack, geo, retract)
+    plan = trial_plan(c, stack, roll=geo.plan_roll, contact=geo.contact_translation, home=retract)
     clock = VirtualClock()
-    truth = RollerGearDrive(drive_cfg)  # the servos power up at the home pose (0 ticks)
-    pose = _pose_fn(stack, spec, geo.tube)
-    servo_ids = {
-        "outer_roll": stack.servos.outer_roll.id,
-        "inner_roll": stack.servos.inner_roll.id,
-        TRANSLATION: stack.servos.translation.id,
-    }
-    holder: dict[str, EmulatedBus] = {}
-    last_ticks: dict[str, int] = {}
-    last_joints = (0.0, 0.0, 0)
-
-    def joints() -> tuple[float, float, int]:
-        nonlocal last_ticks, last_joints
-        bus = holder["bus"]
-        ticks = {n: bus.servo(i).position_ticks for n, i in servo_ids.items()}
-        if ticks != last_ticks:  # the servos rest for most board samples: keep the last answer
-            q = truth.joints({n: rad_from_ticks(t) for n, t in ticks.items()})
-            last_ticks, last_joints = ticks, (q.roll, q.translation, ticks[TRANSLATION])
-        return last_joints
-
-    world = World(
-        section=section,
-        sensor=stack.sensor,
-        fbg=stack.fbg,
-        fidelity=fid,
-        tissue=tissue,
-        surface=geo.surface,
-        pose=pose,
-        joints=joints,
-        rng=rng,
-        has_force=stack.board.has_force,
-        length_grows=spec.kind == "robot",
-        encoder_step=stack.drive.lead / TICKS_PER_REV,
-    )
-    tick = 1.0 / scene.control_rate_hz
-    plan = TrialPlan(
-        roll=geo.plan_roll,
-        contact_advance=geo.contact_translation,
-        home_advance=retract,
-        standoff=c.standoff_mm * 1e-3,
-        post_buckling_travel=c.post_buckling_mm * 1e-3,
-        approach_speed=c.approach_speed_mm_per_s * 1e-3,
-        indent_speed=c.indent_speed_mm_per_s * 1e-3,
-        fast_speed=stack.drive.max_speed,
-        position_tolerance=position_tolerance(stack),
-    )
-    guards = guards_for(c, stack, tick)
-    log: TrialLogWriter | None = None
-    log_path: str | None = None
-    series: dict[str, list[float]] = {"advance": [], "force": [], "s1": [], "s2": [], "s3": []}
-    with _emulators(transport, stack, clock, world, hook) as (
-        bus,
-        board,
-        servo_port,
-        board_port,
-    ):
-        holder["bus"] = bus
+    servos = ServoJoints(stack)
+    world = trial_world(spec, scene, stack, geo, servos)
+    series: dict[str, list[float]] = {}
+    on_tick = _series_recorder(world, series) if keep_series else None
+    with _emulators(transport, stack, clock, world, hook) as (bus, board, servo_port, board_port):
+        servos.bus = bus
         driver = DynamixelBus.from_config(stack.servos, port=servo_port)
         reader = FrameReader.from_config(board_port, stack.sensor, stack.board, clock=clock)
-        settings = rig_settings(
-            c, stack, tick, sync_to_clock=True, exposed_length=spec.exposed_length
+        settings = _rig_settings(
+            spec, scene, stack, fast_faults=hook is not None and transport == "fast"
         )
-        if hook is not None and transport == "fast":
-            # in-process frames arrive during the clock advance or never: with injected board
-            # faults, do not wait 0.2 s of wall time for each lost frame
-            settings = dataclasses.replace(settings, frame_wait_s=0.0)
-        with DriveController(driver, drive_cfg) as drive, reader:
+        with DriveController(driver, stack.drive) as drive, reader:
             board.start()
             rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
             chain = rig.zero()
-            if log_dir is not None:
-                path = log_dir / f"{spec.trial_id}.jsonl"
-                log_path = str(path)
-                log = TrialLogWriter(path, _header(spec, scene, stack, plan, section, geo))
-                if hook is not None:
-                    hook.log_opened(log)
-            on_tick = None
-            if keep_series:
-
-                def on_tick(obs: Any, state: State) -> None:
-                    st = world.last
-                    series["advance"].append(obs.advance)
-                    series["force"].append(st.P if st else 0.0)
-                    for k, s in zip(("s1", "s2", "s3"), obs.strains, strict=False):
-                        series[k].append(s)
-
-            try:
-                result = run_trial(
-                    rig,
-                    clock,
-                    plan,
-                    guards,
-                    detector_for(c, chain),
-                    log,
-                    on_tick=on_tick,
-                )
-                estimate, l_b = _estimate(result, spec, stack, section, sample.poisson)
-                fit_start = time.perf_counter()
-                joint = joint_from_rows(
-                    result.record, _estimator_inputs(spec, scene, stack, geo), stack, section
-                )
-                joint_seconds = time.perf_counter() - fit_start
+            with _trial_log(log_dir, spec, scene, stack, plan, geo, hook) as log:
+                guards = guards_for(c, stack, rig.tick)
+                detector = detector_for(c, chain)
+                result = run_trial(rig, clock, plan, guards, detector, log, on_tick=on_tick)
+                estimate = _estimate(result, spec, scene, stack, geo)
                 if log is not None:
-                    log.write(estimate_record(estimate, l_b, joint))
+                    log.write(estimate_record(estimate))
                     log.write(end_record(result))
-            finally:
-                if log is not None:
-                    log.close()
+    log_path = None if log is None else str(log.path)
+    return _outcome(spec, geo, result, estimate, log_path, series)
+
+
+def _rig_settings(
+    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, *, fast_faults: bool
+) -> RigSettings:
+    settings = rig_settings(
+        scene.campaign,
+        stack,
+        1.0 / scene.control_rate_hz,
+        sync_to_clock=True,
+        exposed_length=spec.exposed_length,
+    )
+    if fast_faults:
+        # in-process frames arrive during the clock advance or never: with injected board
+        # faults, do not wait 0.2 s of wall time for each lost frame
+        settings = dataclasses.replace(settings, frame_wait_s=0.0)
+    return settings
+
+
+def _series_recorder(
+    world: World, series: dict[str, list[float]]
+) -> Callable[[Observation, State], None]:
+    """An ``on_tick`` that fills ``series``: stage advance, the world's true load, strains."""
+    series.update(advance=[], force=[], s1=[], s2=[], s3=[])
+
+    def on_tick(obs: Observation, state: State) -> None:
+        st = world.last
+        series["advance"].append(obs.advance)
+        series["force"].append(st.P if st else 0.0)
+        for k, s in zip(("s1", "s2", "s3"), obs.strains, strict=False):
+            series[k].append(s)
+
+    return on_tick
+
+
+@contextlib.contextmanager
+def _trial_log(
+    log_dir: Path | None,
+    spec: TrialSpec,
+    scene: SceneConfig,
+    stack: StackConfig,
+    plan: TrialPlan,
+    geo: TrialGeometry,
+    hook: EmulatorHook | None,
+) -> Iterator[TrialLogWriter | None]:
+    """The trial's log in ``log_dir`` (None: no log), closed however the trial ends."""
+    if log_dir is None:
+        yield None
+        return
+    header = _header(spec, scene, stack, plan, geo)
+    with TrialLogWriter(log_dir / f"{spec.trial_id}.jsonl", header) as log:
+        if hook is not None:
+            hook.log_opened(log)
+        yield log
+
+
+def _estimate(
+    result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
+) -> TrialEstimate:
+    flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
+    return estimate_trial(
+        result,
+        kind=spec.kind,
+        exposed_length=spec.exposed_length,
+        flush_translation=flush,
+        stack=stack,
+        section=sensor_section(stack),
+        poisson=trial_sample(scene, spec).poisson,
+        inputs=_estimator_inputs(spec, scene, stack, geo),
+    )
+
+
+def _outcome(
+    spec: TrialSpec,
+    geo: TrialGeometry,
+    result: TrialResult,
+    estimate: TrialEstimate,
+    log_path: str | None,
+    series: dict[str, list[float]],
+) -> TrialOutcome:
     return TrialOutcome(
         spec=spec,
         state=result.state.value,
         reason=result.reason,
-        estimate=estimate,
-        exposed_length_at_buckling=l_b,
+        estimate=estimate.paper,
+        exposed_length_at_buckling=estimate.exposed_length_at_buckling,
         ik_residual=geo.residual,
         ticks=result.ticks,
         sim_time=result.duration,
         log_path=log_path,
-        series=series if keep_series else {},
+        series=series,
         marks=result.marks,
-        joint=joint,
-        joint_seconds=joint_seconds,
+        joint=estimate.joint,
+        joint_seconds=estimate.joint_seconds,
     )
-
-
-def exposed_length_at(kind: str, x: float, fixed_length: float, flush_translation: float) -> float:
-    """Exposed length (m) at stage position ``x``: fixed on the bench, on the robot the stage
-    translation past the tube's flush translation. Shared by the trial and ``palpate replay``."""
-    if kind == "bench":
-        return fixed_length
-    return x - flush_translation
-
-
-def estimate_from_marks(
-    x_contact: float | None,
-    x_buckling: float | None,
-    strains: tuple[float, ...],
-    length: float | None,
-    stack: StackConfig,
-    section: Section,
-    poisson: float,
-) -> StiffnessEstimate | None:
-    """The paper's estimate: delta from the encoder (Eq. 14), P from the FBG-fitted elastica at
-    the exposed length at buckling (Eq. 7; P_cr when the fit fails), E from Hertz (Eq. 13)."""
-    if x_contact is None or x_buckling is None or length is None:
-        return None
-    beam = Beam.from_section(section, length)
-    P: float | None = None
-    if strains:
-        fit = beam.fit_strains(np.asarray(strains), grating_intervals(stack.sensor, length))
-        if fit.success and fit.P > 0:
-            P = float(fit.P)
-    return paper_estimate(
-        x_contact, x_buckling, length, section, stack.sensor.tip_radius, poisson, P=P
-    )
-
-
-def _estimate(
-    result: TrialResult, spec: TrialSpec, stack: StackConfig, section: Section, poisson: float
-) -> tuple[StiffnessEstimate | None, float | None]:
-    m = result.marks
-    if m.x_buckling is None:
-        return None, None
-    flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
-    length = exposed_length_at(spec.kind, m.x_buckling, spec.exposed_length, flush)
-    est = estimate_from_marks(
-        m.x_contact, m.x_buckling, m.strains_at_buckling, length, stack, section, poisson
-    )
-    return est, length
 
 
 def _header(
@@ -473,29 +325,24 @@ def _header(
     scene: SceneConfig,
     stack: StackConfig,
     plan: TrialPlan,
-    section: Section,
-    geo: _Geometry,
+    geo: TrialGeometry,
 ) -> dict[str, Any]:
+    tube = stack.tube(geo.tube) if spec.kind == "robot" else None
+    inputs = _estimator_inputs(spec, scene, stack, geo)
     return {
         "trial": spec.trial_id,
         "source": "simulation",
         "spec": dataclasses.asdict(spec),
         "scene": scene.name,
-        "plan": dataclasses.asdict(plan),
-        "section": dataclasses.asdict(section),
-        "sensor": dataclasses.asdict(stack.sensor),
-        "tube": dataclasses.asdict(stack.tube(geo.tube)) if spec.kind == "robot" else None,
-        "poisson": spec.poisson,
-        "estimator": _estimator_inputs(spec, scene, stack, geo).as_dict(),
-        "units": "SI (m, N, Pa, rad, s); strains dimensionless",
+        **header_common(plan, sensor_section(stack), stack.sensor, tube, spec.poisson, inputs),
     }
 
 
 def _estimator_inputs(
-    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: _Geometry
+    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
 ) -> EstimatorInputs:
     """What the joint fit is told: the sample as the user knows it (not the sim's switches)."""
-    sample = next(s for s in scene.samples if s.name == spec.sample)
+    sample = trial_sample(scene, spec)
     return EstimatorInputs(
         kind=spec.kind,
         exposed_length=spec.exposed_length,
@@ -507,33 +354,3 @@ def _estimator_inputs(
         encoder_resolution=stack.drive.lead / TICKS_PER_REV,
         misalignment=geo.residual,
     )
-
-
-def joint_from_rows(
-    rows: Any, inputs: EstimatorInputs, stack: StackConfig, section: Section
-) -> JointFit:
-    """The joint fit from (state, advance, strains) rows: the trial's record or a log's samples."""
-    advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
-    return joint_estimate(advance, strains, inputs, stack.sensor, section)
-
-
-def estimate_record(
-    est: StiffnessEstimate | None, length: float | None, joint: JointFit | None = None
-) -> dict[str, Any]:
-    if est is None:
-        return {
-            "kind": "estimate",
-            "success": False,
-            "message": "no buckling detected",
-            "joint": joint_record(joint),
-        }
-    return {
-        "kind": "estimate",
-        "success": est.success,
-        "modulus": est.modulus,
-        "delta": est.delta,
-        "force": est.force,
-        "exposed_length": length,
-        "message": est.message,
-        "joint": joint_record(joint),
-    }

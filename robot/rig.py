@@ -1,6 +1,6 @@
 """The trial rig on real interfaces: servos through the drive, FBG frames through the reader.
 
-:class:`ServoFbgRig` implements :class:`robot.trial.Rig` over a
+:class:`ServoFbgRig` implements :class:`robot.trial.run.Rig` over a
 :class:`robot.drive.DriveController` (any :class:`robot.motors.MotorBus`: dynamixel-sdk on a
 real port, on the emulator's pty, or on the in-process transport) and a
 :class:`sensor.reader.FrameReader` (a real port, a pty, or an in-memory serial object). The
@@ -50,7 +50,7 @@ class RigSettings:
 
 
 class ServoFbgRig:
-    """A :class:`robot.trial.Rig` over a drive and an FBG frame reader."""
+    """A :class:`robot.trial.run.Rig` over a drive and an FBG frame reader."""
 
     def __init__(
         self,

@@ -11,9 +11,14 @@ from typing import Any
 from config.loader import from_mapping
 from config.schema import SensorConfig, StackConfig, TubeConfig
 from estimation.section import Section
-from palpate.estimates import EstimatorInputs, joint_record
-from palpate.simtrial import estimate_from_marks, exposed_length_at, joint_from_rows
-from robot.triallog import TrialLog, TrialLogError, read_log
+from robot.trial.estimate import (
+    EstimatorInputs,
+    estimate_from_marks,
+    exposed_length_at,
+    joint_from_rows,
+)
+from robot.trial.log import TrialLog, TrialLogError, read_log
+from robot.trial.record import joint_record
 
 
 def register(parser: argparse.ArgumentParser) -> None:

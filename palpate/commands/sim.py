@@ -145,7 +145,7 @@ def _prepare(path: Path, args: argparse.Namespace) -> _Campaign:
 
 def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
     from palpate.compare import compare_methods, comparison_payload, print_comparison
-    from palpate.trialsetup import sensor_section
+    from robot.trial.setup import sensor_section
 
     for c in campaigns:
         table = compare_methods(c.outcomes, c.stack, sensor_section(c.stack))

@@ -28,10 +28,10 @@ from config.schema import StackConfig
 from config.targets import save_target
 from palpate.hardware import open_hardware, run_on_hardware
 from palpate.simbench import SimulatedBench
-from palpate.trialsetup import detector_for, guards_for, rig_settings
 from robot.indentation import State
 from robot.rig import ServoFbgRig
 from robot.teleop import Teleop, render
+from robot.trial.setup import detector_for, guards_for, rig_settings
 from sensor.clock import Clock, SystemClock
 from sensor.strain import StrainChain
 

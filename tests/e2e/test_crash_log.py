@@ -15,7 +15,7 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.cli import main
 from palpate.faults import child_command, fault_jobs
-from robot.triallog import read_log
+from robot.trial.log import read_log
 
 SCENE_PATH = resolve("scenes/faults.yaml")
 SCENE = load(SceneConfig, SCENE_PATH)
@@ -66,7 +66,7 @@ def test_sigkill_mid_trial_keeps_every_record_written(
 
 
 def test_a_torn_last_line_is_counted_not_fatal(tmp_path: Path) -> None:
-    from robot.triallog import TrialLogWriter
+    from robot.trial.log import TrialLogWriter
 
     path = tmp_path / "t.jsonl"
     with TrialLogWriter(path, {"trial": "x"}) as w:

@@ -12,7 +12,7 @@ from config.scene import SceneConfig
 from palpate.commands.replay import replay
 from palpate.compare import compare_methods
 from palpate.simtrial import TrialOutcome, TrialSpec, run_sim_trial
-from palpate.trialsetup import sensor_section
+from robot.trial.setup import sensor_section
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

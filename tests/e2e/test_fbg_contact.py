@@ -15,8 +15,8 @@ import math
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.simtrial import TrialSpec, run_sim_trial
-from palpate.trialsetup import sensor_section
 from robot.rig import RigSettings
+from robot.trial.setup import sensor_section
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

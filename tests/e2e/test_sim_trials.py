@@ -13,7 +13,7 @@ from config.scene import SceneConfig
 from palpate.cli import main
 from palpate.commands.replay import replay
 from palpate.simtrial import TrialSpec, run_sim_trial
-from robot.triallog import read_log
+from robot.trial.log import read_log
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

@@ -28,7 +28,7 @@ from palpate.commands.trial import run_session
 from palpate.hardware import HardwareError, explain, open_hardware
 from palpate.simbench import SimulatedBench, surface_at
 from robot.motors import ServoTransportError
-from robot.triallog import read_log
+from robot.trial.log import read_log
 from sim.clock import VirtualClock
 
 ROBOT_SCENE = load(SceneConfig, resolve("scenes/robot.yaml"))

@@ -23,8 +23,9 @@ from robot.indentation import (
     Transition,
     TrialPlan,
 )
-from robot.trial import end_record, run_trial
-from robot.triallog import TrialLogWriter, read_log
+from robot.trial.log import TrialLogWriter, read_log
+from robot.trial.record import end_record
+from robot.trial.run import run_trial
 from sim.clock import VirtualClock
 
 

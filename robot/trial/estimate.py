@@ -1,4 +1,10 @@
-"""The contact-point-free estimate of one trial, from its loading record (trial and replay alike).
+"""The estimates of one finished trial (trial and replay alike): the paper's and the joint fit.
+
+The paper's estimate (:func:`estimate_from_marks`) takes delta from the encoder marks at contact
+and at buckling (Eq. 14), the load from the elastica fitted to the strains at buckling (Eq. 7)
+and E from Hertz (Eq. 13). The joint fit (:func:`joint_estimate`) is contact-point-free: it
+reads the whole loading record. :func:`estimate_trial` runs both on a trial's result; the
+simulator and the bench call it, ``palpate replay`` the two functions on a log.
 
 A trial's record is one row per control tick: state, stage advance (encoder, m) and grating
 strains. The joint fit uses the loading rows (approach to the end of the post-buckling travel):
@@ -19,6 +25,7 @@ the same inputs and reproduces the fit bit for bit.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 from statistics import NormalDist
@@ -27,12 +34,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from config.schema import SensorConfig
+from config.schema import SensorConfig, StackConfig
+from estimation.beam import Beam
 from estimation.beamstate import infer_states
 from estimation.corrections import ContactLaw
 from estimation.detect_contact import baseline_deviation
 from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from estimation.section import Section
+from estimation.stiffness import StiffnessEstimate, paper_estimate
+from robot.trial.run import TrialResult
 from sensor.strain import grating_intervals
 
 FloatArray = NDArray[np.float64]
@@ -137,8 +147,90 @@ def joint_estimate(
     )
 
 
-def joint_record(fit: JointFit | None) -> dict[str, Any]:
-    """The joint fit as it goes into the log's estimate record and ``--json``."""
-    if fit is None:
-        return {"success": False, "message": "no loading record"}
-    return fit.as_dict()
+def joint_from_rows(
+    rows: Iterable[tuple[str, float, Sequence[float]]],
+    inputs: EstimatorInputs,
+    stack: StackConfig,
+    section: Section,
+) -> JointFit:
+    """The joint fit from (state, advance, strains) rows: the trial's record or a log's samples."""
+    advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
+    return joint_estimate(advance, strains, inputs, stack.sensor, section)
+
+
+def exposed_length_at(kind: str, x: float, fixed_length: float, flush_translation: float) -> float:
+    """Exposed length (m) at stage position ``x``: fixed on the bench, on the robot the stage
+    translation past the tube's flush translation. Shared by the trial and ``palpate replay``."""
+    if kind == "bench":
+        return fixed_length
+    return x - flush_translation
+
+
+def estimate_from_marks(
+    x_contact: float | None,
+    x_buckling: float | None,
+    strains: tuple[float, ...],
+    length: float | None,
+    stack: StackConfig,
+    section: Section,
+    poisson: float,
+) -> StiffnessEstimate | None:
+    """The paper's estimate: delta from the encoder (Eq. 14), P from the FBG-fitted elastica at
+    the exposed length at buckling (Eq. 7; P_cr when the fit fails), E from Hertz (Eq. 13)."""
+    if x_contact is None or x_buckling is None or length is None:
+        return None
+    beam = Beam.from_section(section, length)
+    P: float | None = None
+    if strains:
+        fit = beam.fit_strains(np.asarray(strains), grating_intervals(stack.sensor, length))
+        if fit.success and fit.P > 0:
+            P = float(fit.P)
+    return paper_estimate(
+        x_contact, x_buckling, length, section, stack.sensor.tip_radius, poisson, P=P
+    )
+
+
+@dataclass(frozen=True)
+class TrialEstimate:
+    """What :func:`estimate_trial` found.
+
+    Attributes:
+        paper: the paper's estimate (Eqs. 13-14), None when no buckling was detected.
+        exposed_length_at_buckling: L (m) at the buckling mark, None without one.
+        joint: the joint fit, None when the runner did not ask for it.
+        joint_seconds: wall time of the joint fit (for reports, never for tests).
+    """
+
+    paper: StiffnessEstimate | None
+    exposed_length_at_buckling: float | None
+    joint: JointFit | None = None
+    joint_seconds: float | None = None
+
+
+def estimate_trial(
+    result: TrialResult,
+    *,
+    kind: str,
+    exposed_length: float,
+    flush_translation: float,
+    stack: StackConfig,
+    section: Section,
+    poisson: float,
+    inputs: EstimatorInputs | None = None,
+) -> TrialEstimate:
+    """The estimates of a finished trial: the paper's from its marks at the exposed length at
+    buckling (:func:`exposed_length_at` of ``kind``, ``exposed_length`` and
+    ``flush_translation``, m), and with ``inputs`` the joint fit of its record."""
+    m = result.marks
+    paper: StiffnessEstimate | None = None
+    length: float | None = None
+    if m.x_buckling is not None:
+        length = exposed_length_at(kind, m.x_buckling, exposed_length, flush_translation)
+        paper = estimate_from_marks(
+            m.x_contact, m.x_buckling, m.strains_at_buckling, length, stack, section, poisson
+        )
+    if inputs is None:
+        return TrialEstimate(paper, length)
+    start = time.perf_counter()
+    joint = joint_from_rows(result.record, inputs, stack, section)
+    return TrialEstimate(paper, length, joint, time.perf_counter() - start)

@@ -9,9 +9,8 @@ written, so a crash keeps the trial up to the crash.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from estimation.detect_buckling import BucklingDetector
@@ -25,7 +24,8 @@ from robot.indentation import (
     TrialMarks,
     TrialPlan,
 )
-from robot.triallog import TrialLogWriter
+from robot.trial.log import TrialLogWriter
+from robot.trial.record import end_record
 from sensor.clock import Clock
 
 
@@ -64,7 +64,7 @@ class TrialResult:
     duration: float  # simulated or wall seconds on the rig's clock
     transitions: list[Transition] = field(default_factory=list)
     # (state after the tick, advance m, strains) per tick, as in the log's sample records: the
-    # whole-record estimators (``palpate.estimates``) read it without a log
+    # whole-record estimators (``robot.trial.estimate``) read it without a log
     record: list[tuple[str, float, tuple[float, ...]]] = field(default_factory=list)
 
     @property
@@ -93,17 +93,7 @@ def run_trial(
     def record_transition(tr: Transition) -> None:
         transitions.append(tr)
         if log is not None:
-            log.write(
-                {
-                    "kind": "transition",
-                    "t": tr.t,
-                    "from": tr.source.value,
-                    "to": tr.target.value,
-                    "reason": tr.reason,
-                    "advance": tr.advance,
-                    "strains": list(tr.strains),
-                }
-            )
+            log.write(_transition_record(tr))
 
     machine = IndentationMachine(plan, guards, detector, on_transition=record_transition)
     t0 = clock.now()
@@ -115,14 +105,7 @@ def run_trial(
                 machine.abort(clock.now(), f"tick budget of {max_ticks} exhausted")
                 if ticks >= max_ticks + 100_000:
                     break
-            obs = rig.observe(clock.now())
-            cmd = machine.step(obs)
-            if obs.servo_fault is not None and machine.state is State.RETRACTING and not recovered:
-                # One attempt to clear the fault (reboot) so the sensor can be pulled back; a
-                # fault seen again while retracting ends the trial in FAULT with torque off.
-                recovered = True
-                rig.recover()
-            rig.command(cmd)
+            obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
             record.append((machine.state.value, obs.advance, tuple(obs.strains)))
             if log is not None:
                 log.write(_sample_record(obs, machine.state, cmd))
@@ -132,10 +115,7 @@ def run_trial(
             if not machine.finished:
                 clock.sleep(rig.tick)
     except BaseException as exc:
-        machine.marks.reason = f"crash: {type(exc).__name__}: {exc}"
-        rig.release()
-        if log is not None:
-            log.write(_end_record(State.FAULT, machine.marks, ticks, clock.now() - t0))
+        _crashed(exc, rig, machine.marks, log, ticks, clock, t0)
         raise
     if machine.state is not State.DONE:
         rig.release()  # torque policy: a trial that did not complete leaves the servos limp
@@ -148,6 +128,39 @@ def run_trial(
         transitions=transitions,
         record=record,
     )
+
+
+def _tick(
+    rig: Rig, machine: IndentationMachine, t: float, recovered: bool
+) -> tuple[Observation, Command, bool]:
+    """Observe, step the machine, command; ``recovered``: the one recovery was tried."""
+    obs = rig.observe(t)
+    cmd = machine.step(obs)
+    if obs.servo_fault is not None and machine.state is State.RETRACTING and not recovered:
+        # One attempt to clear the fault (reboot) so the sensor can be pulled back; a fault
+        # seen again while retracting ends the trial in FAULT with torque off.
+        recovered = True
+        rig.recover()
+    rig.command(cmd)
+    return obs, cmd, recovered
+
+
+def _crashed(
+    exc: BaseException,
+    rig: Rig,
+    marks: TrialMarks,
+    log: TrialLogWriter | None,
+    ticks: int,
+    clock: Clock,
+    t0: float,
+) -> None:
+    """An exception ended the loop: name it in the marks, release the servos, close the log's
+    record with FAULT and the time since ``t0`` (the caller re-raises)."""
+    marks.reason = f"crash: {type(exc).__name__}: {exc}"
+    rig.release()
+    if log is not None:
+        crashed = TrialResult(State.FAULT, marks.reason, marks, ticks, clock.now() - t0)
+        log.write(end_record(crashed))
 
 
 def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, Any]:
@@ -163,19 +176,13 @@ def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, An
     }
 
 
-def _end_record(state: State, marks: TrialMarks, ticks: int, duration: float) -> dict[str, Any]:
-    m = asdict(marks)
-    m["strains_at_buckling"] = list(marks.strains_at_buckling)
+def _transition_record(tr: Transition) -> dict[str, Any]:
     return {
-        "kind": "end",
-        "state": state.value,
-        "reason": marks.reason,
-        "marks": m,
-        "ticks": ticks,
-        "duration": duration if math.isfinite(duration) else None,
+        "kind": "transition",
+        "t": tr.t,
+        "from": tr.source.value,
+        "to": tr.target.value,
+        "reason": tr.reason,
+        "advance": tr.advance,
+        "strains": list(tr.strains),
     }
-
-
-def end_record(result: TrialResult) -> dict[str, Any]:
-    """The closing record of a trial log."""
-    return _end_record(result.state, result.marks, result.ticks, result.duration)

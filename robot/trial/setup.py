@@ -1,8 +1,9 @@
-"""What every trial runner builds the same way from a campaign: guards, rig settings, the
-stage's position tolerance and the buckling detector.
+"""What every trial runner builds the same way from a campaign: the sensor's section, guards, rig
+settings, the stage's position tolerance, the buckling detector and the trial plan.
 
 One place for the simulated campaign (``palpate.simtrial``), the bench (``palpate.benchtrial``)
-and teleoperation (``palpate teleop``), so a guard or a threshold means the same everywhere.
+and teleoperation (``palpate teleop``), so a guard, a threshold or a speed means the same
+everywhere.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from config.schema import MM, StackConfig
 from estimation.beamstate import onset_mode
 from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
 from estimation.section import Section, composite_section
-from robot.indentation import Guards
+from robot.indentation import Guards, TrialPlan
 from robot.rig import RigSettings
 from sensor.strain import StrainChain, grating_intervals
 from wire.dynamixel import TICKS_PER_REV
@@ -29,7 +30,8 @@ def sensor_section(stack: StackConfig) -> Section:
 
 
 def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Guards:
-    """The trial guards of a campaign: travel past contact, fiber strain, stream timeout."""
+    """The trial guards of a campaign: travel past contact, fiber strain, stream timeout (at
+    least five control periods ``tick``, s)."""
     return Guards(
         max_travel_past_contact=campaign.max_travel_past_contact_mm * MM,
         strain_limit=stack.fbg.strain_limit,
@@ -45,9 +47,10 @@ def rig_settings(
     sync_to_clock: bool = False,
     exposed_length: float | None = None,
 ) -> RigSettings:
-    """The rig's settings for a campaign at a control period ``tick`` (s). ``sync_to_clock``
-    only for emulators on a virtual clock. With ``exposed_length`` (m) FBG contact reads the
-    axial strain with the beam's onset bow taken out (``estimation.beamstate.axial_strain``)."""
+    """The rig's settings for a campaign at a control period ``tick`` (s), the one place a trial
+    keeps it. ``sync_to_clock`` only for emulators on a virtual clock. With ``exposed_length``
+    (m) FBG contact reads the axial strain with the beam's onset bow taken out
+    (``estimation.beamstate.axial_strain``)."""
     mode = None
     if exposed_length is not None:
         fiber_offset = sensor_section(stack).fiber_offset
@@ -65,6 +68,25 @@ def rig_settings(
 def position_tolerance(stack: StackConfig) -> float:
     """The stage encoder's resolution, 1.5 ticks of the translation servo (m)."""
     return 1.5 * stack.drive.lead / TICKS_PER_REV
+
+
+def trial_plan(
+    campaign: CampaignConfig, stack: StackConfig, *, roll: float, contact: float, home: float
+) -> TrialPlan:
+    """The plan of one trial: roll to ``roll`` (rad) at the ``home`` advance (m), advance fast to
+    the campaign's stand-off before the expected ``contact`` advance (m), approach and indent at
+    the campaign's speeds, keep indenting ``post_buckling_mm`` after buckling, retract."""
+    return TrialPlan(
+        roll=roll,
+        contact_advance=contact,
+        home_advance=home,
+        standoff=campaign.standoff_mm * MM,
+        post_buckling_travel=campaign.post_buckling_mm * MM,
+        fast_speed=stack.drive.max_speed,
+        approach_speed=campaign.approach_speed_mm_per_s * MM,
+        indent_speed=campaign.indent_speed_mm_per_s * MM,
+        position_tolerance=position_tolerance(stack),
+    )
 
 
 def detector_for(campaign: CampaignConfig, chain: StrainChain) -> BucklingDetector:

@@ -1,0 +1,196 @@
+"""What one simulated trial is and the world it runs in.
+
+:class:`TrialSpec` is one trial of a campaign; :func:`trial_geometry` places its sample where the
+campaign wants it and finds how the robot reaches it (inverse kinematics on the robot, a fixed
+stage on the bench); :func:`trial_world` builds the ``sim.world`` of the trial: the tissue
+(:func:`tissue_model`), the sensor's pose from the joints, and the joints themselves, read off
+the emulated servos' encoders (:class:`ServoJoints`). ``palpate.simtrial`` wires it to the
+emulators and the control stack.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from config.scene import FidelityConfig, SampleConfig, SceneConfig
+from config.schema import StackConfig
+from robot import kinematics
+from robot.drive import TRANSLATION, RollerGearDrive
+from robot.dynamixel.units import rad_from_ticks
+from robot.trial.estimate import exposed_length_at
+from robot.trial.setup import sensor_section
+from sim.dynamixel.bus import EmulatedBus
+from sim.tissue import TissueModel
+from sim.world import Surface, World
+from wire.dynamixel import TICKS_PER_REV
+
+BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
+VERTICAL = np.array([0.0, 0.0, -1.0])
+
+
+@dataclass(frozen=True)
+class TrialSpec:
+    """One trial of a campaign."""
+
+    trial_id: str
+    kind: Literal["bench", "robot"]
+    sample: str
+    modulus: float  # Pa, the ground truth
+    poisson: float
+    tube: str
+    orientation: str
+    roll: float  # rad
+    exposed_length: float  # m at contact
+    seed: int
+
+
+def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
+    """The simulated tissue's force law for a scene's sample and fidelity switches."""
+    return TissueModel(
+        modulus=sample.modulus,
+        poisson=sample.poisson,
+        thickness=(
+            sample.thickness if (sample.thickness and fidelity.finite_thickness) else math.inf
+        ),
+        bonded=sample.bonded,
+        tip_radius=tip_radius,
+        finite_thickness=fidelity.finite_thickness,
+        large_indentation=fidelity.large_indentation,
+    )
+
+
+@dataclass(frozen=True)
+class TrialGeometry:
+    """Where a trial's sample is and how the robot reaches it (SI: rad, m): the planned roll and
+    contact translation, the sample's surface, the IK's residual angle and the tube it chose."""
+
+    plan_roll: float
+    contact_translation: float
+    surface: Surface
+    residual: float
+    tube: str
+
+
+def _robot_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
+    """Place the sample where the campaign wants it, then let the IK find the way back to it."""
+    tube = stack.tube(spec.tube)
+    nominal = kinematics.forward(tube, spec.roll, tube.flush_translation + spec.exposed_length)
+    r_tip = stack.sensor.tip_radius
+    target = nominal.sensor_tip + r_tip * nominal.tangent
+    normal = -nominal.tangent
+    ik = kinematics.inverse(
+        stack.tubes,
+        target,
+        normal,
+        tip_radius=r_tip,
+        translation_limits=stack.drive.translation_limits,
+        roll_limits=stack.drive.roll_limits,
+    )
+    if not ik.reachable:
+        raise ValueError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
+    surface = Surface(point=target, normal=normal)
+    return TrialGeometry(ik.roll, ik.advance, surface, ik.residual, ik.tube)
+
+
+def _bench_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
+    depth = BENCH_CONTACT_TRANSLATION + spec.exposed_length + stack.sensor.tip_radius
+    surface = Surface(point=depth * VERTICAL, normal=-VERTICAL)
+    return TrialGeometry(0.0, BENCH_CONTACT_TRANSLATION, surface, 0.0, "bench-stage")
+
+
+def trial_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
+    """Where the sample is and how the robot reaches it; ValueError if it cannot."""
+    return _bench_geometry(stack, spec) if spec.kind == "bench" else _robot_geometry(stack, spec)
+
+
+def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
+    if spec.kind == "bench":
+        length = spec.exposed_length
+
+        def bench_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
+            return translation * VERTICAL, VERTICAL, length
+
+        return bench_pose
+    tube = stack.tube(tube_name)
+    frame_roll = math.nan
+    frame = kinematics.forward(tube, 0.0, 0.0)
+
+    def robot_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
+        # The tip frame depends on the roll only, which is constant while the stage moves:
+        # keep the last one (the board asks for a pose at every sample).
+        nonlocal frame, frame_roll
+        if roll != frame_roll:
+            frame, frame_roll = kinematics.forward(tube, roll, 0.0), roll
+        length = exposed_length_at("robot", translation, 0.0, tube.flush_translation)
+        return frame.tube_tip, frame.tangent, length
+
+    return robot_pose
+
+
+def trial_stack(
+    scene: SceneConfig, stack: StackConfig, geo: TrialGeometry, retract: float
+) -> StackConfig:
+    """The robot as this trial runs it: its servos power up at the trial's home pose (retracted
+    by ``retract``, m, at the planned roll) and the board streams at the scene's rate."""
+    drive = dataclasses.replace(
+        stack.drive, home_translation_mm=retract * 1e3, home_roll_deg=math.degrees(geo.plan_roll)
+    )
+    board = stack.board
+    if scene.board_rate_hz is not None:
+        board = dataclasses.replace(board, rate_hz=scene.board_rate_hz)
+    return dataclasses.replace(stack, drive=drive, board=board)
+
+
+def trial_sample(scene: SceneConfig, spec: TrialSpec) -> SampleConfig:
+    """The scene's sample the trial indents."""
+    return next(s for s in scene.samples if s.name == spec.sample)
+
+
+class ServoJoints:
+    """The stage's true joints read off the emulated servos' encoders (the world's ``joints``):
+    (roll rad, translation m, translation encoder ticks). ``bus`` is set once the emulators run."""
+
+    def __init__(self, stack: StackConfig) -> None:
+        self.bus: EmulatedBus | None = None
+        self._truth = RollerGearDrive(stack.drive)  # the servos power up at the home pose
+        self._ids = {
+            "outer_roll": stack.servos.outer_roll.id,
+            "inner_roll": stack.servos.inner_roll.id,
+            TRANSLATION: stack.servos.translation.id,
+        }
+        self._last_ticks: dict[str, int] = {}
+        self._last: tuple[float, float, int] = (0.0, 0.0, 0)
+
+    def read(self) -> tuple[float, float, int]:
+        if self.bus is None:
+            raise RuntimeError("the world read the servos before the emulated bus was started")
+        ticks = {n: self.bus.servo(i).position_ticks for n, i in self._ids.items()}
+        if ticks != self._last_ticks:  # the servos rest for most board samples: keep the last
+            q = self._truth.joints({n: rad_from_ticks(t) for n, t in ticks.items()})
+            self._last_ticks, self._last = ticks, (q.roll, q.translation, ticks[TRANSLATION])
+        return self._last
+
+
+def trial_world(
+    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry, servos: ServoJoints
+) -> World:
+    """The simulated world of one trial: the scene's sample at the trial's surface, seeded."""
+    return World(
+        section=sensor_section(stack),
+        sensor=stack.sensor,
+        fbg=stack.fbg,
+        fidelity=scene.fidelity,
+        tissue=tissue_model(trial_sample(scene, spec), scene.fidelity, stack.sensor.tip_radius),
+        surface=geo.surface,
+        pose=_pose_fn(stack, spec, geo.tube),
+        joints=servos.read,
+        rng=np.random.default_rng(spec.seed),
+        has_force=stack.board.has_force,
+        length_grows=spec.kind == "robot",
+        encoder_step=stack.drive.lead / TICKS_PER_REV,
+    )
