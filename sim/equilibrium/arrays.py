@@ -2,9 +2,10 @@
 
 Every callable of the beam law is only ever evaluated on arrays shaped like ``u``, so a law whose
 parameters are arrays of that shape (one exposed length per stage position) also solves in one
-call (~0.5-13 us per position, after ~4 ms of numpy call overhead per call). The two stages (see
-:mod:`sim.equilibrium`) run on the elements before and after the onset; a side with no element
-is not evaluated. The plain-float twin for one position is :mod:`sim.equilibrium.scalar`.
+call (~0.5-13 us per position, plus ~0.1-0.5 ms per law evaluation, ~20 of them a call). The
+two stages (see :mod:`sim.equilibrium`) run on the elements before and after the onset; a side
+with no element is not evaluated. The plain-float twin for one position is
+:mod:`sim.equilibrium.scalar`.
 """
 
 from __future__ import annotations

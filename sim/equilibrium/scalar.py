@@ -2,10 +2,15 @@
 
 Why a twin: numpy costs ~1 us per operation even on 0-d arrays, so the array path takes
 0.2-2 ms for one position; in plain floats the same two stages take ~15-60 us with Hertz
-tissue, up to ~0.3 ms with Sneddon + thin layer + imperfection (dominated by the tissue
-inverse inside the bracketing steps). Every floating-point operation is the array path's, in
-the same order, so a position gives the same bits either way; :class:`ScalarBeam` mirrors
-:class:`sim.equilibrium.sides.BeamSide` and the stages mirror :mod:`sim.equilibrium.arrays`.
+tissue and a closed-form beam law, up to ~0.3 ms with Sneddon + thin layer + imperfection
+(dominated by the tissue inverse inside the bracketing steps); with ``estimation.beam.Beam``
+its elastica evaluations on 0-d arrays dominate past the onset (~1 ms). The trial itself
+tabulates the equilibrium on grids (:mod:`sim.contact_table`), so this path serves callers of
+one position.
+
+It follows the array path step by step (:class:`ScalarBeam` mirrors
+:class:`sim.equilibrium.sides.BeamSide`, the stages mirror :mod:`sim.equilibrium.arrays`):
+a change to one is a change to both.
 """
 
 from __future__ import annotations
