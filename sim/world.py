@@ -4,41 +4,32 @@ Each board sample asks the world for its state at time ``t``. The world reads th
 positions (through injected callables, so ``sim/`` never imports the control code), places the
 sensor with the injected forward kinematics, and solves the quasi-static contact along the sensor
 axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.tissue`), which is not the
-estimator's Hertz model. From the beam state it makes what the hardware would send: peak
-wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and temperature drift), the force scale
-reading and the contact event.
+estimator's Hertz model, tabulated along the trial's path (:mod:`sim.contact_table`, which
+also turns the beam state into grating strains). From the beam state it makes what the hardware
+would send: peak wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and temperature drift),
+the force scale reading and the contact event. Gratings still inside the tube read 0.
 
 Only what the scene switches on is computed (:class:`config.scene.FidelityConfig`).
-
-Grating strains. The bending strain of a grating follows the beam's lateral pin reaction ``R``:
-for the perfect beam this is the elastica at the solved shortening; for an imperfect beam the
-contact solver gives ``R`` of the amplified imperfection, and the strains are those of the
-perfect elastica with the same ``R`` (bending moments scale with ``R`` in the first mode). The
-fiber also feels the uniform axial compression ``-P/EA``. Gratings still inside the tube read 0.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
 
 from config.scene import FidelityConfig
 from config.schema import FbgConfig, SensorConfig
-from estimation.beam import Beam
-from estimation.elastica import post_buckling
 from estimation.section import Section
 from sim.board import BoardSample
-from sim.equilibrium import ContactEffects, solve_contact
+from sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
+from sim.equilibrium import ContactEffects
 from sim.tissue import TissueModel
 from wire.frame import Status
 
-Vector = NDArray[np.float64]
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)
 PoseFn = Callable[[float, float], tuple[Vector, Vector, float]]
 JointsFn = Callable[[], tuple[float, float, int]]  # -> (roll rad, translation m, encoder count)
@@ -46,23 +37,6 @@ JointsFn = Callable[[], tuple[float, float, int]]  # -> (roll rad, translation m
 CONTACT_EVENT = Status.CONTACT_EVENT
 _CONTACT_FLAG = int(Status.CONTACT_EVENT)  # int() of an IntFlag costs ~0.3 us per sample
 _FORCE_FLAG = int(Status.FORCE_VALID)
-
-
-@functools.lru_cache(maxsize=1)
-def _r_table() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """log(r) and log(e/L) of the perfect elastica on a dense grid, to invert r -> e/L."""
-    e_over_l = np.logspace(-12, -1, 600)
-    r = np.abs(np.asarray(post_buckling(e_over_l, method="fast").r, dtype=float))
-    if not np.all(np.diff(r) > 0):
-        raise RuntimeError("elastica reaction r(e/L) is not increasing on the inversion grid")
-    return np.log(r), np.log(e_over_l)
-
-
-def shortening_for_reaction(r: NDArray[np.float64]) -> NDArray[np.float64]:
-    """e/L of the perfect elastica whose dimensionless pin reaction is ``r`` (0 where r <= 0)."""
-    log_r, log_e = _r_table()
-    safe = np.maximum(r, 1e-300)
-    return np.where(r > 0.0, np.exp(np.interp(np.log(safe), log_r, log_e)), 0.0)
 
 
 @dataclass(frozen=True)
@@ -89,48 +63,6 @@ class WorldState(NamedTuple):
     strains: tuple[float, ...]
     contact_event: bool
     encoder: int = 0  # the stage encoder count the board reports with this state
-
-
-class GridPhysics(NamedTuple):
-    """Everything a table of contact equilibria depends on besides the grid and the length."""
-
-    EI: float
-    EA: float
-    fiber_offset: float
-    grating_length: float
-    centres_from_tip: tuple[float, ...]
-    tissue: TissueModel
-    effects: ContactEffects
-
-
-@functools.lru_cache(maxsize=256, typed=True)
-def equilibrium_on_grid(
-    physics: GridPhysics, u: tuple[float, ...], length: float
-) -> tuple[Vector, Vector, Vector, Vector, Vector]:
-    """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R| (M,) and the
-    grating strains (M, G); read-only arrays.
-
-    Cached per process: a pure function of its arguments, and a campaign solves the same table
-    again whenever a trial repeats a sample, tube length and contact geometry (the robot
-    campaign's straight and bent tubes meet the tissue at the same exposed length to the last
-    bit), which saves its ~5 ms per call. Raises RuntimeError naming the failure if the contact
-    solver does not converge."""
-    beam = Beam(physics.EI, physics.EA, physics.fiber_offset, length)
-    sol = solve_contact(np.asarray(u, dtype=np.float64), beam, physics.tissue, physics.effects)
-    if not sol.success:
-        raise RuntimeError(f"contact equilibrium failed at L = {length:.6g} m: {sol.message}")
-    R = np.abs(sol.R)
-    r = R * length**2 / physics.EI
-    g = shortening_for_reaction(r)  # e_g/L of the shape that carries this pin reaction
-    half = 0.5 * physics.grating_length
-    centres = length - np.asarray(physics.centres_from_tip)
-    intervals = np.stack([centres - half, np.minimum(centres + half, length)], axis=-1)
-    eps = beam.bending_strains(g, intervals)
-    eps = eps - (sol.P / physics.EA)[:, None]
-    out = (sol.delta, sol.e, sol.P, R, eps)
-    for a in out:
-        a.flags.writeable = False  # shared by every caller of the cache
-    return out
 
 
 # The physics at one pose: exposed length, advance past contact, delta, e, P, R, strains.
@@ -299,80 +231,3 @@ class World:
         if noise:
             wl = [w + n for w, n in zip(wl, noise[: len(wl)], strict=True)]
         return tuple(wl)
-
-
-def _lerp(a: list[float], b: list[float], w: float) -> list[float]:
-    """``a (1 - w) + b w`` elementwise in plain floats: the same IEEE operations as numpy's
-    ``a * (1 - w) + b * w`` on rows of 7 values, at a third of its cost."""
-    c = 1 - w
-    return [x * c + y * w for x, y in zip(a, b, strict=True)]
-
-
-class _Bin(NamedTuple):
-    u: list[float]  # the bin's u grid (n,)
-    rows: list[list[list[float]]]  # per edge length: rows [delta, e, P, |R|, strains...] (n, 4 + G)
-
-
-class ContactTable:
-    """Equilibrium tabulated over the advance past contact ``u``, solved lazily in bins.
-
-    A trial visits one path through (u, L): L = L_contact + u on the robot (the sensor slides
-    out of the tube), L fixed on the bench. The grid in u is the encoder lattice when the world
-    knows it (``lattice`` = (step, origin): every sample in contact is at origin + j step, so a
-    lookup lands on a solved point and the linear interpolation in u is exact; it was not on a
-    fixed 5 um grid, whose strains near the buckling knee were off by up to 2.4 ue, about one
-    noise sd). Each bin of about ``bin_width`` (a whole number of steps) is solved in one
-    vectorised call per bin edge length, and values are interpolated linearly in L between the
-    edges (error O(dL^2 / L^2) ~ 4e-5 for 0.25 mm bins at L = 42 mm). Why bins: a vectorised
-    solve costs ~4 ms of numpy call overhead plus ~30 us per point (2 points: 4.0 ms, 51: 5.6
-    ms, 101: 6.8 ms), so one call per sample would make a trial take a minute. A trial touches
-    3-5 bins and visits most of each but the last (~140 samples per bin at 0.5 mm/s and 250 Hz),
-    so solving part of a bin would save little; 0.5 mm bins (half the calls, 101 points) saved
-    ~15 % on the bench and nothing on the robot. The tables are kept as plain floats: a lookup
-    is ~20 float operations.
-    """
-
-    def __init__(
-        self,
-        world: World,
-        contact_length: float,
-        grows: bool,
-        *,
-        lattice: tuple[float, float] | None = None,
-        bin_width: float = 0.25e-3,
-    ) -> None:
-        self.world = world
-        self.contact_length = contact_length
-        self.grows = grows
-        self.step, self.origin = lattice if lattice is not None else (5e-6, 0.0)
-        self.n = max(2, round(bin_width / self.step))  # grid intervals per bin
-        self.bin_width = self.n * self.step
-        self._bins: dict[int, _Bin] = {}
-
-    def _bin(self, k: int) -> _Bin:
-        """Bin ``k``: its u grid (lattice points k n .. (k + 1) n) and, per edge length, the
-        rows on that grid."""
-        if k not in self._bins:
-            j = np.arange(k * self.n, (k + 1) * self.n + 1, dtype=np.float64)
-            u = self.origin + j * self.step  # the same value for a point two bins share
-            edges = (u[0], u[-1]) if self.grows else (0.0,)
-            rows = [
-                np.column_stack(self.world.solve_on_grid(u, self.contact_length + edge)).tolist()
-                for edge in edges
-            ]
-            self._bins[k] = _Bin(u.tolist(), rows)
-        return self._bins[k]
-
-    def at(self, u: float) -> tuple[float, float, float, float, tuple[float, ...]]:
-        """(delta, e, P, |R|, strains) at advance ``u`` past contact."""
-        pos = (u - self.origin) / self.step  # lattice index, whole on the lattice
-        k = max(0, int(pos // self.n))
-        local = pos - k * self.n
-        i = min(max(int(local), 0), self.n - 1)
-        w_u = local - i
-        grid, rows = self._bin(k)
-        row = _lerp(rows[0][i], rows[0][i + 1], w_u)
-        if self.grows:
-            w_l = (u - grid[0]) / (grid[-1] - grid[0])
-            row = _lerp(row, _lerp(rows[1][i], rows[1][i + 1], w_u), w_l)
-        return row[0], row[1], row[2], row[3], tuple(row[4:])

@@ -2,10 +2,12 @@
 
 ``EmulatedBus([EmulatedServo(1, "XM430-W350"), ...], clock=clock)`` opened as a context manager
 gives a port path the unmodified ``dynamixel_sdk`` can drive. Modules: :mod:`.protocol` (pure
-framing), :mod:`.servo` (one servo's state and motion), :mod:`.bus` (the pty server thread).
+framing), :mod:`.registers` (one servo's control table and its write rules), :mod:`.motion`
+(the motion profiles), :mod:`.servo` (one servo: instructions, fault hooks, motion on the
+clock), :mod:`.bus` (the pty server thread), :mod:`.faults` (a faulty return line).
 
-Layering: nothing here imports ``robot/`` control code; the pure-data control table
-:mod:`wire.dynamixel` is the one shared module (a hardware fact, kept in one place).
+Layering: the control table is :mod:`wire.dynamixel` (a hardware fact kept in one place, which
+the driver in ``robot/`` reads too); nothing here imports ``robot/``.
 """
 
 from sim.dynamixel.bus import EmulatedBus

@@ -18,8 +18,8 @@ bit (0x80) is set while Hardware_Error_Status is non-zero; a packet with a bad C
 servo gets CRC Error; an unknown instruction gets Instruction Error. Fast sync/bulk read are not
 emulated (Instruction Error).
 
-Layering: ``sim/`` never imports ``robot/`` control code; the one exception is the pure-data
-control table :mod:`wire.dynamixel`, used through :mod:`sim.dynamixel.servo`.
+Layering: the control table comes from :mod:`wire.dynamixel`, the leaf the driver in ``robot/``
+reads too; ``sim/`` never imports ``robot/``.
 """
 
 from __future__ import annotations

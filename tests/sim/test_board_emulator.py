@@ -162,10 +162,10 @@ def test_without_faults_the_fault_generator_is_never_drawn() -> None:
     clock = VirtualClock()
     sink = _Sink()
     emu = BoardEmulator(constant_source(WAVELENGTHS), LAYOUT, clock=clock, sink=sink)
-    before = emu._rng.bit_generator.state
+    before = emu._injector.rng.bit_generator.state
     with emu:
         clock.advance(0.1)
-    assert emu._rng.bit_generator.state == before
+    assert emu._injector.rng.bit_generator.state == before
     assert emu.stats.frames_sent == emu.stats.samples == 100
     assert len(sink.data) == 100 * LAYOUT.size
     assert not BoardFaults().random

@@ -7,7 +7,8 @@ import math
 
 import pytest
 
-from sim.dynamixel.servo import EmulatedServo, profile_motion
+from sim.dynamixel.motion import profile_motion
+from sim.dynamixel.servo import EmulatedServo
 from wire import dynamixel as tables
 
 GOAL = tables.X_SERIES_CONTROL_TABLE["Goal_Position"][0]

@@ -15,9 +15,9 @@ from sim.equilibrium import (
     AxialLaw,
     ContactEffects,
     ContactState,
-    _Recall,
     solve_contact,
 )
+from sim.equilibrium.sides import Recall
 from sim.tissue import TissueModel
 
 EI = 1.18e-4
@@ -332,11 +332,11 @@ def test_recalled_evaluations_change_no_bit(
     recalled = solve_contact(u, beam, tissue, fx)
     calls = []
 
-    def evaluate(self: _Recall[object], x: np.ndarray) -> object:
+    def evaluate(self: Recall[object], x: np.ndarray) -> object:
         calls.append(1)
         return self._fn(x)
 
-    monkeypatch.setattr(_Recall, "__call__", evaluate)
+    monkeypatch.setattr(Recall, "__call__", evaluate)
     fresh = solve_contact(u, beam, tissue, fx)
     assert calls
     assert recalled.success, recalled.message
@@ -351,7 +351,7 @@ def test_recall_returns_the_last_result_only_for_the_same_bits() -> None:
         seen.append(x)
         return 2.0 * x
 
-    f = _Recall(law)
+    f = Recall(law)
     x = np.array([1.0, 2.0])
     first = f(x)
     assert f(x.copy()) is first

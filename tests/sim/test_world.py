@@ -11,9 +11,10 @@ from config import load_stack
 from config.scene import FidelityConfig
 from estimation.beam import Beam
 from estimation.section import composite_section
+from sim.contact_table import ContactTable, equilibrium_on_grid
 from sim.equilibrium import solve_contact
 from sim.tissue import TissueModel
-from sim.world import ContactTable, Surface, World, equilibrium_on_grid
+from sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor

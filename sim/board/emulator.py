@@ -1,8 +1,8 @@
-"""Acquisition-board emulator on a pseudo-terminal, with fault injection.
+"""The acquisition-board emulator: frames on a pseudo-terminal (or a byte sink) on a clock.
 
 The emulator owns the pty master and writes frames to it; a reader opens the slave path
 (:attr:`BoardEmulator.port`) with pyserial exactly as it would open the real board. Each sample
-comes from a caller-supplied source ``source(t) -> BoardSample`` (later: the simulator's world).
+comes from a caller-supplied source ``source(t) -> BoardSample`` (the simulator's world).
 
 Two ways to run:
 
@@ -12,17 +12,8 @@ Two ways to run:
 
 Writes go through a writer thread, so a clock advance never blocks on a full pty buffer; a
 bounded queue models the board's transmit buffer (when full, samples are dropped and the next
-frame carries ``Status.OVERRUN``).
-
-Faults (:class:`BoardFaults`, per sample, from a seeded generator): garbage bursts between frames,
-one flipped bit, truncated frames, dropped frames (the sequence number still advances), stalls
-(the board goes silent and takes no samples, so the sequence does not jump) and a disconnect
-(the master is closed). Garbage bytes never contain the sync byte 0xA5, so the reader's expected
-counters follow exactly from :class:`BoardStats`; sync-looking garbage is a parser unit test.
-
-Import note: this module imports ``wire.frame``, the pure wire codec, as protocol data. It is the
-one accepted exception to "sim/ never imports sensor/": the frame layout is shared by both ends of
-the wire and must not be copied.
+frame carries ``Status.OVERRUN``). The faults are drawn per sample by
+:class:`sim.board.faults.FaultInjector`; the stall's duration and the disconnect are timed here.
 """
 
 from __future__ import annotations
@@ -36,35 +27,15 @@ import select
 import threading
 import time
 import tty
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from types import TracebackType
-from typing import NamedTuple, Protocol
+from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
-from config.loader import limits
+from sim.board.faults import BoardFaults, BoardStats, FaultInjector
+from sim.board.source import SampleSource
 from sim.clock import VirtualClock
 from wire.frame import Frame, FrameLayout, Status, encode, frame_from_si
-
-SYNC_BYTE = 0xA5
-
-
-class BoardSample(NamedTuple):
-    """One sample in SI: peak wavelengths (m, length N), encoder count, optional extras.
-
-    A NamedTuple, not a frozen dataclass: the source builds one per sample (~0.4 us instead
-    of ~1.3 us)."""
-
-    wavelengths: Sequence[float] | NDArray[np.float64]
-    encoder: int = 0
-    reference: float | None = None
-    force: float | None = None
-    flags: int = 0
-
-
-SampleSource = Callable[[float], BoardSample]
 
 
 class ByteSink(Protocol):
@@ -74,58 +45,6 @@ class ByteSink(Protocol):
     def name(self) -> str: ...
 
     def write(self, data: bytes) -> int: ...
-
-
-@dataclass(frozen=True)
-class BoardFaults:
-    """Fault injection; probabilities are per sample. Loadable with ``config.loader``."""
-
-    garbage_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
-    garbage_max_bytes: int = field(default=64, metadata=limits(ge=1, le=4096))
-    bitflip_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
-    truncate_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
-    drop_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
-    stall_probability: float = field(default=0.0, metadata=limits(ge=0, le=1))
-    stall_s: float = field(default=0.5, metadata=limits(gt=0, le=60))
-    disconnect_after_s: float | None = field(default=None, metadata=limits(ge=0))
-    seed: int = 0
-
-    def validate(self) -> None:
-        if self.bitflip_probability + self.truncate_probability > 1:
-            raise ValueError("bitflip_probability + truncate_probability must be <= 1")
-
-    @property
-    def random(self) -> bool:
-        """Whether any per-sample random fault is switched on; if not, the board never draws
-        from its fault generator (the draws would decide nothing)."""
-        return bool(
-            self.garbage_probability
-            or self.bitflip_probability
-            or self.truncate_probability
-            or self.drop_probability
-            or self.stall_probability
-        )
-
-
-@dataclass
-class BoardStats:
-    """What the board did; ``log`` holds ``(seq, outcome, detail)`` when recording is on.
-
-    Outcomes: ``"sent"``, ``"dropped"``, ``"bitflip"`` (detail: byte offset), ``"truncate"``
-    (detail: bytes kept) and ``"stall"`` (seq: the next sample's; detail: start time in us).
-    """
-
-    samples: int = 0
-    frames_sent: int = 0
-    frames_dropped: int = 0
-    frames_corrupted: int = 0
-    overruns: int = 0
-    garbage_bursts: int = 0
-    garbage_bytes: int = 0
-    stalls: int = 0
-    bytes_sent: int = 0
-    disconnected: bool = False
-    log: list[tuple[int, str, int]] = field(default_factory=list)
 
 
 class BoardEmulator:
@@ -150,11 +69,8 @@ class BoardEmulator:
         self.rate_hz = float(rate_hz)
         self.clock = clock
         self.faults = faults if faults is not None else BoardFaults()
-        self.faults.validate()
-        self._faulty = self.faults.random
-        self.record = record
         self.stats = BoardStats()
-        self._rng = np.random.default_rng(self.faults.seed)
+        self._injector = FaultInjector(self.faults, self.stats, record=record)
         self._queue: queue.Queue[bytes | None] = queue.Queue(maxsize=queue_chunks)
         self._lock = threading.Lock()
         self._running = False
@@ -177,6 +93,11 @@ class BoardEmulator:
         self._closed = False
         if clock is not None:
             clock.on_advance(self._on_advance)
+
+    @property
+    def record(self) -> bool:
+        """Whether ``stats.log`` records every sample's outcome."""
+        return self._injector.record
 
     # -- lifetime ------------------------------------------------------------------------
 
@@ -258,13 +179,8 @@ class BoardEmulator:
                     break
                 if ts < self._resume_at:
                     continue
-                if (
-                    self.faults.stall_probability
-                    and self._rng.random() < self.faults.stall_probability
-                ):
-                    self.stats.stalls += 1
+                if self._injector.stalls(self._seq, ts):
                     self._resume_at = ts + self.faults.stall_s
-                    self._log(self._seq, "stall", round(ts * 1e6))
                     continue
                 chunks.append(self._sample(ts))
                 taken += 1
@@ -278,41 +194,10 @@ class BoardEmulator:
         return taken
 
     def _sample(self, ts: float) -> bytes:
-        f = self.faults
-        rng = self._rng
         seq = self._seq
         self._seq = (seq + 1) % 2**32
         self.stats.samples += 1
-        if not self._faulty:  # nothing to draw for: send the frame
-            data = self._frame(seq, ts)
-            self._log(seq, "sent", 0)
-            self.stats.frames_sent += 1
-            return data
-        if f.drop_probability and rng.random() < f.drop_probability:
-            self._log(seq, "dropped", 0)
-            self.stats.frames_dropped += 1
-            return b""
-        data = self._frame(seq, ts)
-        out = b""
-        if f.garbage_probability and rng.random() < f.garbage_probability:
-            out = self._garbage()
-        r = rng.random()
-        if r < f.bitflip_probability:
-            bit = int(rng.integers(len(data) * 8))
-            corrupted = bytearray(data)
-            corrupted[bit // 8] ^= 1 << (bit % 8)
-            data = bytes(corrupted)
-            self._log(seq, "bitflip", bit // 8)
-            self.stats.frames_corrupted += 1
-        elif r < f.bitflip_probability + f.truncate_probability:
-            keep = int(rng.integers(1, len(data)))
-            data = data[:keep]
-            self._log(seq, "truncate", keep)
-            self.stats.frames_corrupted += 1
-        else:
-            self._log(seq, "sent", 0)
-            self.stats.frames_sent += 1
-        return out + data
+        return self._injector.sample(seq, ts, self._frame)
 
     def _frame(self, seq: int, ts: float) -> bytes:
         """The encoded frame of sample ``seq`` taken at ``ts`` from the source."""
@@ -338,18 +223,6 @@ class BoardEmulator:
         if layout is not self.layout and layout != self.layout:
             raise ValueError(f"source gave {layout}, the board streams {self.layout}")
         return encode(frame)
-
-    def _garbage(self) -> bytes:
-        n = int(self._rng.integers(1, self.faults.garbage_max_bytes + 1))
-        raw = self._rng.integers(0, 255, size=n, dtype=np.uint8)
-        raw[raw >= SYNC_BYTE] += 1  # 0..255 without 0xA5
-        self.stats.garbage_bursts += 1
-        self.stats.garbage_bytes += n
-        return raw.tobytes()
-
-    def _log(self, seq: int, outcome: str, detail: int) -> None:
-        if self.record:
-            self.stats.log.append((seq, outcome, detail))
 
     def _enqueue(self, data: bytes, intact: int) -> None:
         if self._sink is not None:
@@ -410,13 +283,3 @@ class BoardEmulator:
         for fd in fds:
             with contextlib.suppress(OSError):
                 os.close(fd)
-
-
-def constant_source(wavelengths: Sequence[float], encoder: int = 0) -> SampleSource:
-    """A source that always returns the same sample (a sensor at rest)."""
-    sample = BoardSample(wavelengths=tuple(wavelengths), encoder=encoder)
-
-    def source(t: float) -> BoardSample:
-        return sample
-
-    return source
