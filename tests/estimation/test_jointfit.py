@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from estimation.corrections import ContactLaw
-from estimation.jointfit import JointFit, _closed_form, _grid_fits, _profiles, joint_fit
+from estimation.jointfit import JointFit, joint_fit
+from estimation.jointfit.grid import closed_form, grid_fits
+from estimation.jointfit.profile import profiles
 
 LAW = ContactLaw(3.5e-3, 0.45, 10e-3, bonded=True, large_indentation=True)
 EA = 9.7e3
@@ -184,7 +186,7 @@ def test_bad_input_raises() -> None:
         joint_fit(u, np.zeros(50), 0.0, LAW, sigma_force=SIGMA_P, confidence=1.0)
 
 
-def test_grid_fits_in_blocks_match_the_whole_matrix_closed_form() -> None:
+def test_grid_fits_in_blocks_match_the_whole_matrixclosed_form() -> None:
     # the blocked, depth-sorted evaluation against the plain (K, N) one it replaced
     rng = np.random.default_rng(9)
     u, P, e = curve(400e3, 0.0, rng, n=600)  # 600 samples: 27 rows a block, 5 blocks
@@ -193,11 +195,11 @@ def test_grid_fits_in_blocks_match_the_whole_matrix_closed_form() -> None:
     grid = np.linspace(-0.5e-3, 0.4e-3, 121)
     laws = [LAW, dataclasses.replace(LAW, layer_ratio_from="sphere")]
     for offset in (True, False):
-        fits = _grid_fits(laws, depth_base, P, w, grid, offset)
+        fits = grid_fits(laws, depth_base, P, w, grid, offset)
         for law, fit in zip(laws, fits, strict=True):
             depth = depth_base[None, :] - grid[:, None]
             f = np.where(depth > 0, law.shape(np.maximum(depth, 0.0))[0], 0.0)
-            for got, want in zip(fit, _closed_form(f, P, w, offset), strict=True):
+            for got, want in zip(fit, closed_form(f, P, w, offset), strict=True):
                 np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.max(np.abs(want)))
 
 
@@ -210,8 +212,8 @@ def test_profiles_in_lockstep_are_each_forms_own_profile() -> None:
     laws = [LAW, dataclasses.replace(LAW, layer_ratio_from="sphere")]
     span = 2e-7
     args = (u - e, P, w, 0.0, span, 3.84, -1e-3, 1e-3, True)
-    together = _profiles(laws, *args)
-    alone = [_profiles([law], *args)[0] for law in laws]
+    together = profiles(laws, *args)
+    alone = [profiles([law], *args)[0] for law in laws]
     assert together == alone
     for prof in together:
         assert prof is not None
