@@ -176,6 +176,34 @@ def test_no_contact_is_an_explicit_failure() -> None:
     assert "no contact" in r.message
 
 
+def test_each_steps_failure_names_the_step() -> None:
+    # the steps raise FitFailed; the recipe returns it as a result with the step's message
+    rng = np.random.default_rng(11)
+    u, P, e = curve(400e3, 0.0, rng)
+    past_the_record = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=5e-3)
+    assert not past_the_record.success
+    assert "ends before the contact search window" in past_the_record.message
+    out_of_budget = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0, max_nfev=2)
+    assert not out_of_budget.success
+    assert out_of_budget.message.startswith("least squares did not converge")
+    assert out_of_budget.nfev > 0
+    strict = joint_fit(
+        u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0, min_contact_points=10**4
+    )
+    assert not strict.success
+    assert "samples past the fitted contact point" in strict.message
+    assert strict.n_contact > 100  # the count the refinement reached
+    assert strict.law == LAW.name
+    assert strict.n_points == u.size
+
+
+def test_a_non_finite_contact_guess_raises_rather_than_fails() -> None:
+    rng = np.random.default_rng(12)
+    u, P, e = curve(400e3, 0.0, rng)
+    with pytest.raises(ValueError, match="contact_guess"):
+        joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=float("nan"))
+
+
 def test_bad_input_raises() -> None:
     u = np.linspace(0, 1e-3, 50)
     with pytest.raises(ValueError, match="force"):
@@ -186,7 +214,7 @@ def test_bad_input_raises() -> None:
         joint_fit(u, np.zeros(50), 0.0, LAW, sigma_force=SIGMA_P, confidence=1.0)
 
 
-def test_grid_fits_in_blocks_match_the_whole_matrixclosed_form() -> None:
+def test_grid_fits_in_blocks_match_the_whole_matrix_closed_form() -> None:
     # the blocked, depth-sorted evaluation against the plain (K, N) one it replaced
     rng = np.random.default_rng(9)
     u, P, e = curve(400e3, 0.0, rng, n=600)  # 600 samples: 27 rows a block, 5 blocks
