@@ -30,10 +30,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from estimation.elastica import fast
-from estimation.elastica._scipy import least_squares
 from estimation.elastica.constants import E_OVER_L_MAX, E_OVER_L_PEAK, P_CRIT, P_PEAK
 from estimation.elastica.errors import ElasticaConvergenceError
 from estimation.section import Section
+from estimation.strain_fit import StrainFit, StrainModel, checked_strains, straight_fit
 
 FloatArray = NDArray[np.float64]
 Branch = Literal["rising", "falling"]
@@ -51,30 +51,6 @@ def _checked(
         first = float(arr[bad].flat[0]) if arr.ndim else float(arr)
         raise ValueError(f"{name} must be finite and in [{lower!r}, {upper!r}], got {first!r}")
     return arr
-
-
-@dataclass(frozen=True)
-class StrainFit:
-    """Least-squares beam state from grating strains (see ``Beam.fit_strains``).
-
-    Attributes:
-        e: total end shortening (m).
-        P: axial load (N).
-        e_geometric: elastica (inextensible) part of e (m); 0 if not buckled.
-        residual: rms of model minus measured strain over the gratings (strain units).
-        direction: +1 if the strains fit the model's buckling direction, -1 its mirror image.
-        buckled: False if the best fit has no bending (then P and e are only bounded).
-        success, message: solver status and what the numbers mean.
-    """
-
-    e: float
-    P: float
-    e_geometric: float
-    residual: float
-    direction: int
-    buckled: bool
-    success: bool
-    message: str
 
 
 @dataclass(frozen=True)
@@ -187,7 +163,7 @@ class Beam:
         reaction of an imperfect beam) asks for it directly."""
         s0, s1 = self._intervals(intervals)
         g_arr = np.clip(np.asarray(g, dtype=float), 0.0, E_OVER_L_MAX)[..., None]
-        return self._bending(g_arr, s0, s1)
+        return self.mean_bending(g_arr, s0, s1)
 
     def _intervals(self, intervals: ArrayLike) -> tuple[FloatArray, FloatArray]:
         arr = np.asarray(intervals, dtype=float)
@@ -205,7 +181,11 @@ class Beam:
             )
         return s0 / self.length, s1 / self.length
 
-    def _bending(self, g: FloatArray, s0: FloatArray, s1: FloatArray) -> FloatArray:
+    def mean_bending(self, g: FloatArray, s0: FloatArray, s1: FloatArray) -> FloatArray:
+        """``bending_strains`` on arcs already checked: ``s0``, ``s1`` (G,) fractions of L
+        (negative inside the tube), ``g`` e_g/L in [0, E_OVER_L_MAX] with a trailing axis of 1
+        (shape g.shape + (1,) broadcasts against the gratings). The fit calls it per candidate
+        z without re-checking the arcs."""
         a, b = np.clip(s0, 0.0, 1.0), np.clip(s1, 0.0, 1.0)
         sol = fast.solve(g)
         inside = b > a
@@ -287,98 +267,25 @@ class Beam:
         e is fitted from the uniform strain -e/L.
         """
         s0, s1 = self._intervals(intervals)
-        y = np.asarray(strains, dtype=float)
-        if y.shape != s0.shape or y.size < 2:
-            raise ValueError(
-                f"strains must have shape (G,) with G >= 2 matching intervals {s0.shape}, "
-                f"got {y.shape}"
-            )
-        if not np.all(np.isfinite(y)):
-            raise ValueError("strains must be finite")
-        if sigma is None:
-            weight = np.ones_like(y)
-        else:
-            sig = np.broadcast_to(np.asarray(sigma, dtype=float), y.shape)
-            if not np.all(np.isfinite(sig) & (sig > 0.0)):
-                raise ValueError("sigma must be finite and > 0")
-            weight = 1.0 / sig
+        y, weight = checked_strains(strains, sigma, s0.shape)
         if self.fiber_offset == 0.0:
             raise ValueError("fiber_offset is 0: the fiber sees no bending strain, nothing to fit")
-        lam = self.slenderness_ratio
-
-        def model(z: FloatArray, direction: int) -> FloatArray:
-            g = np.minimum(z * z, E_OVER_L_MAX)
-            strain = direction * self._bending(g[:, None], s0, s1)
-            if include_axial:
-                strain = strain - lam * fast.load(g)[:, None]
-            return np.asarray(strain)
-
-        z_grid = np.linspace(0.0, math.sqrt(E_OVER_L_MAX), grid)
-        costs = [np.sum((weight * (model(z_grid, d) - y)) ** 2, axis=1) for d in (1, -1)]
-        d_index, i_best = np.unravel_index(int(np.argmin(np.stack(costs))), (2, grid))
-        direction, i = (1, -1)[int(d_index)], int(i_best)
-        lo, hi = z_grid[max(i - 1, 0)], z_grid[min(i + 1, grid - 1)]
-        scale = float(np.max(np.abs(weight * y))) or 1.0  # O(1) residuals: tolerances mean it
-        fit = least_squares(
-            lambda z: weight * (model(z, direction)[0] - y) / scale,
-            np.array([z_grid[i]]),
-            bounds=(lo, hi),
-            method="trf",
-            xtol=xtol,
-            ftol=xtol,
-            gtol=xtol,
-            max_nfev=max_nfev,
-        )
+        model = StrainModel(self, s0, s1, include_axial)
+        direction, fit = model.fit(y, weight, grid, xtol, max_nfev)
         z = float(fit.x[0])
-        cost = float(np.sum((weight * (model(np.array([z]), direction)[0] - y)) ** 2))
-        straight, straight_cost = self._straight_fit(y, weight, include_axial)
-        if straight_cost <= cost * (1.0 + 1e-9):
+        misfit = model(np.array([z]), direction)[0] - y
+        straight, straight_cost = straight_fit(self, y, weight, include_axial)
+        if straight_cost <= float(np.sum((weight * misfit) ** 2)) * (1.0 + 1e-9):
             return straight
         g = min(z * z, E_OVER_L_MAX)
         p = float(fast.load(np.array(g)))
-        rms = float(np.sqrt(np.mean((model(np.array([z]), direction)[0] - y) ** 2)))
         return StrainFit(
-            e=(g + lam * p) * self.length,
+            e=(g + self.slenderness_ratio * p) * self.length,
             P=p * self.load_unit,
             e_geometric=g * self.length,
-            residual=rms,
+            residual=float(np.sqrt(np.mean(misfit**2))),
             direction=direction,
             buckled=True,
             success=bool(fit.success),
             message=f"buckled (first mode): {fit.message}",
         )
-
-    def _straight_fit(
-        self, y: FloatArray, weight: FloatArray, include_axial: bool
-    ) -> tuple[StrainFit, float]:
-        """The best straight-beam (pre-buckling) state and its weighted squared residual."""
-        e_cr = self.critical_shortening()
-        if include_axial:
-            w2 = weight**2
-            eps = float(np.clip(-np.sum(w2 * y) / np.sum(w2), 0.0, e_cr / self.length))
-            fit = StrainFit(
-                e=eps * self.length,
-                P=self.EA * eps,
-                e_geometric=0.0,
-                residual=float(np.sqrt(np.mean((y + eps) ** 2))),
-                direction=1,
-                buckled=False,
-                success=True,
-                message="not buckled: e fitted from the uniform axial strain -e/L",
-            )
-            return fit, float(np.sum((weight * (y + eps)) ** 2))
-        fit = StrainFit(
-            e=e_cr,
-            P=self.critical_load(),
-            e_geometric=0.0,
-            residual=float(np.sqrt(np.mean(y**2))),
-            direction=1,
-            buckled=False,
-            success=True,
-            message=(
-                "no bending in the strains: the beam is straight (before or at buckling), so P is "
-                "only bounded, 0 <= P <= P_cr; returning the onset state P = P_cr, "
-                "e = P_cr L / EA (upper bounds)"
-            ),
-        )
-        return fit, float(np.sum((weight * y) ** 2))

@@ -133,19 +133,7 @@ def infer_states(
     Raises:
         ValueError: shapes, non-finite values, G < 3 or non-positive parameters.
     """
-    y = np.asarray(strains, dtype=np.float64)
-    if y.ndim != 2 or y.shape[1] < 3 or y.shape[0] == 0:
-        raise ValueError(f"strains must have shape (N, G) with N >= 1, G >= 3; got {y.shape}")
-    n, g_count = y.shape
-    L = np.broadcast_to(np.asarray(lengths, dtype=np.float64), (n,))
-    arcs = np.broadcast_to(np.asarray(intervals, dtype=np.float64), (n, g_count, 2))
-    for name, arr in (("strains", y), ("lengths", L), ("intervals", arcs)):
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite")
-    if np.any(L <= 0):
-        raise ValueError("lengths must be > 0 m")
-    if np.any(arcs[..., 1] <= arcs[..., 0]) or np.any(arcs[..., 1] > L[:, None] * (1 + 1e-12)):
-        raise ValueError("intervals: each grating needs s0 < s1 <= L")
+    y, arcs, L = _checked(strains, intervals, lengths)
     if not (math.isfinite(EA) and EA > 0):
         raise ValueError(f"EA must be > 0 N, got {EA!r}")
     if not (math.isfinite(fiber_offset) and fiber_offset != 0):
@@ -153,33 +141,12 @@ def infer_states(
     if not (math.isfinite(sigma_strain) and sigma_strain > 0):
         raise ValueError(f"sigma_strain must be > 0, got {sigma_strain!r}")
     geo = _geometry(arcs, L, fiber_offset)
-    yc = _centred(y)
-
-    m1 = _centred(_bending(np.full(n, ONSET_STEP), geo) / ONSET_STEP)
-    z = np.clip(np.sum(m1 * yc, axis=1) / np.sum(m1 * m1, axis=1), -Z_MAX, Z_MAX)
-    converged = np.zeros(n, dtype=bool)
-    for _ in range(maxiter):
-        jac = _centred(_bending(z + DIFF_STEP, geo) - _bending(z - DIFF_STEP, geo)) / (
-            2 * DIFF_STEP
-        )
-        r = yc - _centred(_bending(z, geo))
-        step = np.sum(jac * r, axis=1) / np.sum(jac * jac, axis=1)
-        z = np.clip(z + step, -Z_MAX, Z_MAX)
-        converged = np.abs(step) <= tol
-        if np.all(converged):
-            break
+    z, converged = _gauss_newton(y, geo, tol, maxiter)
     bend = _bending(z, geo)
     axial = np.mean(bend - y, axis=1)  # P / EA
     fit = bend - axial[:, None]
     residual = np.sqrt(np.mean((y - fit) ** 2, axis=1))
-    # Linearised covariance of (z, P/EA): columns j = dB/dz and -1.
-    jac = (_bending(z + DIFF_STEP, geo) - _bending(z - DIFF_STEP, geo)) / (2 * DIFF_STEP)
-    s_jj = np.sum(jac * jac, axis=1)
-    s_j1 = -np.sum(jac, axis=1)
-    det = s_jj * g_count - s_j1**2
-    var_z = sigma_strain**2 * g_count / det
-    var_a = sigma_strain**2 * s_jj / det
-    cov_za = -(sigma_strain**2) * s_j1 / det
+    var_z, var_a, cov_za = _covariance(z, geo, sigma_strain)
     P = EA * axial
     e = axial * L + z * z * L
     de_dz = 2.0 * z * L
@@ -193,3 +160,64 @@ def infer_states(
         residual=np.asarray(residual),
         converged=np.asarray(converged),
     )
+
+
+def _checked(
+    strains: ArrayLike, intervals: ArrayLike, lengths: ArrayLike
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Strains (N, G), arcs (N, G, 2) and lengths (N,) as float arrays (arcs and lengths
+    broadcast per sample); ValueError for a bad shape, a non-finite value or bad arcs."""
+    y = np.asarray(strains, dtype=np.float64)
+    if y.ndim != 2 or y.shape[1] < 3 or y.shape[0] == 0:
+        raise ValueError(f"strains must have shape (N, G) with N >= 1, G >= 3; got {y.shape}")
+    n, g_count = y.shape
+    L = np.broadcast_to(np.asarray(lengths, dtype=np.float64), (n,))
+    arcs = np.broadcast_to(np.asarray(intervals, dtype=np.float64), (n, g_count, 2))
+    for name, arr in (("strains", y), ("lengths", L), ("intervals", arcs)):
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"{name} must be finite")
+    if np.any(L <= 0):
+        raise ValueError("lengths must be > 0 m")
+    if np.any(arcs[..., 1] <= arcs[..., 0]) or np.any(arcs[..., 1] > L[:, None] * (1 + 1e-12)):
+        raise ValueError("intervals: each grating needs s0 < s1 <= L")
+    return y, arcs, L
+
+
+def _gauss_newton(
+    y: FloatArray, geo: _Geometry, tol: float, maxiter: int
+) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """The amplitudes z (N,) with P concentrated out (all strains centred over the gratings),
+    started from the linear onset-mode fit, and per sample whether the step met ``tol``."""
+    n = y.shape[0]
+    yc = _centred(y)
+    m1 = _centred(_bending(np.full(n, ONSET_STEP), geo) / ONSET_STEP)
+    z = np.clip(np.sum(m1 * yc, axis=1) / np.sum(m1 * m1, axis=1), -Z_MAX, Z_MAX)
+    converged = np.zeros(n, dtype=bool)
+    for _ in range(maxiter):
+        jac = _centred(_bending(z + DIFF_STEP, geo) - _bending(z - DIFF_STEP, geo)) / (
+            2 * DIFF_STEP
+        )
+        r = yc - _centred(_bending(z, geo))
+        step = np.sum(jac * r, axis=1) / np.sum(jac * jac, axis=1)
+        z = np.clip(z + step, -Z_MAX, Z_MAX)
+        converged = np.abs(step) <= tol
+        if np.all(converged):
+            break
+    return z, converged
+
+
+def _covariance(
+    z: FloatArray, geo: _Geometry, sigma_strain: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Linearised (var z, var P/EA, cov) per sample (N,) of the 2-parameter fit y = B(z) - P/EA
+    with white strain noise ``sigma_strain``: the inverse of the (2, 2) normal matrix of the
+    columns dB/dz (central difference) and -1."""
+    jac = (_bending(z + DIFF_STEP, geo) - _bending(z - DIFF_STEP, geo)) / (2 * DIFF_STEP)
+    g_count = jac.shape[1]
+    s_jj = np.sum(jac * jac, axis=1)
+    s_j1 = -np.sum(jac, axis=1)
+    det = s_jj * g_count - s_j1**2
+    var_z = sigma_strain**2 * g_count / det
+    var_a = sigma_strain**2 * s_jj / det
+    cov_za = -(sigma_strain**2) * s_j1 / det
+    return var_z, var_a, cov_za

@@ -92,15 +92,7 @@ def paper_estimate(
     if not tip_radius > 0:
         raise ValueError(f"tip_radius must be > 0, got {tip_radius}")
     _check_poisson(poisson)
-    if not (math.isfinite(exposed_length_at_buckling) and exposed_length_at_buckling > 0):
-        raise ValueError(
-            f"exposed_length_at_buckling must be > 0 m, got {exposed_length_at_buckling}"
-        )
-    force = euler_load(EI, exposed_length_at_buckling)  # also validates EI
-    if P is not None:
-        if not (math.isfinite(P) and P > 0):
-            raise ValueError(f"P must be a positive finite load in N, got {P}")
-        force = float(P)
+    force = _axial_load(EI, exposed_length_at_buckling, P)
     delta = x_buckling - x_contact
     if not delta > 0:
         return StiffnessEstimate(
@@ -193,6 +185,19 @@ def summarize(
         outliers=outliers,
         failed=failed,
     )
+
+
+def _axial_load(EI: float, length: float, P: float | None) -> float:
+    """The load (N) the estimate uses: ``P`` when given, else P_cr = 20.19 EI / L^2 at the
+    exposed length ``length`` (m); EI and L are checked either way."""
+    if not (math.isfinite(length) and length > 0):
+        raise ValueError(f"exposed_length_at_buckling must be > 0 m, got {length}")
+    force = euler_load(EI, length)  # also validates EI
+    if P is not None:
+        if not (math.isfinite(P) and P > 0):
+            raise ValueError(f"P must be a positive finite load in N, got {P}")
+        force = float(P)
+    return force
 
 
 def _check_poisson(poisson: float) -> None:

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from estimation.corrections import ContactLaw
-from estimation.jointfit import JointFit, _closed_form, _grid_fits, _profiles, joint_fit
+from estimation.jointfit import JointFit, joint_fit
+from estimation.jointfit.grid import closed_form, grid_fits
+from estimation.jointfit.profile import profiles
 
 LAW = ContactLaw(3.5e-3, 0.45, 10e-3, bonded=True, large_indentation=True)
 EA = 9.7e3
@@ -174,6 +176,34 @@ def test_no_contact_is_an_explicit_failure() -> None:
     assert "no contact" in r.message
 
 
+def test_each_steps_failure_names_the_step() -> None:
+    # the steps raise FitFailed; the recipe returns it as a result with the step's message
+    rng = np.random.default_rng(11)
+    u, P, e = curve(400e3, 0.0, rng)
+    past_the_record = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=5e-3)
+    assert not past_the_record.success
+    assert "ends before the contact search window" in past_the_record.message
+    out_of_budget = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0, max_nfev=2)
+    assert not out_of_budget.success
+    assert out_of_budget.message.startswith("least squares did not converge")
+    assert out_of_budget.nfev > 0
+    strict = joint_fit(
+        u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0, min_contact_points=10**4
+    )
+    assert not strict.success
+    assert "samples past the fitted contact point" in strict.message
+    assert strict.n_contact > 100  # the count the refinement reached
+    assert strict.law == LAW.name
+    assert strict.n_points == u.size
+
+
+def test_a_non_finite_contact_guess_raises_rather_than_fails() -> None:
+    rng = np.random.default_rng(12)
+    u, P, e = curve(400e3, 0.0, rng)
+    with pytest.raises(ValueError, match="contact_guess"):
+        joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=float("nan"))
+
+
 def test_bad_input_raises() -> None:
     u = np.linspace(0, 1e-3, 50)
     with pytest.raises(ValueError, match="force"):
@@ -193,11 +223,11 @@ def test_grid_fits_in_blocks_match_the_whole_matrix_closed_form() -> None:
     grid = np.linspace(-0.5e-3, 0.4e-3, 121)
     laws = [LAW, dataclasses.replace(LAW, layer_ratio_from="sphere")]
     for offset in (True, False):
-        fits = _grid_fits(laws, depth_base, P, w, grid, offset)
+        fits = grid_fits(laws, depth_base, P, w, grid, offset)
         for law, fit in zip(laws, fits, strict=True):
             depth = depth_base[None, :] - grid[:, None]
             f = np.where(depth > 0, law.shape(np.maximum(depth, 0.0))[0], 0.0)
-            for got, want in zip(fit, _closed_form(f, P, w, offset), strict=True):
+            for got, want in zip(fit, closed_form(f, P, w, offset), strict=True):
                 np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.max(np.abs(want)))
 
 
@@ -210,8 +240,8 @@ def test_profiles_in_lockstep_are_each_forms_own_profile() -> None:
     laws = [LAW, dataclasses.replace(LAW, layer_ratio_from="sphere")]
     span = 2e-7
     args = (u - e, P, w, 0.0, span, 3.84, -1e-3, 1e-3, True)
-    together = _profiles(laws, *args)
-    alone = [_profiles([law], *args)[0] for law in laws]
+    together = profiles(laws, *args)
+    alone = [profiles([law], *args)[0] for law in laws]
     assert together == alone
     for prof in together:
         assert prof is not None
