@@ -50,7 +50,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--faults",
         action="store_true",
         help="the fault campaign: the scene's fault cases (default scene: scenes/faults.yaml); "
-        "prints fault, trials, safe stops, data kept (palpate/faults.py)",
+        "prints fault, trials, safe stops, data kept (palpate/faults/)",
     )
     parser.add_argument(
         "--compare-methods",
