@@ -12,11 +12,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
-
-from tqdm import tqdm
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
@@ -39,6 +36,7 @@ from palpate.designcheck import (
     run_check,
 )
 from palpate.executors import add_executor_arguments
+from palpate.progress import progress_bar
 from palpate.simtrial import TrialOutcome
 from sensor.strain import strain_noise
 from wire.dynamixel import TICKS_PER_REV
@@ -90,13 +88,25 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     space = DesignSpace()
     parser.add_argument(
-        "--fiber-radii-um", default=",".join(f"{r * 1e6:g}" for r in space.fiber_radii)
+        "--fiber-radii-um",
+        default=",".join(f"{r * 1e6:g}" for r in space.fiber_radii),
+        help="fiber radii to consider (comma-separated)",
     )
     parser.add_argument(
-        "--wire-diameters-um", default=",".join(f"{d * 1e6:g}" for d in space.wire_diameters)
+        "--wire-diameters-um",
+        default=",".join(f"{d * 1e6:g}" for d in space.wire_diameters),
+        help="NiTi wire diameters to consider (comma-separated)",
     )
-    parser.add_argument("--wire-counts", default=",".join(str(n) for n in space.wire_counts))
-    parser.add_argument("--tip-radii-mm", default=",".join(f"{r * 1e3:g}" for r in space.tip_radii))
+    parser.add_argument(
+        "--wire-counts",
+        default=",".join(str(n) for n in space.wire_counts),
+        help="numbers of wires around the fiber to consider (comma-separated)",
+    )
+    parser.add_argument(
+        "--tip-radii-mm",
+        default=",".join(f"{r * 1e3:g}" for r in space.tip_radii),
+        help="tip sphere radii to consider (comma-separated)",
+    )
     parser.add_argument(
         "--length-range-mm",
         default=":".join(f"{v * 1e3:g}" for v in space.length_range),
@@ -115,8 +125,15 @@ def register(parser: argparse.ArgumentParser) -> None:
         default=0.0,
         help="contact-detection error (1 sigma) in the simulated campaign",
     )
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--workers", type=int, default=default_workers())
+    parser.add_argument(
+        "--seed", type=int, default=0, help="makes the simulated check reproducible"
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=default_workers(),
+        help="trials of the check run in parallel (processes, threads or local Dask workers)",
+    )
     add_executor_arguments(parser)
     parser.add_argument("--no-sim", action="store_true", help="skip the simulated campaign")
 
@@ -173,7 +190,7 @@ def _run_sim(
     scene: SceneConfig, stack: StackConfig, args: argparse.Namespace
 ) -> tuple[list[TrialOutcome], float]:
     specs = campaign_trials(scene, stack, args.seed)
-    bar = tqdm(total=len(specs), desc="design check", unit="trial", file=sys.stderr)
+    bar = progress_bar(len(specs), "design check")
 
     def progress(o: TrialOutcome) -> None:
         bar.update(1)

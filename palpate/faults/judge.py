@@ -37,8 +37,8 @@ from typing import Any
 from config.faults import FaultCase
 from config.scene import SceneConfig
 from config.schema import StackConfig
-from palpate.commands.replay import replay
 from palpate.faults.injector import GroundTruth
+from palpate.replaylog import replay
 from palpate.simtrial import TrialOutcome, TrialSpec
 from robot.triallog import read_log
 from sim.board import BoardFaults
