@@ -4,6 +4,7 @@ every option with its default and without docstring markup, a static command tab
 
 from __future__ import annotations
 
+import ast
 import importlib
 import json
 import subprocess
@@ -37,32 +38,31 @@ def test_version_is_the_installed_one(capsys: pytest.CaptureFixture[str]) -> Non
     assert capsys.readouterr().out == f"palpate {version('palpate')}\n"
 
 
+def _imported_by(argv: list[str], prefixes: tuple[str, ...]) -> list[str]:
+    """The modules starting with one of ``prefixes`` that ``main(argv)`` leaves imported."""
+    code = (
+        "import sys\n"
+        "from palpate.cli import main\n"
+        f"assert main({argv!r}) == 0\n"
+        f"print(sorted(m for m in sys.modules if m.startswith({prefixes!r})))\n"
+    )
+    done = _run("-c", code)
+    assert done.returncode == 0, done.stderr
+    modules: list[str] = ast.literal_eval(done.stdout.strip().splitlines()[-1])
+    return modules
+
+
 def test_top_level_help_imports_no_command_module() -> None:
     """The subcommand list comes from the static table: numpy, scipy, the configuration and
     every command's module stay unimported (``python -X importtime`` shows the cost)."""
-    code = (
-        "import sys\n"
-        "from palpate.cli import main\n"
-        "assert main(['--help']) == 0\n"
-        "heavy = ('numpy', 'scipy', 'yaml', 'matplotlib', 'tqdm', 'config', 'estimation',\n"
-        "         'robot', 'sensor', 'sim', 'wire', 'palpate.commands')\n"
-        "print(sorted(m for m in sys.modules if m.startswith(heavy)))\n"
-    )
-    done = _run("-c", code)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.strip().splitlines()[-1] == "[]"
+    heavy = ("numpy", "scipy", "yaml", "matplotlib", "tqdm", "config", "estimation", "robot")
+    heavy += ("sensor", "sim", "wire", "palpate.commands")
+    assert _imported_by(["--help"], heavy) == []
 
 
 def test_a_subcommand_imports_only_its_own_module() -> None:
-    code = (
-        "import sys\n"
-        "from palpate.cli import main\n"
-        "assert main(['calibrate', '--help']) == 0\n"
-        "print(sorted(m for m in sys.modules if m.startswith('palpate.commands.')))\n"
-    )
-    done = _run("-c", code)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.strip().splitlines()[-1] == "['palpate.commands.calibrate']"
+    commands = _imported_by(["calibrate", "--help"], ("palpate.commands.",))
+    assert commands == ["palpate.commands.calibrate"]
 
 
 @pytest.mark.parametrize("name", sorted(COMMANDS))

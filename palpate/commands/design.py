@@ -87,26 +87,15 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="smallest indentation at buckling, in encoder counts",
     )
     space = DesignSpace()
-    parser.add_argument(
-        "--fiber-radii-um",
-        default=",".join(f"{r * 1e6:g}" for r in space.fiber_radii),
-        help="fiber radii to consider (comma-separated)",
-    )
-    parser.add_argument(
-        "--wire-diameters-um",
-        default=",".join(f"{d * 1e6:g}" for d in space.wire_diameters),
-        help="NiTi wire diameters to consider (comma-separated)",
-    )
-    parser.add_argument(
-        "--wire-counts",
-        default=",".join(str(n) for n in space.wire_counts),
-        help="numbers of wires around the fiber to consider (comma-separated)",
-    )
-    parser.add_argument(
-        "--tip-radii-mm",
-        default=",".join(f"{r * 1e3:g}" for r in space.tip_radii),
-        help="tip sphere radii to consider (comma-separated)",
-    )
+    for flag, values, what in (
+        ("--fiber-radii-um", [f"{r * 1e6:g}" for r in space.fiber_radii], "fiber radii"),
+        ("--wire-diameters-um", [f"{d * 1e6:g}" for d in space.wire_diameters], "wire diameters"),
+        ("--wire-counts", [str(n) for n in space.wire_counts], "numbers of NiTi wires"),
+        ("--tip-radii-mm", [f"{r * 1e3:g}" for r in space.tip_radii], "tip sphere radii"),
+    ):
+        parser.add_argument(
+            flag, default=",".join(values), help=f"{what} to consider (comma-separated)"
+        )
     parser.add_argument(
         "--length-range-mm",
         default=":".join(f"{v * 1e3:g}" for v in space.length_range),
