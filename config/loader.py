@@ -72,32 +72,14 @@ def _check_range(value: float, meta: Mapping[str, Any], source: str, path: str) 
 def _convert(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any]) -> Any:
     origin = get_origin(tp)
     if origin in (typing.Union, types.UnionType):
-        options = get_args(tp)
-        if value is None and type(None) in options:
-            return None
-        errors = []
-        for option in options:
-            if option is type(None):
-                continue
-            try:
-                return _convert(option, value, source, path, meta)
-            except ConfigError as exc:
-                errors.append(exc.problem)
-        raise ConfigError(source, path, " / ".join(errors))
+        return _convert_union(tp, value, source, path, meta)
     if origin is Literal:
         allowed = get_args(tp)
         if value not in allowed:
             raise ConfigError(source, path, f"must be one of {list(allowed)}, got {value!r}")
         return value
     if origin in (tuple, list):
-        args = get_args(tp)
-        if not isinstance(value, list | tuple):
-            raise ConfigError(source, path, f"expected a list, got {value!r}")
-        item_tp = args[0] if args else Any
-        items = [_convert(item_tp, v, source, _join(path, i), meta) for i, v in enumerate(value)]
-        if origin is tuple and args and args[-1] is not Ellipsis and len(args) != len(items):
-            raise ConfigError(source, path, f"expected {len(args)} items, got {len(items)}")
-        return tuple(items) if origin is tuple else items
+        return _convert_sequence(tp, origin, value, source, path, meta)
     if origin is dict:
         if not isinstance(value, Mapping):
             raise ConfigError(source, path, f"expected a mapping, got {value!r}")
@@ -107,6 +89,41 @@ def _convert(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any
         }
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):
         return from_mapping(tp, value, source, path)
+    return _convert_scalar(tp, value, source, path, meta)
+
+
+def _convert_union(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any]) -> Any:
+    """The first option of ``X | Y | None`` that accepts ``value``; else every option's problem."""
+    options = get_args(tp)
+    if value is None and type(None) in options:
+        return None
+    errors = []
+    for option in options:
+        if option is type(None):
+            continue
+        try:
+            return _convert(option, value, source, path, meta)
+        except ConfigError as exc:
+            errors.append(exc.problem)
+    raise ConfigError(source, path, " / ".join(errors))
+
+
+def _convert_sequence(
+    tp: Any, origin: Any, value: Any, source: str, path: str, meta: Mapping[str, Any]
+) -> Any:
+    """A YAML list as ``list[X]``, ``tuple[X, ...]`` or a fixed-length ``tuple[X, Y]``."""
+    args = get_args(tp)
+    if not isinstance(value, list | tuple):
+        raise ConfigError(source, path, f"expected a list, got {value!r}")
+    item_tp = args[0] if args else Any
+    items = [_convert(item_tp, v, source, _join(path, i), meta) for i, v in enumerate(value)]
+    if origin is tuple and args and args[-1] is not Ellipsis and len(args) != len(items):
+        raise ConfigError(source, path, f"expected {len(args)} items, got {len(items)}")
+    return tuple(items) if origin is tuple else items
+
+
+def _convert_scalar(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any]) -> Any:
+    """bool, int, float (finite, within the field's range), str or Any."""
     if tp is bool:
         if not isinstance(value, bool):
             raise ConfigError(source, path, f"expected true or false, got {value!r}")

@@ -1,69 +1,258 @@
-"""``palpate`` console script: a registry of subcommands, each in its own module.
+"""``palpate`` console script: a static table of subcommands, each in its own module.
 
 Exit codes (a stable interface): 0 success, 2 bad input (configuration, arguments), 1 a fault.
+
+The table below names each subcommand's module and its one-line help, so ``palpate --help``
+imports none of them (nor numpy, scipy, ...): a command's module is imported only when that
+command runs or its own ``--help`` is asked. Results go to stdout; diagnostics (progress notes,
+warnings, errors) go through :mod:`logging` to stderr, at the level ``-v`` / ``-q`` set.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import logging
+import re
 import sys
 from collections.abc import Sequence
-
-from config.loader import ConfigError
-
-# Subcommand name -> module in palpate.commands exposing ``register(parser)`` and ``run(args)``.
-COMMANDS: dict[str, str] = {
-    "sim": "palpate.commands.sim",
-    "bench": "palpate.commands.bench",
-    "replay": "palpate.commands.replay",
-    "emulate": "palpate.commands.emulate",
-    "calibrate": "palpate.commands.calibrate",
-    "design": "palpate.commands.design",
-    "trial": "palpate.commands.trial",
-    "teleop": "palpate.commands.teleop",
-}
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
 
 EXIT_OK = 0
 EXIT_FAULT = 1
 EXIT_BAD_INPUT = 2
 
+log = logging.getLogger("palpate")
 
-def build_parser() -> argparse.ArgumentParser:
+
+@dataclass(frozen=True)
+class Command:
+    """A subcommand: its module (``register(parser)``, ``run(args) -> int``) and one-line help
+    (the first line of the module's docstring; a test keeps them equal)."""
+
+    module: str
+    summary: str
+
+
+COMMANDS: dict[str, Command] = {
+    "sim": Command(
+        "palpate.commands.sim",
+        "Run a simulated campaign (the paper's robot or bench-top experiment): no hardware needed.",
+    ),
+    "bench": Command(
+        "palpate.commands.bench",
+        "Speed against error of the mechanics, the signal chain and the servo bus.",
+    ),
+    "replay": Command(
+        "palpate.commands.replay",
+        "Re-run the estimation on a recorded trial log and compare with what the trial reported.",
+    ),
+    "emulate": Command(
+        "palpate.commands.emulate",
+        "Start the Dynamixel bus and board emulators on pseudo-terminals and print their paths.",
+    ),
+    "calibrate": Command(
+        "palpate.commands.calibrate",
+        "Fit the glued fiber's strain coefficient k'_eps from a recorded (strain, shift) file.",
+    ),
+    "design": Command(
+        "palpate.commands.design",
+        "Design a sensor for a tissue modulus range, then try it on simulated phantoms across "
+        "the range.",
+    ),
+    "trial": Command(
+        "palpate.commands.trial",
+        "Run scripted indentation trials on the real bench: ports, stored poses and protocol "
+        "from a YAML.",
+    ),
+    "teleop": Command(
+        "palpate.commands.teleop",
+        "Jog roll, advance and tube from the keyboard; live pose, strains and flags; store poses.",
+    ),
+}
+
+
+# -- help text -----------------------------------------------------------------------------------
+
+_ROLE = re.compile(r":(?:mod|func|class|meth|attr|data|obj|exc):`(~?)([^`]+)`")
+_LITERAL = re.compile(r"``([^`]+)``")
+_STRONG = re.compile(r"\*\*([^*]+)\*\*")
+
+
+def plain_text(doc: str) -> str:
+    """A docstring without its reStructuredText markup, as ``--help`` shows it:
+    ``:func:`~a.b``` -> ``b``, ``:mod:`a.b``` -> ``a.b``, double backquotes and ``**`` dropped."""
+
+    def role(m: re.Match[str]) -> str:
+        target = m.group(2)
+        return target.rsplit(".", 1)[-1] if m.group(1) else target
+
+    text = _ROLE.sub(role, doc)
+    text = _LITERAL.sub(r"\1", text)
+    return _STRONG.sub(r"\1", text).strip()
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Descriptions keep their paragraphs; every option that takes a value shows its default
+    (unless it has none or its help already says it)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if (
+            "%(default)" in text
+            or default is None
+            or default is False
+            or default is argparse.SUPPRESS
+            or action.nargs == 0  # a flag or a counter: its help says what it does
+            or (not action.option_strings and action.nargs not in ("?", "*"))
+        ):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: the installed distribution's version (read only when asked)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: Any) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            text = version("palpate")
+        except PackageNotFoundError:
+            text = "unknown (not installed)"
+        print(f"palpate {text}")
+        parser.exit()
+
+
+# -- the parser ----------------------------------------------------------------------------------
+
+
+def _add_verbosity(parser: argparse.ArgumentParser, default: Any) -> None:
+    """``-v``/``-q`` (repeatable); the subcommands accept them too (``default`` SUPPRESS there,
+    so they do not reset what was given before the subcommand)."""
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=default, help="more diagnostics on stderr"
+    )
+    parser.add_argument(
+        "-q",
+        "--quiet",
+        action="count",
+        default=default,
+        help="fewer diagnostics on stderr (-q: warnings and errors, -qq: errors only)",
+    )
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``palpate`` parser; only ``command``'s module is imported and its options added."""
+    return _build(command)[0]
+
+
+def command_parser(name: str) -> argparse.ArgumentParser:
+    """The parser of one subcommand, with its options (for tests and documentation)."""
+    return _build(name)[1][name]
+
+
+def _build(
+    command: str | None,
+) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
     parser = argparse.ArgumentParser(
         prog="palpate",
         description="Tissue palpation with a buckling FBG-sensorized beam: "
         "simulator and control stack.",
+        formatter_class=HelpFormatter,
     )
+    parser.add_argument(
+        "--version", action=_VersionAction, help="print the installed version and exit"
+    )
+    _add_verbosity(parser, 0)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name, module_name in COMMANDS.items():
-        module = importlib.import_module(module_name)
-        doc = (module.__doc__ or "").strip().splitlines()[0] if module.__doc__ else ""
-        cmd = sub.add_parser(name, help=doc, description=module.__doc__)
-        cmd.add_argument(
-            "--json", action="store_true", help="print machine-readable results on stdout"
+    commands = {}
+    for name, spec in COMMANDS.items():
+        cmd = sub.add_parser(
+            name, help=spec.summary, description=spec.summary, formatter_class=HelpFormatter
         )
-        module.register(cmd)
-        cmd.set_defaults(_module=module)
-    return parser
+        if name == command:
+            _register(cmd, importlib.import_module(spec.module))
+        commands[name] = cmd
+    return parser, commands
+
+
+def _register(cmd: argparse.ArgumentParser, module: ModuleType) -> None:
+    cmd.description = plain_text(module.__doc__ or "")
+    cmd.add_argument("--json", action="store_true", help="print machine-readable results on stdout")
+    _add_verbosity(cmd, argparse.SUPPRESS)
+    module.register(cmd)
+    cmd.set_defaults(_module=module)
+
+
+def command_in(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option (the global options
+    take no value), if it is a known command."""
+    for arg in argv:
+        if arg == "--":
+            return None
+        if not arg.startswith("-"):
+            return arg if arg in COMMANDS else None
+    return None
+
+
+# -- diagnostics ---------------------------------------------------------------------------------
+
+
+class _StderrHandler(logging.Handler):
+    """Writes each record to whatever ``sys.stderr`` is when it is emitted (a redirect, pytest)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            sys.stderr.write(self.format(record) + "\n")
+            sys.stderr.flush()
+        except Exception:  # logging's own contract: report, never raise
+            self.handleError(record)
+
+
+def configure_logging(verbose: int = 0, quiet: int = 0) -> None:
+    """INFO by default (progress notes), DEBUG with ``-v``, WARNING with ``-q``, ERROR with
+    ``-qq``; records print as their bare message on stderr."""
+    level = min(max(logging.INFO + 10 * (quiet - verbose), logging.DEBUG), logging.CRITICAL)
+    for handler in [h for h in log.handlers if isinstance(h, _StderrHandler)]:
+        log.removeHandler(handler)
+    handler = _StderrHandler()
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    log.addHandler(handler)
+    log.setLevel(level)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    words = list(sys.argv[1:] if argv is None else argv)
     try:
-        args = parser.parse_args(argv)
+        args = build_parser(command_in(words)).parse_args(words)
+        if not hasattr(args, "_module"):  # the command was not where command_in looked
+            args = build_parser(args.command).parse_args(words)
     except SystemExit as exc:  # argparse exits 2 on bad arguments, 0 on --help
         return int(exc.code or 0)
+    configure_logging(args.verbose, args.quiet)
     try:
         return int(args._module.run(args) or EXIT_OK)
-    except ConfigError as exc:
-        print(f"palpate: bad configuration: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
     except (ValueError, FileNotFoundError) as exc:
-        print(f"palpate: bad input: {exc}", file=sys.stderr)
+        from config.loader import ConfigError
+
+        kind = "bad configuration" if isinstance(exc, ConfigError) else "bad input"
+        log.error("palpate: %s: %s", kind, exc)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        print("palpate: interrupted", file=sys.stderr)
+        log.error("palpate: interrupted")
         return EXIT_FAULT
 
 

@@ -117,7 +117,7 @@ def add_executor_arguments(parser: argparse.ArgumentParser) -> None:
         "--executor",
         choices=sorted(EXECUTORS),
         default="process",
-        help="where trials run: local process pool (default), threads, serial, or Dask",
+        help="where trials run: a local process pool, threads, serially, or Dask",
     )
     parser.add_argument(
         "--scheduler",

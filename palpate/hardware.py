@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import logging
 import os
 import signal
-import sys
 import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -32,6 +32,8 @@ from robot.motors import ServoFaultError, ServoTransportError
 from sensor.clock import Clock, SystemClock
 from sensor.ports import DIALOUT_HINT, os_errno
 from sensor.reader import FrameReader, SensorPortError, SerialLike
+
+log = logging.getLogger(__name__)
 
 SIM_PORT = "sim"
 LIST_PORTS = "python -m serial.tools.list_ports"
@@ -183,11 +185,11 @@ def run_on_hardware(command: str, body: Callable[[], int], *, stopped_exit: int 
         with terminate_as_interrupt():
             return body()
     except HardwareError as exc:
-        print(f"palpate {command}: {exc}", file=sys.stderr)
+        log.error("palpate %s: %s", command, exc)
         return 1
     except (ServoTransportError, ServoFaultError, SensorPortError) as exc:
-        print(f"palpate {command}: hardware fault, torque off: {exc}", file=sys.stderr)
+        log.error("palpate %s: hardware fault, torque off: %s", command, exc)
         return 1
     except (KeyboardInterrupt, Terminated) as exc:
-        print(f"palpate {command}: stopped ({type(exc).__name__}), torque off", file=sys.stderr)
+        log.warning("palpate %s: stopped (%s), torque off", command, type(exc).__name__)
         return stopped_exit

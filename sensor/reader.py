@@ -110,23 +110,10 @@ class FrameParser:
                     c.bytes_discarded += j - i
                     i = j
                     synced = True
-                if n - i < size:
+                if n - i < size or buf[i : i + HEADER_SIZE] != header:
                     # Decide early on what is already visible; wait only for a plausible frame.
-                    if n - i >= len(MARKER) and buf[i : i + len(MARKER)] != MARKER:
-                        c.sync_losses += 1
-                    elif n - i >= HEADER_SIZE and buf[i : i + HEADER_SIZE] != header:
-                        c.bad_headers += 1
-                    else:
+                    if not self._count_rejection(buf, i, n):
                         break
-                    synced = False
-                    i += 1
-                    c.bytes_discarded += 1
-                    continue
-                if buf[i : i + HEADER_SIZE] != header:
-                    if buf[i : i + len(MARKER)] != MARKER:
-                        c.sync_losses += 1
-                    else:
-                        c.bad_headers += 1
                     synced = False
                     i += 1
                     c.bytes_discarded += 1
@@ -146,6 +133,17 @@ class FrameParser:
         self._synced = synced
         c.frames += len(frames)
         return frames
+
+    def _count_rejection(self, buf: bytearray, i: int, n: int) -> bool:
+        """Count why the bytes at ``i`` are not a frame header (a sync loss or a bad header);
+        False when too few bytes are there to tell (a partial frame: wait for more)."""
+        if n - i >= len(MARKER) and buf[i : i + len(MARKER)] != MARKER:
+            self.counters.sync_losses += 1
+        elif n - i >= HEADER_SIZE and buf[i : i + HEADER_SIZE] != self.layout.header:
+            self.counters.bad_headers += 1
+        else:
+            return False
+        return True
 
     def _track_seq(self, seq: int) -> None:
         last = self._last_seq

@@ -5,11 +5,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import sys
+import logging
 from pathlib import Path
 
 from palpate.benchmarks import SECTIONS
 from palpate.benchmarks.report import BenchContext, BenchSection
+
+log = logging.getLogger(__name__)
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -18,7 +20,7 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--quick", action="store_true", help="fewer repeats and a coarser grid")
     parser.add_argument("--out", type=Path, default=Path("out/bench"), help="folder for plots")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="seed of every random draw")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -29,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
     results: list[BenchSection] = []
     for name in names:
         module = importlib.import_module(SECTIONS[name])
-        print(f"[bench] {name} ...", file=sys.stderr, flush=True)
+        log.info("[bench] %s ...", name)
         section: BenchSection = module.run(ctx)
         results.append(section)
         if not args.json:

@@ -16,7 +16,7 @@ from sensor.calibration import fit_strain_coefficient, load_pairs_csv
 def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, help="CSV with strain_ue and shift_pm columns")
     parser.add_argument(
-        "--confidence", type=float, default=0.95, help="confidence level of the interval (0.95)"
+        "--confidence", type=float, default=0.95, help="confidence level of the interval"
     )
     parser.add_argument(
         "--through-origin", action="store_true", help="fit shift = k * strain without intercept"

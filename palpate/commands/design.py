@@ -10,19 +10,13 @@ no design satisfies the constraints (the message names the failing constraint).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
-import sys
-import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-from tqdm import tqdm
-
 from config import load, load_stack, resolve
-from config.scene import SampleConfig, SceneConfig
+from config.scene import SceneConfig
 from config.schema import StackConfig
 from estimation.design import (
     DesignConstraints,
@@ -31,18 +25,22 @@ from estimation.design import (
     DesignSpace,
     design_sensor,
 )
-from palpate.campaign import (
-    campaign_trials,
-    default_workers,
-    median_abs_relative_error,
-    run_campaign,
+from palpate.campaign import campaign_trials, default_workers
+from palpate.designcheck import (
+    METHODS,
+    UNITS,
+    CheckSettings,
+    design_scene,
+    error_summary,
+    relative_error,
+    run_check,
 )
-from palpate.executors import add_executor_arguments, open_executor
+from palpate.executors import add_executor_arguments
+from palpate.progress import progress_bar
 from palpate.simtrial import TrialOutcome
 from sensor.strain import strain_noise
 from wire.dynamixel import TICKS_PER_REV
 
-UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}
 EXIT_NO_DESIGN = 2
 
 
@@ -89,14 +87,15 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="smallest indentation at buckling, in encoder counts",
     )
     space = DesignSpace()
-    parser.add_argument(
-        "--fiber-radii-um", default=",".join(f"{r * 1e6:g}" for r in space.fiber_radii)
-    )
-    parser.add_argument(
-        "--wire-diameters-um", default=",".join(f"{d * 1e6:g}" for d in space.wire_diameters)
-    )
-    parser.add_argument("--wire-counts", default=",".join(str(n) for n in space.wire_counts))
-    parser.add_argument("--tip-radii-mm", default=",".join(f"{r * 1e3:g}" for r in space.tip_radii))
+    for flag, values, what in (
+        ("--fiber-radii-um", [f"{r * 1e6:g}" for r in space.fiber_radii], "fiber radii"),
+        ("--wire-diameters-um", [f"{d * 1e6:g}" for d in space.wire_diameters], "wire diameters"),
+        ("--wire-counts", [str(n) for n in space.wire_counts], "numbers of NiTi wires"),
+        ("--tip-radii-mm", [f"{r * 1e3:g}" for r in space.tip_radii], "tip sphere radii"),
+    ):
+        parser.add_argument(
+            flag, default=",".join(values), help=f"{what} to consider (comma-separated)"
+        )
     parser.add_argument(
         "--length-range-mm",
         default=":".join(f"{v * 1e3:g}" for v in space.length_range),
@@ -115,8 +114,15 @@ def register(parser: argparse.ArgumentParser) -> None:
         default=0.0,
         help="contact-detection error (1 sigma) in the simulated campaign",
     )
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--workers", type=int, default=default_workers())
+    parser.add_argument(
+        "--seed", type=int, default=0, help="makes the simulated check reproducible"
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=default_workers(),
+        help="trials of the check run in parallel (processes, threads or local Dask workers)",
+    )
     add_executor_arguments(parser)
     parser.add_argument("--no-sim", action="store_true", help="skip the simulated campaign")
 
@@ -157,108 +163,39 @@ def _inputs(
     return (lo * unit, hi * unit), constraints, space
 
 
-def campaign_lengths(length: float, window: tuple[float, float], count: int) -> tuple[float, ...]:
-    """``count`` exposed lengths (m) around the proposed one, in the middle of the window where
-    the hardware passes every check (geometric means of each end with the proposal)."""
-    if count <= 1:
-        return (length,)
-    lo, hi = math.sqrt(window[0] * length), math.sqrt(window[1] * length)
-    return tuple(float(v) for v in np.linspace(lo, hi, count))
-
-
-def design_scene(
-    ev: DesignEvaluation,
-    window: tuple[float, float],
-    stack: StackConfig,
-    base: SceneConfig,
-    args: argparse.Namespace,
-) -> tuple[SceneConfig, StackConfig]:
-    """The proposed sensor on the robot, and a bench campaign on phantoms across the range.
-
-    The detector threshold comes from the design (the paper's 300 ue is for a sensor 100x
-    stiffer: its axial pre-load alone is 140 ue), and the travel guard from the predicted
-    indentation."""
-    d = ev.design
-    sensor = dataclasses.replace(
-        stack.sensor,
-        fiber_radius_mm=d.fiber_radius * 1e3,
-        wire_count=d.wire_count,
-        wire_radius_mm=d.wire_radius * 1e3,
-        tip_radius_mm=d.tip_radius * 1e3,
-        exposed_length_mm=d.exposed_length * 1e3,
-    )
-    unit = UNITS[args.unit]
-    lo, hi = ev.modulus_range
-    moduli = np.geomspace(lo, hi, max(1, args.moduli)) if args.moduli > 1 else np.array([lo])
-    thickness = None if math.isinf(args.thickness_mm) else args.thickness_mm
-    samples = tuple(
-        SampleConfig(
-            name=f"E{e / unit:.3g}{args.unit}",
-            modulus_kpa=float(e) / 1e3,
-            poisson=args.poisson,
-            thickness_mm=thickness,
-        )
-        for e in moduli
-    )
-    if ev.threshold is None:
-        raise ValueError("the design's buckling is not detectable: no detector threshold")
-    c = base.campaign
-    travel_mm = 1e3 * (3.0 * ev.delta_soft + ev.delta_bias) + c.post_buckling_mm + 0.5
-    campaign = dataclasses.replace(
-        c,
-        kind="bench",
-        samples=(),
-        exposed_lengths_mm=tuple(
-            round(v * 1e3, 1) for v in campaign_lengths(d.exposed_length, window, args.lengths)
-        ),
-        repeats=1,
-        detector="paper",
-        detector_threshold_ue=ev.threshold * 1e6,
-        max_travel_past_contact_mm=max(c.max_travel_past_contact_mm, travel_mm),
-    )
-    fidelity = dataclasses.replace(
-        base.fidelity,
-        imperfection_w0_over_l=args.imperfection,
+def _settings(args: argparse.Namespace) -> CheckSettings:
+    return CheckSettings(
+        unit=args.unit,
+        moduli=args.moduli,
+        lengths=args.lengths,
+        poisson=args.poisson,
+        thickness_mm=args.thickness_mm,
+        imperfection=args.imperfection,
         contact_uncertainty_mm=args.contact_uncertainty_mm,
     )
-    scene = dataclasses.replace(
-        base, name="design", samples=samples, fidelity=fidelity, campaign=campaign
-    )
-    return scene, dataclasses.replace(stack, sensor=sensor)
 
 
 def _run_sim(
     scene: SceneConfig, stack: StackConfig, args: argparse.Namespace
 ) -> tuple[list[TrialOutcome], float]:
     specs = campaign_trials(scene, stack, args.seed)
-    bar = tqdm(total=len(specs), desc="design check", unit="trial", file=sys.stderr)
+    bar = progress_bar(len(specs), "design check")
 
     def progress(o: TrialOutcome) -> None:
         bar.update(1)
         bar.set_postfix_str(o.spec.trial_id)
 
-    t0 = time.perf_counter()
-    with open_executor(args.executor, max(1, args.workers), args.scheduler) as executor:
-        outcomes = run_campaign(specs, scene, stack, executor=executor, progress=progress)
+    outcomes, wall = run_check(
+        specs,
+        scene,
+        stack,
+        executor=args.executor,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=progress,
+    )
     bar.close()
-    return outcomes, time.perf_counter() - t0
-
-
-METHODS = ("paper", "joint")
-"""The estimates shown: the paper's single point (Eqs. 13-14) and the contact-point-free fit."""
-
-
-def _relative_error(o: TrialOutcome, method: str) -> float | None:
-    m = o.modulus(method)
-    return None if m is None else (m - o.spec.modulus) / o.spec.modulus
-
-
-def _error_summary(outcomes: list[TrialOutcome], method: str) -> dict[str, float | None]:
-    errors = [abs(e) for e in (_relative_error(o, method) for o in outcomes) if e is not None]
-    return {
-        "median_abs_relative_error": median_abs_relative_error(outcomes, method),
-        "max_abs_relative_error": max(errors, default=None),
-    }
+    return outcomes, wall
 
 
 def run(args: argparse.Namespace) -> int:
@@ -276,7 +213,9 @@ def run(args: argparse.Namespace) -> int:
     if result.success and not args.no_sim:
         assert result.evaluation is not None
         assert result.length_window is not None
-        scene, sim_stack = design_scene(result.evaluation, result.length_window, stack, base, args)
+        scene, sim_stack = design_scene(
+            result.evaluation, result.length_window, stack, base, _settings(args)
+        )
         outcomes, wall = _run_sim(scene, sim_stack, args)
     if args.json:
         print(json.dumps(_payload(result, constraints, args, outcomes, wall), indent=2))
@@ -352,11 +291,11 @@ def _payload(
             "trials": [
                 {
                     **o.as_dict(),
-                    **{f"relative_error_{m}": _relative_error(o, m) for m in METHODS},
+                    **{f"relative_error_{m}": relative_error(o, m) for m in METHODS},
                 }
                 for o in outcomes
             ],
-            **{m: _error_summary(outcomes, m) for m in METHODS},
+            **{m: error_summary(outcomes, m) for m in METHODS},
             "wall_s": wall,
         },
     }
@@ -369,11 +308,30 @@ def _print(
     outcomes: list[TrialOutcome],
     wall: float,
 ) -> None:
-    ev = result.evaluation
-    unit = UNITS[args.unit]
     print(("design: " if result.success else "NO DESIGN: ") + result.message)
+    ev = result.evaluation
     if ev is None:
         return
+    print()
+    for k, v in _design_rows(result, ev, constraints, args.unit):
+        print(f"  {k:<20} {v}")
+    print()
+    print(f"  {'check':<13} {'value':>10} {'limit':>10} {'margin':>7}  ok")
+    for c in ev.checks:
+        print(
+            f"  {c.name:<13} {c.value:>10.4g} {c.limit:>10.4g} {c.margin:>7.2f}  "
+            f"{'yes' if c.ok else 'NO'}"
+        )
+    if outcomes:
+        print()
+        _print_campaign(outcomes, args, wall)
+
+
+def _design_rows(
+    result: DesignResult, ev: DesignEvaluation, constraints: DesignConstraints, unit_name: str
+) -> list[tuple[str, str]]:
+    """(label, value) of the proposed sensor and its predicted indentations."""
+    unit = UNITS[unit_name]
     d = ev.design
     lo, hi = ev.modulus_range
     counts = ev.delta_stiff / constraints.encoder_resolution
@@ -386,19 +344,19 @@ def _print(
         else "all checks pass for "
         f"{result.length_window[0] * 1e3:.1f}-{result.length_window[1] * 1e3:.1f} mm"
     )
-    rows = [
+    return [
         ("fiber radius", f"{d.fiber_radius * 1e6:g} um"),
         ("NiTi wires", wires),
         ("tip radius", f"{d.tip_radius * 1e3:g} mm"),
         ("exposed length", f"{d.exposed_length * 1e3:.1f} mm ({window})"),
         ("P_cr", f"{ev.critical_load * 1e3:.3g} mN"),
         (
-            f"delta at {lo / unit:g} {args.unit}",
+            f"delta at {lo / unit:g} {unit_name}",
             f"{ev.delta_soft * 1e3:.3f} mm (delta/R {ev.depth_ratio:.3f}, a/h "
             f"{ev.contact_ratio:.3f})",
         ),
         (
-            f"delta at {hi / unit:g} {args.unit}",
+            f"delta at {hi / unit:g} {unit_name}",
             f"{ev.delta_stiff * 1e3:.3f} mm ({counts:.0f} counts)",
         ),
         ("delta bias", f"{ev.delta_bias * 1e6:.1f} um (compression, detection, bow)"),
@@ -407,19 +365,10 @@ def _print(
             "-" if ev.threshold is None else f"{ev.threshold * 1e6:.1f} ue (strain norm)",
         ),
     ]
-    print()
-    for k, v in rows:
-        print(f"  {k:<20} {v}")
-    print()
-    print(f"  {'check':<13} {'value':>10} {'limit':>10} {'margin':>7}  ok")
-    for c in ev.checks:
-        print(
-            f"  {c.name:<13} {c.value:>10.4g} {c.limit:>10.4g} {c.margin:>7.2f}  "
-            f"{'yes' if c.ok else 'NO'}"
-        )
-    if not outcomes:
-        return
-    print()
+
+
+def _print_campaign(outcomes: list[TrialOutcome], args: argparse.Namespace, wall: float) -> None:
+    unit = UNITS[args.unit]
     print(f"simulated bench campaign with the proposed sensor ({args.executor} executor):")
     head = f"  {'trial':<34} {'actual':>8}"
     for m in METHODS:
@@ -428,12 +377,12 @@ def _print(
     for o in outcomes:
         line = f"  {o.spec.trial_id:<34} {o.spec.modulus / unit:>8.3f}"
         for m in METHODS:
-            value, err = o.modulus(m), _relative_error(o, m)
+            value, err = o.modulus(m), relative_error(o, m)
             line += " " + ("-" if value is None else f"{value / unit:.3f}").rjust(8)
             line += " " + ("-" if err is None else f"{100 * err:+.1f}%").rjust(8)
         print(f"{line}  {o.state}{'' if o.state == 'done' else ': ' + o.reason}")
     for m in METHODS:
-        summary = _error_summary(outcomes, m)
+        summary = error_summary(outcomes, m)
         mare, worst = summary["median_abs_relative_error"], summary["max_abs_relative_error"]
         if mare is not None and worst is not None:
             print(f"  {m}: median |relative error| {100 * mare:.1f} %, worst {100 * worst:.1f} %")

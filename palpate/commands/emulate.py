@@ -5,12 +5,15 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import logging
 import threading
 
 from config import load_stack
 from sensor.reader import layout_from_config
 from sim.board import BoardEmulator, constant_source
 from sim.dynamixel.bus import EmulatedBus
+
+log = logging.getLogger(__name__)
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -33,8 +36,8 @@ def run(args: argparse.Namespace) -> int:
             print(json.dumps(ports), flush=True)
         else:
             print(f"dynamixel bus (Protocol 2.0, {stack.servos.baudrate} bps): {bus.port}")
-            print(f"acquisition board ({stack.board.rate_hz:g} frames/s): {board.port}")
-            print("Ctrl-C to stop", flush=True)
+            print(f"acquisition board ({stack.board.rate_hz:g} frames/s): {board.port}", flush=True)
+        log.info("Ctrl-C to stop")
         stop = threading.Event()
         with contextlib.suppress(KeyboardInterrupt):
             stop.wait(args.seconds)

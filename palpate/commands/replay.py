@@ -4,106 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from pathlib import Path
-from typing import Any
 
-from config.loader import from_mapping
-from config.schema import SensorConfig, StackConfig, TubeConfig
-from estimation.section import Section
-from robot.trial.estimate import (
-    EstimatorInputs,
-    estimate_from_marks,
-    exposed_length_at,
-    joint_from_rows,
-)
-from robot.trial.log import TrialLog, TrialLogError, read_log
-from robot.trial.record import joint_record
+from palpate.replaylog import replay
+from robot.trial.log import TrialLogError
 
 
 def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", type=Path, help="a trial log (.jsonl) written by palpate sim/trial")
-
-
-def replay(path: Path) -> dict[str, Any]:
-    """Recompute the estimate from a log; raises TrialLogError (a ValueError) if unreadable."""
-    log = read_log(path)
-    h = log.header
-    report: dict[str, Any] = {
-        "log": str(path),
-        "trial": h.get("trial"),
-        "complete": log.complete,
-        "bad_lines": log.bad_lines,
-        "records": len(log.records),
-    }
-    end = log.end
-    if end is None:
-        transitions = list(log.of_kind("transition"))
-        last = transitions[-1]["to"] if transitions else "none"
-        report["message"] = (
-            f"truncated log: no end record ({len(log.records)} records kept, last state {last}); "
-            "no estimate can be reproduced"
-        )
-        return report
-    sensor = from_mapping(SensorConfig, _tuples(h["sensor"]), str(path), "sensor")
-    section = Section(**h["section"])
-    spec = h["spec"]
-    marks = end["marks"]
-    x_b = marks.get("x_buckling")
-    length: float | None = None
-    if x_b is not None:
-        flush = 0.0
-        if spec["kind"] == "robot":
-            flush = from_mapping(TubeConfig, h["tube"], str(path), "tube").flush_translation
-        length = exposed_length_at(spec["kind"], x_b, spec["exposed_length"], flush)
-    stack = StackConfig(sensor=sensor)
-    est = estimate_from_marks(
-        marks.get("x_contact"),
-        x_b,
-        tuple(marks.get("strains_at_buckling") or ()),
-        length,
-        stack,
-        section,
-        h["poisson"],
-    )
-    recorded = next(log.of_kind("estimate"), None)
-    modulus = None if est is None else est.modulus
-    report.update(
-        {
-            "state": end["state"],
-            "reason": end["reason"],
-            "modulus": modulus,
-            "recorded_modulus": None if recorded is None else recorded.get("modulus"),
-        }
-    )
-    rec = report["recorded_modulus"]
-    paper_same = (modulus is None and rec is None) or (
-        modulus is not None and rec is not None and math.isclose(modulus, rec, rel_tol=0, abs_tol=0)
-    )
-    report["identical"] = paper_same and _replay_joint(log, stack, section, report)
-    return report
-
-
-def _replay_joint(
-    log: TrialLog, stack: StackConfig, section: Section, report: dict[str, Any]
-) -> bool:
-    """Re-run the joint fit on the log's samples; True if it equals the recorded one exactly
-    (every field of the fit, compared as JSON values), or if the log predates it."""
-    recorded = next(log.of_kind("estimate"), None)
-    inputs = log.header.get("estimator")
-    if recorded is None or "joint" not in recorded or inputs is None:
-        report["joint"] = None
-        return True
-    rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
-    fit = joint_from_rows(rows, EstimatorInputs.from_dict(inputs), stack, section)
-    replayed = json.loads(json.dumps(joint_record(fit)))
-    report["joint"] = replayed
-    report["recorded_joint"] = recorded["joint"]
-    return bool(replayed == recorded["joint"])
-
-
-def _tuples(d: dict[str, Any]) -> dict[str, Any]:
-    return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
 
 
 def run(args: argparse.Namespace) -> int:

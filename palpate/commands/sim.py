@@ -4,12 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-
-from tqdm import tqdm
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
@@ -24,6 +21,7 @@ from palpate.campaign import (
 )
 from palpate.executors import add_executor_arguments, open_executor
 from palpate.preflight import check_campaign, check_reachable
+from palpate.progress import progress_bar
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec
 
 CAMPAIGNS = {"robot": ("robot",), "bench": ("bench",), "paper": ("bench", "robot")}
@@ -38,19 +36,26 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--scene", type=Path, help="a scene YAML (overrides --campaign)")
     parser.add_argument("--seed", type=int, default=0, help="makes the run reproducible")
-    parser.add_argument("--out", type=Path, default=Path("out/sim"), help="logs and plots")
-    parser.add_argument("--workers", type=int, default=default_workers())
+    parser.add_argument(
+        "--out", type=Path, default=Path("out/sim"), help="folder for the logs and plots"
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=default_workers(),
+        help="trials run in parallel (processes, threads or local Dask workers)",
+    )
     add_executor_arguments(parser)
     parser.add_argument(
         "--wire", action="store_true", help="servos and board over ptys (the hardware path)"
     )
     parser.add_argument("--limit", type=int, help="run only the first N trials")
-    parser.add_argument("--no-plots", action="store_true")
+    parser.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
     parser.add_argument(
         "--faults",
         action="store_true",
         help="the fault campaign: the scene's fault cases (default scene: scenes/faults.yaml); "
-        "prints fault, trials, safe stops, data kept (palpate/faults.py)",
+        "prints fault, trials, safe stops, data kept (palpate/faults/)",
     )
     parser.add_argument(
         "--compare-methods",
@@ -86,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     # every scene is loaded and checked first: a bad one stops the run before any trial moves
     campaigns = [_prepare(path, args) for path in paths]
     total = sum(len(c.specs) for c in campaigns)
-    bar = tqdm(total=total, desc="campaign", unit="trial", file=sys.stderr)
+    bar = progress_bar(total, "campaign")
 
     def progress(o: TrialOutcome) -> None:
         bar.update(1)

@@ -4,8 +4,9 @@
 world with a tissue sample of a scene, so strains and contact respond), on the real bench with
 ``--config config/bench.yaml``, or on any two ports with ``--servo-port`` and ``--board-port``.
 The terminal interface is the standard library's curses (no extra dependency; it runs over ssh
-and in tmux, which the tests use); the jog logic, limits and screen text are
-:mod:`robot.teleop`. Torque is released on quit, on Ctrl-C, on SIGTERM/SIGHUP and on a crash.
+and in tmux, which the tests use); the jog logic and limits are ``robot.teleop``, the screen's
+text ``palpate.commands.teleop_screen``. Torque is released on quit, on Ctrl-C, on SIGTERM/SIGHUP
+and on a crash.
 """
 
 from __future__ import annotations
@@ -26,11 +27,12 @@ from config.bench import load_bench
 from config.scene import CampaignConfig, SceneConfig
 from config.schema import StackConfig
 from config.targets import save_target
+from palpate.commands.teleop_screen import draw, key_name, render, screen_width
 from palpate.hardware import open_hardware, run_on_hardware
 from palpate.simbench import SimulatedBench
 from robot.indentation import State
 from robot.rig import ServoFbgRig
-from robot.teleop import Teleop, render
+from robot.teleop import Teleop
 from robot.trial.setup import detector_for, guards_for, rig_settings
 from sensor.clock import Clock, SystemClock
 from sensor.strain import StrainChain
@@ -68,6 +70,18 @@ class Session:
     saved: list[str] = field(default_factory=list)
 
 
+@dataclass
+class _Where:
+    """What teleop drives: the robot's configuration, the ports and how the title names them."""
+
+    stack: StackConfig
+    campaign: CampaignConfig
+    targets: Path
+    mode: str
+    ports: dict[str, Any] = field(default_factory=dict)
+    sim: SimulatedBench | None = None
+
+
 def run(args: argparse.Namespace) -> int:
     if not (sys.stdin.isatty() and sys.stdout.isatty()):
         raise ValueError("palpate teleop needs a terminal (stdin and stdout)")
@@ -75,54 +89,12 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--rate: {args.rate} outside 1..1000 ticks per second")
     if (args.servo_port is None) != (args.board_port is None):
         raise ValueError("--servo-port and --board-port go together")
-    sim: SimulatedBench | None = None
-    ports: dict[str, Any] = {}
-    if args.config is not None:
-        loaded = load_bench(args.config)
-        stack, campaign, targets = loaded.stack, loaded.bench.campaign, loaded.targets_path
-        ports = {
-            "servo_key": f"servos.port in {loaded.path}",
-            "board_key": f"board.port in {loaded.path}",
-        }
-        mode = f"bench {loaded.path}"
-    elif args.servo_port is not None:
-        stack, campaign = load_stack(args.robot), CampaignConfig()
-        targets = CONFIG_DIR / "targets.yaml"
-        ports = {"servo_key": "--servo-port", "board_key": "--board-port"}
-        mode = f"ports {args.servo_port} {args.board_port}"
-    else:
-        scene = load(SceneConfig, resolve(args.scene))
-        stack, campaign = load_stack(resolve(scene.robot)), scene.campaign
-        targets = CONFIG_DIR / "targets.yaml"
-        _check_tube(stack, args.tube)
-        sim = SimulatedBench(stack, scene, sample=args.sample, tube=args.tube, wire=False)
-        s = sim.sample
-        mode = f"simulator: sample {s.name} ({s.modulus_kpa:g} kPa), scene {scene.name}"
-    if args.servo_port is not None:
-        ports.update(servo_port=args.servo_port, board_port=args.board_port)
-    if sim is not None:
-        ports.update(servo_port=sim.servo_port, board_port=sim.board_port)
+    where = _where(args)
     if args.targets is not None:
-        targets = args.targets
-    _check_tube(stack, args.tube)
+        where.targets = args.targets
+    _check_tube(where.stack, args.tube)
     summary: dict[str, Any] = {}
-
-    def body() -> int:
-        with contextlib.ExitStack() as stack_:
-            if sim is not None:
-                stack_.enter_context(sim)
-            hw = stack_.enter_context(open_hardware(stack, clock=SystemClock(), **ports))
-            session = _session(stack, campaign, hw.drive, hw.reader, hw.clock, args, targets)
-            session.title = f"palpate teleop ({mode})"
-            session.sim = sim
-            try:
-                os.environ.setdefault("ESCDELAY", "25")  # a lone Esc cancels at once
-                summary.update(curses.wrapper(_loop, session))
-            finally:
-                session.rig.release()
-        return 0
-
-    code = run_on_hardware("teleop", body, stopped_exit=0)
+    code = run_on_hardware("teleop", lambda: _body(where, args, summary), stopped_exit=0)
     if code or not summary:
         return code
     if args.json:
@@ -131,6 +103,57 @@ def run(args: argparse.Namespace) -> int:
         for name in summary["saved"]:
             print(f"saved target {name!r} in {summary['targets']}")
         print(f"final state {summary['state']}; torque off")
+    return 0
+
+
+def _where(args: argparse.Namespace) -> _Where:
+    """The bench file's robot and ports, the given ports, or the simulator (the default)."""
+    if args.config is not None:
+        loaded = load_bench(args.config)
+        ports = {
+            "servo_key": f"servos.port in {loaded.path}",
+            "board_key": f"board.port in {loaded.path}",
+        }
+        b = loaded.bench
+        where = _Where(loaded.stack, b.campaign, loaded.targets_path, f"bench {loaded.path}", ports)
+    elif args.servo_port is not None:
+        ports = {"servo_key": "--servo-port", "board_key": "--board-port"}
+        mode = f"ports {args.servo_port} {args.board_port}"
+        targets = CONFIG_DIR / "targets.yaml"
+        where = _Where(load_stack(args.robot), CampaignConfig(), targets, mode, ports)
+    else:
+        return _simulator(args)
+    where.ports.update(servo_port=args.servo_port, board_port=args.board_port)
+    return where
+
+
+def _simulator(args: argparse.Namespace) -> _Where:
+    scene = load(SceneConfig, resolve(args.scene))
+    stack = load_stack(resolve(scene.robot))
+    _check_tube(stack, args.tube)
+    sim = SimulatedBench(stack, scene, sample=args.sample, tube=args.tube, wire=False)
+    s = sim.sample
+    mode = f"simulator: sample {s.name} ({s.modulus_kpa:g} kPa), scene {scene.name}"
+    ports = {"servo_port": sim.servo_port, "board_port": sim.board_port}
+    return _Where(stack, scene.campaign, CONFIG_DIR / "targets.yaml", mode, ports, sim)
+
+
+def _body(where: _Where, args: argparse.Namespace, summary: dict[str, Any]) -> int:
+    """Open the robot, zero the sensor, run the terminal loop; torque off on the way out."""
+    with contextlib.ExitStack() as stack_:
+        if where.sim is not None:
+            stack_.enter_context(where.sim)
+        hw = stack_.enter_context(open_hardware(where.stack, clock=SystemClock(), **where.ports))
+        session = _session(
+            where.stack, where.campaign, hw.drive, hw.reader, hw.clock, args, where.targets
+        )
+        session.title = f"palpate teleop ({where.mode})"
+        session.sim = where.sim
+        try:
+            os.environ.setdefault("ESCDELAY", "25")  # a lone Esc cancels at once
+            summary.update(curses.wrapper(_loop, session))
+        finally:
+            session.rig.release()
     return 0
 
 
@@ -160,30 +183,6 @@ def _session(
         tube_name=args.tube,
     )
     return Session(model, rig, clock, tick, targets, "palpate teleop")
-
-
-_SPECIAL_KEYS = {
-    curses.KEY_UP: "up",
-    curses.KEY_DOWN: "down",
-    curses.KEY_LEFT: "left",
-    curses.KEY_RIGHT: "right",
-    curses.KEY_ENTER: "enter",
-    10: "enter",
-    13: "enter",
-    27: "escape",
-    curses.KEY_BACKSPACE: "backspace",
-    127: "backspace",
-    8: "backspace",
-}
-
-
-def key_name(code: int) -> str | None:
-    """A curses key code as the key name :mod:`robot.teleop` uses; None for others."""
-    if code in _SPECIAL_KEYS:
-        return _SPECIAL_KEYS[code]
-    if 32 <= code < 127:
-        return chr(code)
-    return None
 
 
 def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
@@ -218,7 +217,7 @@ def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
         rig.command(cmd)
         now = clock.now()
         if now >= next_draw:
-            _draw(stdscr, render(model.view(), _width(stdscr), s.title))
+            draw(stdscr, render(model.view(), screen_width(stdscr), s.title))
             next_draw = now + DRAW_PERIOD_S
         # fell behind (a slow draw)? then do not try to catch up in a burst
         next_tick = max(next_tick + s.tick, now)
@@ -233,20 +232,6 @@ def _save(s: Session, name: str) -> None:
         return
     s.saved.append(name)
     s.model.message = f"saved pose {name!r} in {s.targets}"
-
-
-def _width(stdscr: Any) -> int:
-    _, w = stdscr.getmaxyx()
-    return max(1, int(w) - 1)
-
-
-def _draw(stdscr: Any, lines: list[str]) -> None:
-    stdscr.erase()
-    h, _ = stdscr.getmaxyx()
-    for row, line in enumerate(lines[: max(0, int(h))]):
-        with contextlib.suppress(curses.error):
-            stdscr.addstr(row, 0, line)
-    stdscr.refresh()
 
 
 def _summary(s: Session) -> dict[str, Any]:

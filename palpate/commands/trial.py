@@ -31,7 +31,9 @@ from sensor.reader import SerialLike
 
 def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--config", default="bench.yaml", help="the bench file (default: config/bench.yaml)"
+        "--config",
+        default="bench.yaml",
+        help="the bench file: a path, or a name in the shipped config/",
     )
     parser.add_argument("--target", help="run only the trials at this stored pose")
     parser.add_argument(

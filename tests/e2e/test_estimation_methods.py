@@ -9,8 +9,8 @@ import pytest
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.commands.replay import replay
 from palpate.compare import compare_methods
+from palpate.replaylog import replay
 from palpate.simtrial import TrialOutcome, TrialSpec, run_sim_trial
 from robot.trial.setup import sensor_section
 

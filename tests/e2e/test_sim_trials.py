@@ -11,7 +11,7 @@ import pytest
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.cli import main
-from palpate.commands.replay import replay
+from palpate.replaylog import replay
 from palpate.simtrial import TrialSpec, run_sim_trial
 from robot.trial.log import read_log
 

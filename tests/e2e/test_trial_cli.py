@@ -23,9 +23,9 @@ from config.bench import LoadedBench, load_bench
 from config.scene import SceneConfig
 from palpate.benchtrial import SKIPPED, BenchOutcome, plan_bench_trials
 from palpate.cli import main
-from palpate.commands.replay import replay
 from palpate.commands.trial import run_session
 from palpate.hardware import HardwareError, explain, open_hardware
+from palpate.replaylog import replay
 from palpate.simbench import SimulatedBench, surface_at
 from robot.motors import ServoTransportError
 from robot.trial.log import read_log

@@ -1,7 +1,8 @@
 """Fuzzing (Hypothesis, seeded by the "ci" profile, a few seconds in all): the frame parser, the
 servo emulator's packet handling, the driver's reply handling and the config loader take any
 input and fail only in their documented ways. The targets and their invariants live in
-``bench/fuzz.py``; ``palpate bench --only fuzz`` runs them long."""
+``palpate/benchmarks/fuzztargets.py`` and ``fuzzconfig.py``; ``palpate bench --only fuzz`` runs them
+long."""
 
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ from hypothesis import strategies as st
 
 from config.scene import SceneConfig
 from config.schema import StackConfig
-from palpate.benchmarks import fuzz
+from palpate.benchmarks import fuzzconfig
+from palpate.benchmarks import fuzztargets as fuzz
 from sim.dynamixel import protocol
 
 seeds = st.integers(0, 2**32 - 1)
@@ -135,13 +137,15 @@ SCHEMAS = st.sampled_from([StackConfig, SceneConfig])
 
 @given(SCHEMAS, yaml_values)
 def test_config_loader_on_random_mappings(cls: type, data: object) -> None:
-    fuzz.config_mapping_case(cls, data)
+    fuzzconfig.config_mapping_case(cls, data)
 
 
 @given(SCHEMAS, seeds)
 def test_config_loader_on_mutated_defaults(cls: type, seed: int) -> None:
     rng = np.random.default_rng(seed)
-    fuzz.config_mapping_case(cls, fuzz.mutate_mapping(fuzz.default_mapping(cls), rng))
+    fuzzconfig.config_mapping_case(
+        cls, fuzzconfig.mutate_mapping(fuzzconfig.default_mapping(cls), rng)
+    )
 
 
 @given(SCHEMAS, st.text(max_size=120))
@@ -149,7 +153,7 @@ def test_config_loader_on_random_text(
     tmp_path_factory: pytest.TempPathFactory, cls: type, text: str
 ) -> None:
     path = tmp_path_factory.getbasetemp() / "fuzz.yaml"
-    fuzz.config_text_case(cls, text, path)
+    fuzzconfig.config_text_case(cls, text, path)
 
 
 @given(SCHEMAS, seeds)
@@ -157,18 +161,18 @@ def test_config_loader_on_mutated_yaml(
     tmp_path_factory: pytest.TempPathFactory, cls: type, seed: int
 ) -> None:
     rng = np.random.default_rng(seed)
-    text = yaml.safe_dump(fuzz.default_mapping(cls))
-    fuzz.config_text_case(
-        cls, fuzz.mutate_text(text, rng), tmp_path_factory.getbasetemp() / "m.yaml"
+    text = yaml.safe_dump(fuzzconfig.default_mapping(cls))
+    fuzzconfig.config_text_case(
+        cls, fuzzconfig.mutate_text(text, rng), tmp_path_factory.getbasetemp() / "m.yaml"
     )
 
 
 def test_config_defaults_load(tmp_path: Path) -> None:
     """The fuzz's starting points are valid, so mutations explore near-valid files."""
     for cls in (StackConfig, SceneConfig):
-        assert fuzz.config_mapping_case(cls, fuzz.default_mapping(cls))
-        assert fuzz.config_text_case(
-            cls, yaml.safe_dump(fuzz.default_mapping(cls)), tmp_path / "d.yaml"
+        assert fuzzconfig.config_mapping_case(cls, fuzzconfig.default_mapping(cls))
+        assert fuzzconfig.config_text_case(
+            cls, yaml.safe_dump(fuzzconfig.default_mapping(cls)), tmp_path / "d.yaml"
         )
 
 

@@ -1,11 +1,5 @@
-"""Teleoperation: jog roll, advance and tube by key, within the limits of a scripted trial.
-
-Pure logic, no terminal and no hardware, so it is unit-tested like the state machine: the
-terminal front end (``palpate teleop``) turns key codes into key names, calls :meth:`Teleop.press`
-for each and :meth:`Teleop.step` once per control tick with the rig's
-:class:`~robot.indentation.Observation`, sends the returned
-:class:`~robot.indentation.Command` to the same :class:`robot.rig.ServoFbgRig` a trial uses, and
-draws :func:`render` of :meth:`Teleop.view`.
+"""The jog model: :class:`Teleop` turns key names into goals, within the limits of a scripted
+trial.
 
 Safety, the same rules as a scripted trial:
 
@@ -28,10 +22,8 @@ goal), ``retracting``, ``aborted`` (after an emergency stop), ``fault``.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
 
 from config.schema import DriveConfig, TubeConfig
 from config.targets import TargetConfig
@@ -45,117 +37,17 @@ from robot.indentation import (
     State,
     limit_violation,
 )
-
-Action = Literal[
-    "advance",
-    "retract",
-    "roll+",
-    "roll-",
-    "tube+",
-    "tube-",
-    "step+",
-    "step-",
-    "speed+",
-    "speed-",
-    "estop",
-    "rearm",
-    "save",
-    "quit",
-]
-
-# Key names (what the terminal front end passes) -> actions. Arrow keys and vi keys both jog.
-KEYMAP: dict[str, Action] = {
-    "up": "advance",
-    "k": "advance",
-    "down": "retract",
-    "j": "retract",
-    "right": "roll+",
-    "l": "roll+",
-    "left": "roll-",
-    "h": "roll-",
-    "t": "tube+",
-    "T": "tube-",
-    "+": "step+",
-    "=": "step+",
-    "-": "step-",
-    "]": "speed+",
-    "[": "speed-",
-    " ": "estop",
-    "r": "rearm",
-    "s": "save",
-    "q": "quit",
-}
-ESTOP_KEY = " "
-HELP = (
-    "up/k advance  down/j retract  left/h right/l roll  t/T tube  +/- step  [/] speed",
-    "SPACE emergency stop (retract)  r re-arm  s save pose as target  q quit (torque off)",
+from robot.teleop.interface import (
+    ESTOP_KEY,
+    KEYMAP,
+    MAX_NAME,
+    NAME_CHARS,
+    Effect,
+    JogSettings,
+    TeleopView,
 )
+
 LATCHED = frozenset({State.RETRACTING, State.ABORTED, State.FAULT})
-NAME_CHARS = re.compile(r"[A-Za-z0-9_.-]")
-MAX_NAME = 40
-
-
-@dataclass(frozen=True)
-class JogSettings:
-    """Step sizes (advance m, roll rad, chosen together), advance speeds (m/s) and margins."""
-
-    steps: tuple[tuple[float, float], ...] = (
-        (0.1e-3, math.radians(1.0)),
-        (0.5e-3, math.radians(5.0)),
-        (1e-3, math.radians(10.0)),
-        (5e-3, math.radians(45.0)),
-    )
-    step_index: int = 2
-    speeds: tuple[float, ...] = (0.5e-3, 1e-3, 2e-3, 5e-3)
-    speed_index: int = 2
-    travel_margin: float = 20e-6  # jogs stop this short of the travel-past-contact limit (m)
-    position_tolerance: float = 15e-6  # m: "there" for the advance (about 3 encoder ticks)
-    roll_tolerance: float = 2e-3  # rad
-
-    def __post_init__(self) -> None:
-        if not self.steps or not self.speeds:
-            raise ValueError("teleop needs at least one step size and one speed")
-        if not 0 <= self.step_index < len(self.steps):
-            raise ValueError(f"step_index {self.step_index} outside 0..{len(self.steps) - 1}")
-        if not 0 <= self.speed_index < len(self.speeds):
-            raise ValueError(f"speed_index {self.speed_index} outside 0..{len(self.speeds) - 1}")
-
-
-@dataclass(frozen=True)
-class Effect:
-    """Something only the front end can do: quit, save a target, re-enable torque after a
-    fault (``recover``), or mount another tube in a simulated world (``tube``)."""
-
-    kind: Literal["quit", "save", "recover", "tube"]
-    value: str = ""
-
-
-@dataclass(frozen=True)
-class TeleopView:
-    """Everything the screen shows, in SI; None where nothing was measured yet."""
-
-    state: State
-    tube: TubeConfig
-    roll: float | None
-    advance: float | None
-    goal: JointState | None
-    step: tuple[float, float]
-    speed: float
-    exposed_length: float | None
-    tube_tip: tuple[float, float, float] | None
-    tangent: tuple[float, float, float] | None
-    sensor_tip: tuple[float, float, float] | None
-    strains: tuple[float, ...]
-    strain_norm: float
-    strain_limit: float
-    contact: bool
-    buckled: bool
-    travel_past_contact: float | None
-    travel_limit: float
-    stream_age: float
-    fault: str | None
-    message: str
-    prompt: str | None
 
 
 @dataclass
@@ -495,55 +387,3 @@ class Teleop:
 
 def _triple(v: kinematics.Vector) -> tuple[float, float, float]:
     return float(v[0]), float(v[1]), float(v[2])
-
-
-def _mm(v: float | None, width: int = 9, digits: int = 3) -> str:
-    return f"{'-':>{width}}" if v is None else f"{v * 1e3:{width}.{digits}f}"
-
-
-def _flag(on: bool) -> str:
-    return "YES " if on else "no  "
-
-
-def _xyz(v: tuple[float, float, float] | None, scale: float, digits: int) -> str:
-    if v is None:
-        return "-"
-    return "  ".join(f"{axis} {c * scale:+8.{digits}f}" for axis, c in zip("xyz", v, strict=True))
-
-
-def render(view: TeleopView, width: int = 80, title: str = "palpate teleop") -> list[str]:
-    """The screen as lines of text (no terminal codes), each cut to ``width``."""
-    g = view.goal
-    roll_deg = None if view.roll is None else math.degrees(view.roll)
-    goal_roll = "-" if g is None else f"{math.degrees(g.roll):8.2f}"
-    goal_adv = "-" if g is None else f"{g.translation * 1e3:9.3f}"
-    strains = "  ".join(f"e{i + 1} {s * 1e6:+8.1f}" for i, s in enumerate(view.strains)) or "-"
-    past = view.travel_past_contact
-    stream = "ok" if view.stream_age <= 0.5 else "LOST"
-    lines = [
-        title,
-        f"state      {view.state.value.upper()}",
-        f"tube       {view.tube.name} ({view.tube.tip_angle_deg:g} deg)",
-        f"roll       {'-' if roll_deg is None else f'{roll_deg:9.2f}'} deg   goal {goal_roll} deg",
-        f"advance    {_mm(view.advance)} mm   goal {goal_adv} mm",
-        f"exposed    {_mm(view.exposed_length)} mm",
-        f"step       {view.step[0] * 1e3:.3g} mm / {math.degrees(view.step[1]):.3g} deg"
-        f"   speed {view.speed * 1e3:.3g} mm/s",
-        "",
-        f"tube tip   {_xyz(view.tube_tip, 1e3, 2)} mm",
-        f"tangent    {_xyz(view.tangent, 1.0, 3)}",
-        f"sensor tip {_xyz(view.sensor_tip, 1e3, 2)} mm",
-        "",
-        f"strains    {strains} ue",
-        f"norm       {view.strain_norm * 1e6:8.1f} ue   limit {view.strain_limit * 1e6:.0f} ue"
-        f"   FBG stream {stream}",
-        f"contact    {_flag(view.contact)} buckled {_flag(view.buckled)}"
-        f" past contact {_mm(past, 6)} / {view.travel_limit * 1e3:.2f} mm",
-        f"fault      {view.fault or '-'}",
-        "",
-        f"> {view.message}",
-    ]
-    if view.prompt is not None:
-        lines.append(f"save as: {view.prompt}_")
-    lines += ["", *HELP]
-    return [line[:width] for line in lines]

@@ -1,0 +1,181 @@
+"""The layers of DESIGN.md, read from every module's imports (ast, so imports inside functions
+count too): which package may import which, and no two packages importing each other.
+
+wire imports nothing of ours; config only config; estimation only estimation and config; sensor
+wire, estimation, config; robot wire, estimation, sensor, config; sim wire, estimation, config
+(never sensor, robot or palpate); palpate, the application, anything. Tests are not a layer.
+"""
+
+from __future__ import annotations
+
+import ast
+import itertools
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+ALLOWED: dict[str, frozenset[str]] = {
+    "wire": frozenset({"wire"}),
+    "config": frozenset({"config"}),
+    "estimation": frozenset({"estimation", "config"}),
+    "sensor": frozenset({"sensor", "wire", "estimation", "config"}),
+    "robot": frozenset({"robot", "wire", "estimation", "sensor", "config"}),
+    "sim": frozenset({"sim", "wire", "estimation", "config"}),
+    "palpate": frozenset({"palpate", "wire", "config", "estimation", "sensor", "robot", "sim"}),
+}
+PACKAGES = frozenset(ALLOWED)
+
+
+def module_name(path: Path, root: Path = ROOT) -> str:
+    parts = path.relative_to(root).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imported_modules(path: Path, root: Path = ROOT) -> Iterator[tuple[int, str]]:
+    """(line, absolute name) of every import in the file, relative ones resolved; ``from a
+    import b`` gives ``a.b`` (``b`` may be a module or a name in ``a``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+    package = module_name(path, root)
+    if path.name != "__init__.py":
+        package = package.rpartition(".")[0]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield node.lineno, alias.name
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                base = ".".join([*anchor, base]) if base else ".".join(anchor)
+            for alias in node.names:  # a name may be a module: ``from sim.dynamixel import bus``
+                yield node.lineno, f"{base}.{alias.name}"
+
+
+def our_imports(root: Path = ROOT) -> Iterator[tuple[str, str, str]]:
+    """(importing package, imported package, "file:line module") for imports between ours."""
+    for package in sorted(PACKAGES):
+        for path in sorted((root / package).rglob("*.py")):
+            for line, name in imported_modules(path, root):
+                top = name.partition(".")[0]
+                if top in PACKAGES:
+                    where = f"{path.relative_to(root)}:{line} {name}"
+                    yield package, top, where
+
+
+def package_graph(root: Path = ROOT) -> dict[str, set[str]]:
+    graph: dict[str, set[str]] = {p: set() for p in PACKAGES}
+    for source, target, _ in our_imports(root):
+        if source != target:
+            graph[source].add(target)
+    return graph
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """A cycle of the directed graph as [a, b, ..., a], or None."""
+    state: dict[str, int] = {}  # 1: on the current path, 2: done
+    path: list[str] = []
+
+    def visit(node: str) -> list[str] | None:
+        state[node] = 1
+        path.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                return [*path[path.index(nxt) :], nxt]
+            if nxt not in state and (cycle := visit(nxt)) is not None:
+                return cycle
+        path.pop()
+        state[node] = 2
+        return None
+
+    for node in sorted(graph):
+        if node not in state and (cycle := visit(node)) is not None:
+            return cycle
+    return None
+
+
+def subpackages(root: Path = ROOT) -> frozenset[str]:
+    """Every package of ours, top-level and nested (a folder with an ``__init__.py``)."""
+    return frozenset(
+        module_name(init, root)
+        for package in PACKAGES
+        for init in (root / package).rglob("__init__.py")
+    )
+
+
+def package_of(name: str, packages: frozenset[str]) -> str:
+    """The deepest package of ours that holds the module or name ``name``."""
+    parts = name.split(".")
+    for n in range(len(parts), 0, -1):
+        if ".".join(parts[:n]) in packages:
+            return ".".join(parts[:n])
+    raise ValueError(f"{name} is not in one of our packages")
+
+
+def subpackage_graph(root: Path = ROOT) -> dict[str, set[str]]:
+    """Imports between packages at any depth, leaving out a package and its own subpackages
+    (``sim`` and ``sim.dynamixel`` are one room)."""
+    packages = subpackages(root)
+    graph: dict[str, set[str]] = {p: set() for p in packages}
+    for package in PACKAGES:
+        for path in (root / package).rglob("*.py"):
+            source = package_of(module_name(path, root), packages)
+            for _, name in imported_modules(path, root):
+                if name.partition(".")[0] not in PACKAGES:
+                    continue
+                target = package_of(name, packages)
+                nested = f"{target}.".startswith(f"{source}.") or f"{source}.".startswith(
+                    f"{target}."
+                )
+                if not nested:
+                    graph[source].add(target)
+    return graph
+
+
+@pytest.mark.parametrize("package", sorted(PACKAGES))
+def test_a_package_imports_only_the_layers_below_it(package: str) -> None:
+    bad = [
+        where
+        for source, target, where in our_imports()
+        if source == package and target not in ALLOWED[package]
+    ]
+    assert not bad, f"{package} may import only {sorted(ALLOWED[package])}:\n" + "\n".join(bad)
+
+
+def test_no_two_packages_import_each_other() -> None:
+    graph = package_graph()
+    mutual = [
+        (a, b)
+        for a, b in itertools.combinations(sorted(graph), 2)
+        if b in graph[a] and a in graph[b]
+    ]
+    assert not mutual
+    assert find_cycle(graph) is None
+
+
+def test_no_two_subpackages_import_each_other() -> None:
+    """Inside a layer too: e.g. palpate.faults may use palpate.replaylog, but not a command
+    module that imports palpate.faults back."""
+    assert find_cycle(subpackage_graph()) is None
+
+
+def test_the_check_sees_every_kind_of_import(tmp_path: Path) -> None:
+    """Imports inside functions and relative imports are found; a cycle is found."""
+    pkg = tmp_path / "robot" / "teleop"
+    pkg.mkdir(parents=True)
+    (tmp_path / "robot" / "__init__.py").write_text("", encoding="utf-8")
+    (pkg / "__init__.py").write_text("from . import model\n", encoding="utf-8")
+    (pkg / "model.py").write_text(
+        "import math\n\ndef f():\n    from sim.world import World\n    from ..drive import x\n",
+        encoding="utf-8",
+    )
+    found = {name for _, name in imported_modules(pkg / "model.py", tmp_path)}
+    assert found == {"math", "sim.world.World", "robot.drive.x"}
+    assert {name for _, name in imported_modules(pkg / "__init__.py", tmp_path)} == {
+        "robot.teleop.model"
+    }
+    assert package_of("robot.teleop.model", subpackages(tmp_path)) == "robot.teleop"
+    assert package_of("robot.drive.x", subpackages(tmp_path)) == "robot"
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
