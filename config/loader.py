@@ -93,19 +93,24 @@ def _convert(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any
 
 
 def _convert_union(tp: Any, value: Any, source: str, path: str, meta: Mapping[str, Any]) -> Any:
-    """The first option of ``X | Y | None`` that accepts ``value``; else every option's problem."""
+    """The first option of ``X | Y | None`` that accepts ``value``. Else: an option whose shape
+    fits but a key inside it is wrong gives that key's error (``assumed.poisson[1]: must be <=
+    0.5``), otherwise every option's problem at ``path``."""
     options = get_args(tp)
     if value is None and type(None) in options:
         return None
-    errors = []
+    errors: list[ConfigError] = []
     for option in options:
         if option is type(None):
             continue
         try:
             return _convert(option, value, source, path, meta)
         except ConfigError as exc:
-            errors.append(exc.problem)
-    raise ConfigError(source, path, " / ".join(errors))
+            errors.append(exc)
+    deeper = [exc for exc in errors if exc.key != path]
+    if deeper:
+        raise deeper[0]
+    raise ConfigError(source, path, " / ".join(exc.problem for exc in errors))
 
 
 def _convert_sequence(

@@ -13,40 +13,11 @@ from typing import Literal
 
 from config.faults import FaultsConfig
 from config.loader import limits
-from config.schema import DEFAULT_CONTROL_RATE_HZ, MM
-
-KPA = 1e3
+from config.sample import PAPER_SAMPLES, SampleConfig
+from config.schema import DEFAULT_CONTROL_RATE_HZ
 
 Orientation = Literal["downward", "sideways", "upward"]
 ORIENTATION_ROLL_DEG: dict[str, float] = {"downward": 0.0, "sideways": 90.0, "upward": 180.0}
-
-
-@dataclass(frozen=True)
-class SampleConfig:
-    """A tissue phantom: modulus, Poisson's ratio, layer thickness (null = half-space)."""
-
-    name: str
-    modulus_kpa: float = field(metadata=limits(gt=0, le=1e6))
-    poisson: float = field(default=0.45, metadata=limits(ge=0, le=0.5))
-    thickness_mm: float | None = field(default=10.0, metadata=limits(gt=0, le=1000))
-    bonded: bool = True
-
-    @property
-    def modulus(self) -> float:
-        return self.modulus_kpa * KPA
-
-    @property
-    def thickness(self) -> float | None:
-        return None if self.thickness_mm is None else self.thickness_mm * MM
-
-
-# Paper Table I: actual moduli (kPa) of the 11 PDMS / PA-gel phantoms.
-TABLE_I_KPA: tuple[float, ...] = (
-    1023.67, 706.30, 504.03, 823.77, 529.33, 908.88, 1122.86, 314.53, 716.74, 499.56, 323.78,
-)  # fmt: skip
-PAPER_SAMPLES: tuple[SampleConfig, ...] = tuple(
-    SampleConfig(name=f"S{i}", modulus_kpa=e) for i, e in enumerate(TABLE_I_KPA, start=1)
-)
 
 
 @dataclass(frozen=True)
@@ -65,6 +36,12 @@ class FidelityConfig:
     large_indentation: bool = True
     tube_tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
     temperature_drift_degc_per_s: float = field(default=0.0, metadata=limits(ge=-10, le=10))
+    # The tissue's force law: "fe" solves each sample's own finite-element model (sim/fem);
+    # "closed-form" is Sneddon's sphere with the thin-layer series, the estimator's own family of
+    # laws (cheap; a scene that picks it judges the estimator on its own model).
+    tissue_model: Literal["fe", "closed-form"] = "closed-form"
+    viscoelastic: bool = False  # the samples' standard-linear-solid relaxation (off: elastic)
+    gravity: bool = False  # gravity on the sensor beam and the tubes (pre-bend, tip sag)
 
 
 @dataclass(frozen=True)
@@ -87,6 +64,10 @@ class CampaignConfig:
     detector: Literal["paper", "cusum"] = "paper"
     detector_threshold_ue: float = field(default=300.0, metadata=limits(gt=0, le=10000))
     outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))
+    # Find the surface normal by light touches before indenting; null: on for robot campaigns,
+    # off on the vertical bench stage.
+    probe: bool | None = None
+    misalignment_tolerance_deg: float = field(default=2.0, metadata=limits(gt=0, le=45))
 
     @property
     def orientation_rolls_deg(self) -> tuple[float, ...]:

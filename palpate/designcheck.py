@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from config.scene import SampleConfig, SceneConfig
+from config.sample import SampleConfig
+from config.scene import SceneConfig
 from config.schema import StackConfig
 from estimation.design import DesignEvaluation
 from palpate.campaign import median_abs_relative_error, run_campaign

@@ -17,7 +17,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from config.scene import FidelityConfig, SampleConfig, SceneConfig
+from config.sample import SampleConfig
+from config.scene import FidelityConfig, SceneConfig
 from config.schema import StackConfig
 from robot import kinematics
 from robot.drive import TRANSLATION, RollerGearDrive

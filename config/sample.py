@@ -1,0 +1,137 @@
+"""A tissue sample: what the world is (truth), where it is, and what the operator believes.
+
+A scene's ``samples[]`` entry describes the world's truth: modulus, Poisson's ratio, layer
+thickness and bonding, material, viscoelasticity, the surface's pose and friction. The
+estimator is never told the truth: it is told what the operator believes, the ``assumed:``
+block (:class:`AssumedConfig`), or, without one, the sample's own values. So a scene can make
+the belief wrong, as it is on a real bench::
+
+    samples:
+      - {name: S8, modulus_kpa: 314.53, thickness_mm: 6, bonded: false, poisson: 0.45,
+         assumed: {thickness_mm: [5, 20], bonded: unknown, poisson: [0.40, 0.50]}}
+
+Units are in the key when not SI; the SI values are properties without the suffix.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+from config.loader import limits
+from config.schema import MM
+
+KPA = 1e3
+UNKNOWN = "unknown"
+HALF_SPACE = "half-space"
+
+Range = tuple[float, float]
+
+
+def _check_range(key: str, value: object, lo: float, hi: float) -> None:
+    if isinstance(value, tuple) and not lo <= value[0] <= value[1] <= hi:
+        raise ValueError(f"{key}: a range [min, max] needs {lo} <= min <= max <= {hi}, got {value}")
+
+
+@dataclass(frozen=True)
+class AssumedConfig:
+    """What the operator believes about a sample; the estimator is told this.
+
+    Each key is a value, a ``[min, max]`` range or ``unknown``; ``thickness_mm`` may also be
+    ``half-space``. A key left out (null) means, in a scene, the sample's own value (the
+    operator knows it), and on the bench: thickness and bonding ``unknown``, Poisson's ratio
+    the trial's ``poisson``. The estimate's interval carries what a range or ``unknown``
+    leaves open (profiled or marginalised), not only the FBG noise.
+    """
+
+    thickness_mm: float | Range | Literal["unknown", "half-space"] | None = field(
+        default=None, metadata=limits(gt=0, le=1000)
+    )
+    bonded: bool | Literal["unknown"] | None = None
+    poisson: float | Range | Literal["unknown"] | None = field(
+        default=None, metadata=limits(ge=0, le=0.5)
+    )
+
+    def validate(self) -> None:
+        _check_range("thickness_mm", self.thickness_mm, 0.0, 1000.0)
+        _check_range("poisson", self.poisson, 0.0, 0.5)
+
+
+@dataclass(frozen=True)
+class SampleConfig:
+    """A tissue phantom as the world has it, and where it sits.
+
+    Truth: ``modulus_kpa``, ``poisson``, ``thickness_mm`` (null = half-space) on a rigid base,
+    ``bonded`` to it or sliding, ``material`` (linear elastic or neo-Hookean),
+    ``lateral_radius_mm`` (the sample's finite lateral size), a standard-linear-solid relaxation
+    (``relaxation_time_s``, null = elastic, and ``relaxed_ratio`` = E_inf / E_0, used where the
+    scene's fidelity switches viscoelasticity on), the Coulomb ``friction`` between tip and
+    surface, and ``rigid`` (a rigid reference for calibrating the tube's and stage's
+    compliance: the modulus is then not used).
+
+    Surface pose, relative to where the campaign plans the sample (the surface normal against
+    the nominal approach): ``tilt_deg`` (angle between the surface normal and the nominal
+    approach direction), ``tilt_azimuth_deg`` (about the approach axis),
+    ``curvature_radius_mm`` (a convex sphere of that radius; null = flat) and ``offset_mm``
+    (x, y, z in the robot's base frame).
+
+    ``assumed``: what the operator believes (:class:`AssumedConfig`); null = the truth above.
+    """
+
+    name: str
+    modulus_kpa: float = field(metadata=limits(gt=0, le=1e6))
+    poisson: float = field(default=0.45, metadata=limits(ge=0, le=0.5))
+    thickness_mm: float | None = field(default=10.0, metadata=limits(gt=0, le=1000))
+    bonded: bool = True
+    material: Literal["linear", "neo-hookean"] = "linear"
+    lateral_radius_mm: float = field(default=40.0, metadata=limits(gt=0, le=1000))
+    relaxation_time_s: float | None = field(default=None, metadata=limits(gt=0, le=1e4))
+    relaxed_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1))
+    friction: float = field(default=0.0, metadata=limits(ge=0, le=5))
+    rigid: bool = False
+    tilt_deg: float = field(default=0.0, metadata=limits(ge=0, le=80))
+    tilt_azimuth_deg: float = field(default=0.0, metadata=limits(ge=-360, le=360))
+    curvature_radius_mm: float | None = field(default=None, metadata=limits(gt=0, le=1e4))
+    offset_mm: tuple[float, float, float] = field(
+        default=(0.0, 0.0, 0.0), metadata=limits(ge=-1000, le=1000)
+    )
+    assumed: AssumedConfig | None = None
+
+    @property
+    def modulus(self) -> float:
+        return self.modulus_kpa * KPA
+
+    @property
+    def thickness(self) -> float | None:
+        return None if self.thickness_mm is None else self.thickness_mm * MM
+
+    @property
+    def lateral_radius(self) -> float:
+        return self.lateral_radius_mm * MM
+
+    @property
+    def tilt(self) -> float:
+        return math.radians(self.tilt_deg)
+
+    @property
+    def tilt_azimuth(self) -> float:
+        return math.radians(self.tilt_azimuth_deg)
+
+    @property
+    def curvature_radius(self) -> float | None:
+        return None if self.curvature_radius_mm is None else self.curvature_radius_mm * MM
+
+    @property
+    def offset(self) -> tuple[float, float, float]:
+        x, y, z = self.offset_mm
+        return (x * MM, y * MM, z * MM)
+
+
+# Paper Table I: actual moduli (kPa) of the 11 PDMS / PA-gel phantoms.
+TABLE_I_KPA: tuple[float, ...] = (
+    1023.67, 706.30, 504.03, 823.77, 529.33, 908.88, 1122.86, 314.53, 716.74, 499.56, 323.78,
+)  # fmt: skip
+PAPER_SAMPLES: tuple[SampleConfig, ...] = tuple(
+    SampleConfig(name=f"S{i}", modulus_kpa=e) for i, e in enumerate(TABLE_I_KPA, start=1)
+)

@@ -1,0 +1,63 @@
+"""The sample schema: the world's truth, its pose, and what the operator believes."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from config.loader import ConfigError, from_mapping
+from config.sample import AssumedConfig, SampleConfig
+from config.scene import SceneConfig
+
+
+def test_assumed_takes_a_value_a_range_or_unknown() -> None:
+    s = from_mapping(
+        SampleConfig,
+        {
+            "name": "S8",
+            "modulus_kpa": 314.53,
+            "thickness_mm": 6,
+            "bonded": False,
+            "assumed": {"thickness_mm": [5, 20], "bonded": "unknown", "poisson": 0.45},
+        },
+        "scene.yaml",
+        "samples[0]",
+    )
+    assert s.assumed == AssumedConfig(thickness_mm=(5.0, 20.0), bonded="unknown", poisson=0.45)
+    assert s.thickness == pytest.approx(6e-3)
+    half = from_mapping(AssumedConfig, {"thickness_mm": "half-space", "poisson": "unknown"})
+    assert half.thickness_mm == "half-space"
+    assert half.bonded is None  # left out: the sample's own value
+
+
+@pytest.mark.parametrize(
+    ("assumed", "key"),
+    [
+        ({"thickness_mm": [20, 5]}, "samples[0].assumed"),
+        ({"poisson": [0.4, 0.6]}, "samples[0].assumed.poisson"),
+        ({"bonded": "maybe"}, "samples[0].assumed.bonded"),
+        ({"thickness_mm": -3}, "samples[0].assumed.thickness_mm"),
+    ],
+)
+def test_bad_beliefs_name_the_key(assumed: dict[str, object], key: str) -> None:
+    data = {"name": "S1", "modulus_kpa": 500, "assumed": assumed}
+    with pytest.raises(ConfigError, match=key.replace("[", r"\[").replace("]", r"\]")):
+        from_mapping(SampleConfig, data, "scene.yaml", "samples[0]")
+
+
+def test_surface_pose_in_si() -> None:
+    s = SampleConfig(
+        name="T", modulus_kpa=300, tilt_deg=20, curvature_radius_mm=25, offset_mm=(1, -2, 3)
+    )
+    assert s.tilt == pytest.approx(math.radians(20))
+    assert s.curvature_radius == pytest.approx(25e-3)
+    assert s.offset == pytest.approx((1e-3, -2e-3, 3e-3))
+    assert SampleConfig(name="F", modulus_kpa=300).curvature_radius is None
+
+
+def test_scene_defaults_are_the_papers_phantoms() -> None:
+    scene = SceneConfig()
+    assert [s.name for s in scene.samples][:2] == ["S1", "S2"]
+    assert scene.fidelity.tissue_model in ("fe", "closed-form")
+    assert scene.campaign.probe is None
