@@ -179,3 +179,36 @@ def test_the_check_sees_every_kind_of_import(tmp_path: Path) -> None:
     assert package_of("robot.drive.x", subpackages(tmp_path)) == "robot"
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+MAX_MODULE_LINES = 450
+MAX_FUNCTION_LINES = 80
+
+
+def oversized(root: Path = ROOT) -> list[str]:
+    """Modules over MAX_MODULE_LINES lines and functions over MAX_FUNCTION_LINES (issue 14: every
+    module fits on a few screens, every function on one)."""
+    found = []
+    for package in sorted(PACKAGES):
+        for path in sorted((root / package).rglob("*.py")):
+            text = path.read_text(encoding="utf-8")
+            where = path.relative_to(root)
+            if text.count("\n") > MAX_MODULE_LINES:
+                found.append(f"{where}: {text.count(chr(10))} lines")
+            for node in ast.walk(ast.parse(text, str(path))):
+                if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                    length = (node.end_lineno or node.lineno) - node.lineno + 1
+                    if length > MAX_FUNCTION_LINES:
+                        found.append(f"{where}:{node.lineno} {node.name}: {length} lines")
+    return found
+
+
+def test_modules_and_functions_fit_on_a_screen() -> None:
+    assert oversized() == []
+
+
+def test_the_size_check_sees_a_long_function(tmp_path: Path) -> None:
+    body = "\n".join(f"    x{i} = {i}" for i in range(MAX_FUNCTION_LINES + 1))
+    (tmp_path / "wire").mkdir()
+    (tmp_path / "wire" / "big.py").write_text(f"def big() -> None:\n{body}\n", encoding="utf-8")
+    assert [f.split(" ")[1] for f in oversized(tmp_path)] == ["big:"]
