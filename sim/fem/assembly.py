@@ -18,7 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
+from scipy import sparse  # type: ignore[import-untyped,unused-ignore]
 from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector
 
 from sim.fem.material import MaterialLaw, Response
@@ -40,7 +40,7 @@ class Discretization:
         pbasis: scalar P1 basis of the pressure.
         B: (12, 5, nel, nqp) axisymmetric gradients of the displacement basis functions.
         P: (3, nel, nqp) values of the pressure basis functions.
-        dV: (nel, nqp) quadrature weights times 2 pi r.
+        weights: (nel, nqp) quadrature weights times 2 pi r.
     """
 
     layer: LayerMesh
@@ -48,7 +48,7 @@ class Discretization:
     pbasis: Basis
     B: FloatArray
     P: FloatArray
-    dV: FloatArray
+    weights: FloatArray
 
     @property
     def n_u(self) -> int:
@@ -74,25 +74,27 @@ def discretize(layer: LayerMesh) -> Discretization:
     mesh = layer.mesh
     ubasis = Basis(mesh, ElementVector(ElementTriP2()), intorder=_QUADRATURE_ORDER)
     pbasis = Basis(mesh, ElementTriP1(), intorder=_QUADRATURE_ORDER)
-    r = ubasis.global_coordinates().value[0]
+    r = np.asarray(ubasis.global_coordinates())[0]
     nel, nqp = r.shape
     B = np.empty((ubasis.Nbfun, 5, nel, nqp))
     for i, (phi,) in enumerate(ubasis.basis):
         g = phi.grad
-        B[i] = [g[0, 0], g[0, 1], g[1, 0], g[1, 1], phi.value[0] / r]
-    P = np.stack([phi.value for (phi,) in pbasis.basis])
-    dV = 2.0 * np.pi * r * ubasis.dx
-    return Discretization(layer, ubasis, pbasis, B, P, dV)
+        B[i] = [g[0, 0], g[0, 1], g[1, 0], g[1, 1], np.asarray(phi)[0] / r]
+    P = np.stack([np.asarray(phi) for (phi,) in pbasis.basis])
+    weights = 2.0 * np.pi * r * ubasis.dx
+    return Discretization(layer, ubasis, pbasis, B, P, weights)
 
 
 def gradients(disc: Discretization, u: FloatArray) -> FloatArray:
     """H (5, nel, nqp) of the displacement ``u`` (n_u,) at the quadrature points."""
-    return np.einsum("ie,iaeq->aeq", u[disc.ubasis.element_dofs], disc.B, optimize=True)
+    H: FloatArray = np.einsum("ie,iaeq->aeq", u[disc.ubasis.element_dofs], disc.B, optimize=True)
+    return H
 
 
 def pressures(disc: Discretization, p: FloatArray) -> FloatArray:
     """p (nel, nqp) of the pressure ``p`` (n_p,) at the quadrature points."""
-    return np.einsum("ie,ieq->eq", p[disc.pbasis.element_dofs], disc.P, optimize=True)
+    pq: FloatArray = np.einsum("ie,ieq->eq", p[disc.pbasis.element_dofs], disc.P, optimize=True)
+    return pq
 
 
 def assemble(
@@ -111,15 +113,15 @@ def assemble(
     H = gradients(disc, u)
     pq = pressures(disc, p)
     resp: Response = law(H, shear)
-    dV = disc.dV
+    weights = disc.weights
     B, P = disc.B, disc.P
     stress = resp.stress + pq * resp.volume_grad
-    r_u = np.einsum("iaeq,aeq,eq->ei", B, stress, dV, optimize=True)
-    r_p = np.einsum("ieq,eq->ei", P, (resp.volume - bulk_compliance * pq) * dV, optimize=True)
+    r_u = np.einsum("iaeq,aeq,eq->ei", B, stress, weights, optimize=True)
+    r_p = np.einsum("ieq,eq->ei", P, (resp.volume - bulk_compliance * pq) * weights, optimize=True)
     D = resp.tangent + pq * resp.volume_hess
-    k_uu = np.einsum("iaeq,abeq,jbeq,eq->eij", B, D, B, dV, optimize=True)
-    k_up = np.einsum("iaeq,aeq,jeq,eq->eij", B, resp.volume_grad, P, dV, optimize=True)
-    k_pp = -bulk_compliance * np.einsum("ieq,jeq,eq->eij", P, P, dV, optimize=True)
+    k_uu = np.einsum("iaeq,abeq,jbeq,eq->eij", B, D, B, weights, optimize=True)
+    k_up = np.einsum("iaeq,aeq,jeq,eq->eij", B, resp.volume_grad, P, weights, optimize=True)
+    k_pp = -bulk_compliance * np.einsum("ieq,jeq,eq->eij", P, P, weights, optimize=True)
     ud, pd = disc.ubasis.element_dofs, disc.pbasis.element_dofs
     return Assembled(
         r_u=_vector(r_u, ud, disc.n_u),
@@ -131,7 +133,7 @@ def assemble(
 
 
 def _vector(local: FloatArray, dofs: IntArray, n: int) -> FloatArray:
-    return np.bincount(dofs.T.ravel(), weights=local.ravel(), minlength=n)
+    return np.bincount(dofs.T.ravel(), weights=local.ravel(), minlength=n).astype(np.float64)
 
 
 def _matrix(

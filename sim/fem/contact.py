@@ -17,11 +17,12 @@ its normal reaction turns tensile.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
+from scipy import sparse  # type: ignore[import-untyped,unused-ignore]
 
 from sim.fem.assembly import Discretization
 
@@ -99,7 +100,9 @@ def positions(surface: Surface, u: FloatArray, finite: bool) -> FloatArray:
     return np.stack([surface.X + u[surface.dof_r], u[surface.dof_z]], axis=1)
 
 
-def gaps(surface: Surface, u: FloatArray, delta: float, finite: bool) -> tuple[FloatArray, FloatArray]:
+def gaps(
+    surface: Surface, u: FloatArray, delta: float, finite: bool
+) -> tuple[FloatArray, FloatArray]:
     """Gap (n,) of every surface node and its gradient (n, 2) with respect to (u_r, u_z)."""
     y = positions(surface, u, finite)
     if finite:
@@ -134,14 +137,20 @@ def constraints(
     rows_s = nn.size + np.arange(2 * sn.size)
     cols_s = np.stack([surface.dof_r[sn], surface.dof_z[sn]], axis=1).ravel()
     C = sparse.csr_matrix(
-        (np.concatenate([vals_n, np.ones(2 * sn.size)]),
-         (np.concatenate([rows_n, rows_s]), np.concatenate([cols_n, cols_s]))),
+        (
+            np.concatenate([vals_n, np.ones(2 * sn.size)]),
+            (np.concatenate([rows_n, rows_s]), np.concatenate([cols_n, cols_s])),
+        ),
         shape=(nn.size + 2 * sn.size, n_u),
     )
     y = positions(surface, u, finite)
     centre = np.array([0.0, 1.0 - delta])
     g_stuck = (y[sn] - centre - state.offset[sn]).ravel()
-    geometric = _curvature(surface, nn, u, delta, normal_force[nn], n_u) if finite else sparse.csr_matrix((n_u, n_u))
+    geometric = (
+        _curvature(surface, nn, u, delta, normal_force[nn], n_u)
+        if finite
+        else sparse.csr_matrix((n_u, n_u))
+    )
     return Constraints(C, np.concatenate([g[nn], g_stuck]), geometric, nn, sn)
 
 
@@ -180,7 +189,9 @@ def update(
     return new, changed
 
 
-def stick_all(state: ContactState, surface: Surface, u: FloatArray, delta: float, finite: bool) -> ContactState:
+def stick_all(
+    state: ContactState, surface: Surface, u: FloatArray, delta: float, finite: bool
+) -> ContactState:
     """Every frictionless contact node becomes stuck where it is now (full stick)."""
     new = state.copy()
     y = positions(surface, u, finite)
@@ -191,7 +202,9 @@ def stick_all(state: ContactState, surface: Surface, u: FloatArray, delta: float
     return new
 
 
-def contact_radius(surface: Surface, u: FloatArray, gap: FloatArray, touching: BoolArray, finite: bool) -> float:
+def contact_radius(
+    surface: Surface, u: FloatArray, gap: FloatArray, touching: BoolArray, finite: bool
+) -> float:
     """Radius of the contact's edge, between the outermost touching node and the next one.
 
     Outside a smooth frictionless contact the gap grows like (x - a)^(3/2); two free nodes fix
@@ -207,7 +220,7 @@ def contact_radius(surface: Surface, u: FloatArray, gap: FloatArray, touching: B
         return float(x[last])
     x0, x1, x2 = x[last], x[last + 1], x[last + 2]
     g1, g2 = gap[last + 1], gap[last + 2]
-    if not (g2 > g1 > 0.0):
+    if not (math.isfinite(g2) and g2 > g1 > 0.0):
         return float(0.5 * (x0 + x1))
     q = (g2 / g1) ** (2.0 / 3.0)
     a = (x2 - q * x1) / (1.0 - q)

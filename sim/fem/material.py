@@ -108,7 +108,9 @@ def neo_hookean(H: FloatArray, shear: float) -> Response:
     d2phi = -2.0 / 3.0 * phi * (d2J / J - 5.0 / 3.0 * mm)
     eye = np.eye(5).reshape((5, 5, *tail))
     mF = m[:, None] * F[None, :]
-    tangent = shear * (phi * eye - 2.0 / 3.0 * phi * (mF + np.swapaxes(mF, 0, 1)) + 0.5 * I1 * d2phi)
+    tangent = shear * (
+        phi * eye - 2.0 / 3.0 * phi * (mF + np.swapaxes(mF, 0, 1)) + 0.5 * I1 * d2phi
+    )
     return Response(stress, tangent, J - 1.0, dJ, d2J)
 
 

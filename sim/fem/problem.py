@@ -49,7 +49,7 @@ class LayerProblem:
     contact: str = "frictionless"
     depth_max: float = 1.0
     n_depths: int = 20
-    resolution: int = 8
+    resolution: int = 6
 
     def __post_init__(self) -> None:
         _check_choice("material", self.material, MATERIALS)
@@ -83,6 +83,21 @@ class LayerProblem:
         s_max = math.sqrt(self.depth_max)
         return [(s_max * k / self.n_depths) ** 2 for k in range(1, self.n_depths + 1)]
 
+    @classmethod
+    def from_dimensions(
+        cls, tip_radius: float, thickness: float, radius: float, **options: Any
+    ) -> LayerProblem:
+        """The problem of a sample in SI units (tip radius R, layer thickness h and lateral
+        radius, m); the ratios are rounded to 9 significant digits so that the same sample
+        written two ways (10 mm / 3.5 mm or 0.01 / 0.0035) names the same table."""
+        if not (math.isfinite(tip_radius) and tip_radius > 0):
+            raise ValueError(f"tip_radius must be finite and > 0, got {tip_radius}")
+        return cls(
+            thickness_ratio=_round(thickness / tip_radius),
+            radius_ratio=_round(radius / tip_radius),
+            **options,
+        )
+
     def as_dict(self) -> dict[str, Any]:
         """Plain-data form (what the table key hashes)."""
         return asdict(self)
@@ -91,3 +106,7 @@ class LayerProblem:
 def _check_choice(name: str, value: str, allowed: tuple[str, ...]) -> None:
     if value not in allowed:
         raise ValueError(f"{name} must be one of {allowed}, got {value!r}")
+
+
+def _round(x: float) -> float:
+    return float(f"{x:.9g}")

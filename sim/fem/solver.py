@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
-from scipy.sparse import linalg as splinalg
+from scipy import sparse  # type: ignore[import-untyped,unused-ignore]
+from scipy.sparse import linalg as splinalg  # type: ignore[import-untyped,unused-ignore]
 
 from sim.fem import contact
 from sim.fem.assembly import Assembled, Discretization, assemble, discretize
@@ -43,6 +43,9 @@ class SolverOptions:
     tolerance: float = 1e-9
     max_iterations: int = 40
     max_bisections: int = 6
+    stick_growth: float = 1.1
+    """With full stick, each step goes at most from delta to ``stick_growth * delta`` (a node that
+    enters the contact during a step slides within it), starting at 1e-3 of the first depth."""
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,8 @@ class _State:
     lam_normal: FloatArray  # (n,) last multipliers of the frictionless nodes
     force: float = 0.0
     radius: float = 0.0
+    rate_u: FloatArray | None = None  # du/ddelta of the last step (the predictor)
+    rate_p: FloatArray | None = None
 
 
 @dataclass
@@ -88,7 +93,7 @@ class _System:
     cached: dict[str, Assembled] = field(default_factory=dict)
 
 
-class StepFailure(RuntimeError):
+class StepError(RuntimeError):
     """One depth did not converge (the message says why)."""
 
 
@@ -133,8 +138,11 @@ def _newton_step(
     K = (a.K_uu - cons.geometric)[f][:, f]
     Kup = a.K_up[f]
     Cf = cons.C[:, f]
-    A = sparse.bmat([[K, Kup, -Cf.T], [Kup.T, a.K_pp, None], [-Cf, None, None]], format="csc")
-    rhs = np.concatenate([-a.r_u[f], -a.r_p, cons.g])
+    # A stuck node on the axis has no free radial dof: its row is empty; solve lambda = 0 there.
+    empty = np.diff(Cf.tocsr().indptr) == 0
+    idle = sparse.diags(empty.astype(float)) if np.any(empty) else None
+    A = sparse.bmat([[K, Kup, -Cf.T], [Kup.T, a.K_pp, None], [-Cf, None, idle]], format="csc")
+    rhs = np.concatenate([-a.r_u[f], -a.r_p, np.where(empty, 0.0, cons.g)])
     x = solve_saddle(A, rhs)
     du = np.zeros(n_u)
     du[f] = x[: f.size]
@@ -151,11 +159,15 @@ def solve_saddle(A: sparse.csc_matrix, b: FloatArray) -> FloatArray:
     partial pivoting); if its residual is poor, again with partial pivoting.
 
     Raises:
-        StepFailure: the matrix is singular or the solution is not finite.
+        StepError: the matrix is singular or the solution is not finite.
     """
     scale = max(float(np.max(np.abs(b))), 1e-300)
     attempts: list[dict[str, Any]] = [
-        {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.0, "options": {"SymmetricMode": True}},
+        {
+            "permc_spec": "MMD_AT_PLUS_A",
+            "diag_pivot_thresh": 0.0,
+            "options": {"SymmetricMode": True},
+        },
         {},
     ]
     reason = "no attempt"
@@ -170,17 +182,24 @@ def solve_saddle(A: sparse.csc_matrix, b: FloatArray) -> FloatArray:
         if np.all(np.isfinite(x)) and np.max(np.abs(A @ x - b)) <= 1e-8 * scale:
             return np.asarray(x, dtype=np.float64)
         reason = "inaccurate or non-finite solution"
-    raise StepFailure(f"singular Newton system ({reason})")
+    raise StepError(f"singular Newton system ({reason})")
 
 
-def solve_depth(system: _System, start: _State, delta: float, options: SolverOptions) -> tuple[_State, int]:
-    """Equilibrium at depth ``delta`` from ``start``: the new state and the iterations spent.
+def solve_depth(
+    system: _System, start: _State, start_depth: float, delta: float, options: SolverOptions
+) -> tuple[_State, int]:
+    """Equilibrium at depth ``delta`` from the converged ``start`` at ``start_depth``, predicted
+    along the last step's tangent: the new state and the iterations spent.
 
     Raises:
-        StepFailure: Newton or the active set did not settle within ``max_iterations``, the
+        StepError: Newton or the active set did not settle within ``max_iterations``, the
             system was singular, or an element inverted.
     """
     state = _State(start.u.copy(), start.p.copy(), start.contact.copy(), start.lam_normal.copy())
+    if start.rate_u is not None and start.rate_p is not None:
+        step = delta - start_depth
+        state.u += step * start.rate_u
+        state.p += step * start.rate_p
     gap, normal = contact.gaps(system.surface, state.u, delta, system.finite)
     state.contact.active |= (gap < 0.0) & ~state.contact.stuck
     scale = max(delta, 1e-12)
@@ -188,7 +207,7 @@ def solve_depth(system: _System, start: _State, delta: float, options: SolverOpt
         try:
             du, dp, lam, cons = _newton_step(system, state, delta)
         except FloatingPointError as exc:
-            raise StepFailure(str(exc)) from exc
+            raise StepError(str(exc)) from exc
         state.u += du
         state.p += dp
         state.lam_normal = np.zeros(system.surface.X.size)
@@ -205,7 +224,7 @@ def solve_depth(system: _System, start: _State, delta: float, options: SolverOpt
             )
             return state, it
         state.contact = new_contact
-    raise StepFailure(f"no convergence in {options.max_iterations} Newton/active-set iterations")
+    raise StepError(f"no convergence in {options.max_iterations} Newton/active-set iterations")
 
 
 def _force(system: _System, cons: contact.Constraints, lam: FloatArray) -> float:
@@ -216,7 +235,12 @@ def _force(system: _System, cons: contact.Constraints, lam: FloatArray) -> float
 
 def _initial_state(system: _System) -> _State:
     n = system.surface.X.size
-    return _State(np.zeros(system.disc.n_u), np.zeros(system.disc.n_p), contact.ContactState.empty(n), np.zeros(n))
+    return _State(
+        np.zeros(system.disc.n_u),
+        np.zeros(system.disc.n_p),
+        contact.ContactState.empty(n),
+        np.zeros(n),
+    )
 
 
 def _advance(
@@ -226,24 +250,36 @@ def _advance(
     total = 0
     step = target - reached
     failures = 0
+    stick = system.problem.contact == "stick"
     while reached < target:
         nxt = min(target, reached + step)
+        if stick:
+            nxt = min(nxt, max(reached * options.stick_growth, 1e-3 * target))
         try:
-            state, its = solve_depth(system, state, nxt, options)
-        except StepFailure as exc:
+            new, its = solve_depth(system, state, reached, nxt, options)
+        except StepError as exc:
             failures += 1
             if failures > options.max_bisections:
-                raise StepFailure(f"at delta/R = {nxt:.4g} after {failures - 1} bisections: {exc}") from exc
+                raise StepError(
+                    f"at delta/R = {nxt:.4g} after {failures - 1} bisections: {exc}"
+                ) from exc
             step *= 0.5
             continue
         total += its
-        if system.problem.contact == "stick":
-            state.contact = contact.stick_all(state.contact, system.surface, state.u, nxt, system.finite)
+        new.rate_u = (new.u - state.u) / (nxt - reached)
+        new.rate_p = (new.p - state.p) / (nxt - reached)
+        state = new
+        if stick:
+            state.contact = contact.stick_all(
+                state.contact, system.surface, state.u, nxt, system.finite
+            )
         reached = nxt
     return state, total
 
 
-def solve_indentation(problem: LayerProblem, options: SolverOptions | None = None) -> IndentationResult:
+def solve_indentation(
+    problem: LayerProblem, options: SolverOptions | None = None
+) -> IndentationResult:
     """Force, contact radius and iterations at ``problem.depths()``, in order."""
     opts = options or SolverOptions()
     system = build_system(problem)
@@ -255,7 +291,7 @@ def solve_indentation(problem: LayerProblem, options: SolverOptions | None = Non
     for target in problem.depths():
         try:
             state, its = _advance(system, state, reached, target, opts)
-        except StepFailure as exc:
+        except StepError as exc:
             success, message = False, f"stopped {exc}"
             break
         reached = target
