@@ -24,6 +24,7 @@ import bisect
 import functools
 import math
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,6 +34,7 @@ from sim.fem.problem import LayerProblem
 from sim.fem.table import ForceTable, load_table, table_key
 
 FloatArray = NDArray[np.float64]
+T = TypeVar("T", float, FloatArray)
 
 _RTOL = 1e-13
 _MAX_ITER = 60
@@ -76,21 +78,28 @@ def curve_from_table(table: ForceTable) -> _Curve:
     return _Curve(s, g, m, c, s.tolist(), g.tolist(), m.tolist())
 
 
-def _hermite(cv: _Curve, s: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """g(s) and g'(s) (vectorised), linear beyond the last knot."""
-    n = cv.s.size
-    i = np.clip(np.searchsorted(cv.s, s, side="right") - 1, 0, n - 2)
-    h = cv.s[i + 1] - cv.s[i]
-    t = np.minimum((s - cv.s[i]) / h, 1.0)
-    y0, y1, m0, m1 = cv.g[i], cv.g[i + 1], cv.m[i] * h, cv.m[i + 1] * h
-    t2, t3 = t * t, t * t * t
+def _cubic(t: T, h: T, y0: T, y1: T, m0: T, m1: T) -> tuple[T, T]:
+    """Cubic Hermite value and derivative at t in [0, 1] of an interval of width h with end
+    values y0, y1 and end slopes m0, m1 (plain arithmetic: floats or arrays)."""
+    a0, a1 = m0 * h, m1 * h
+    t2 = t * t
+    t3 = t2 * t
     g = (
         (2 * t3 - 3 * t2 + 1) * y0
-        + (t3 - 2 * t2 + t) * m0
+        + (t3 - 2 * t2 + t) * a0
         + (3 * t2 - 2 * t3) * y1
-        + (t3 - t2) * m1
+        + (t3 - t2) * a1
     )
-    dg = ((6 * t2 - 6 * t) * (y0 - y1) + (3 * t2 - 4 * t + 1) * m0 + (3 * t2 - 2 * t) * m1) / h
+    dg = ((6 * t2 - 6 * t) * (y0 - y1) + (3 * t2 - 4 * t + 1) * a0 + (3 * t2 - 2 * t) * a1) / h
+    return g, dg
+
+
+def _hermite(cv: _Curve, s: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """g(s) and g'(s) (vectorised), linear beyond the last knot."""
+    i = np.clip(np.searchsorted(cv.s, s, side="right") - 1, 0, cv.s.size - 2)
+    h = cv.s[i + 1] - cv.s[i]
+    t = np.minimum((s - cv.s[i]) / h, 1.0)
+    g, dg = _cubic(t, h, cv.g[i], cv.g[i + 1], cv.m[i], cv.m[i + 1])
     beyond = s > cv.s[-1]
     g = np.where(beyond, cv.g[-1] + cv.m[-1] * (s - cv.s[-1]), g)
     return g, np.where(beyond, cv.m[-1], dg)
@@ -103,19 +112,8 @@ def _hermite_at(cv: _Curve, s: float) -> tuple[float, float]:
         return cv.g_list[-1] + cv.m_list[-1] * (s - ks[-1]), cv.m_list[-1]
     i = max(0, bisect.bisect_right(ks, s) - 1)
     h = ks[i + 1] - ks[i]
-    t = (s - ks[i]) / h
-    y0, y1 = cv.g_list[i], cv.g_list[i + 1]
-    m0, m1 = cv.m_list[i] * h, cv.m_list[i + 1] * h
-    t2 = t * t
-    t3 = t2 * t
-    g = (
-        (2 * t3 - 3 * t2 + 1) * y0
-        + (t3 - 2 * t2 + t) * m0
-        + (3 * t2 - 2 * t3) * y1
-        + (t3 - t2) * m1
-    )
-    dg = ((6 * t2 - 6 * t) * (y0 - y1) + (3 * t2 - 4 * t + 1) * m0 + (3 * t2 - 2 * t) * m1) / h
-    return g, dg
+    gs, ms = cv.g_list, cv.m_list
+    return _cubic((s - ks[i]) / h, h, gs[i], gs[i + 1], ms[i], ms[i + 1])
 
 
 @dataclass(frozen=True)
