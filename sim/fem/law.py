@@ -28,7 +28,6 @@ from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import PchipInterpolator  # type: ignore[import-untyped,unused-ignore]
 
 from sim.fem.problem import LayerProblem
 from sim.fem.table import ForceTable, load_table, table_key
@@ -72,10 +71,37 @@ def curve_from_table(table: ForceTable) -> _Curve:
         raise ValueError(f"table {table.key}: forces must be > 0 at increasing depths > 0")
     s = np.concatenate([[0.0], np.sqrt(x)])
     g = np.concatenate([[0.0], np.log(f / (c * x**1.5))])
-    m = PchipInterpolator(s, g)(s, 1)
+    m = pchip_slopes(s, g)
     if np.any(3.0 + s * m <= 0.0):  # d log f / d log s = 3 + s g'(s) at the knots
         raise ValueError(f"table {table.key}: the interpolated force would not increase")
     return _Curve(s, g, m, c, s.tolist(), g.tolist(), m.tolist())
+
+
+def pchip_slopes(x: FloatArray, y: FloatArray) -> FloatArray:
+    """Knot slopes of the shape-preserving PCHIP interpolant (Fritsch-Carlson with the
+    weighted harmonic mean and the one-sided three-point end rule: scipy's
+    ``PchipInterpolator``, whose import costs ~0.4 s in a fresh process against ~1 ms for the
+    table read). ``x`` (n,) increasing, ``y`` (n,), n >= 3."""
+    h = np.diff(x)
+    m = np.diff(y) / h
+    d = np.zeros_like(y)
+    a, b = m[:-1], m[1:]
+    flat = (np.sign(a) != np.sign(b)) | (a == 0) | (b == 0)
+    w1, w2 = 2 * h[1:] + h[:-1], h[1:] + 2 * h[:-1]
+    safe_a, safe_b = np.where(flat, 1.0, a), np.where(flat, 1.0, b)
+    d[1:-1] = np.where(flat, 0.0, (w1 + w2) / (w1 / safe_a + w2 / safe_b))
+    d[0] = _pchip_end(h[0], h[1], m[0], m[1])
+    d[-1] = _pchip_end(h[-1], h[-2], m[-1], m[-2])
+    return d
+
+
+def _pchip_end(h0: float, h1: float, m0: float, m1: float) -> float:
+    d = ((2 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
+    if np.sign(d) != np.sign(m0):
+        return 0.0
+    if np.sign(m0) != np.sign(m1) and abs(d) > 3 * abs(m0):
+        return float(3 * m0)
+    return float(d)
 
 
 def _cubic(t: T, h: T, y0: T, y1: T, m0: T, m1: T) -> tuple[T, T]:

@@ -7,10 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from scipy.interpolate import PchipInterpolator
 
 from estimation.hertz import hertz_force
 from sim.fem.generate import SHIPPED
-from sim.fem.law import FeTissueLaw
+from sim.fem.law import FeTissueLaw, pchip_slopes
 from sim.fem.table import load_table
 
 R_TIP = 3.5e-3
@@ -101,3 +102,13 @@ def test_neo_hookean_layer_is_stiffer_than_linear_at_depth() -> None:
     assert neo.force_and_stiffness_at(2.5e-3)[0] != pytest.approx(
         lin.force_and_stiffness_at(2.5e-3)[0], rel=0.005
     )
+
+
+def test_pchip_slopes_are_scipys() -> None:
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        x = np.sort(rng.uniform(0, 1, 9))
+        y = np.cumsum(rng.normal(0, 1, 9)) * rng.choice([0.0, 1.0], 9, p=[0.2, 0.8])
+        np.testing.assert_allclose(
+            pchip_slopes(x, y), PchipInterpolator(x, y)(x, 1), rtol=1e-12, atol=1e-12
+        )
