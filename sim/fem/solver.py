@@ -84,7 +84,11 @@ class _State:
 
 
 @dataclass
-class _System:
+class IndentationSystem:
+    """What stays fixed over one table's solve: the problem, its discretisation, the surface
+    nodes, the free displacement dofs, the kinematics (finite or small) and, for the linear
+    material, the assembled (constant) matrices."""
+
     problem: LayerProblem
     disc: Discretization
     surface: contact.Surface
@@ -97,7 +101,7 @@ class StepError(RuntimeError):
     """One depth did not converge (the message says why)."""
 
 
-def build_system(problem: LayerProblem) -> _System:
+def build_system(problem: LayerProblem) -> IndentationSystem:
     """Mesh, discretisation, surface and free dofs of ``problem``."""
     disc = discretize(build_mesh(problem))
     ub = disc.ubasis
@@ -108,10 +112,10 @@ def build_system(problem: LayerProblem) -> _System:
         fixed += [base.nodal["u^1"], base.facet["u^1"]]
     free = np.setdiff1d(np.arange(disc.n_u), np.concatenate(fixed))
     finite = problem.material not in CONSTANT_TANGENT
-    return _System(problem, disc, contact.top_surface(disc), free, finite)
+    return IndentationSystem(problem, disc, contact.top_surface(disc), free, finite)
 
 
-def _assemble(system: _System, state: _State) -> Assembled:
+def _assemble(system: IndentationSystem, state: _State) -> Assembled:
     prob = system.problem
     if not system.finite and "linear" in system.cached:
         a = system.cached["linear"]
@@ -126,7 +130,7 @@ def _assemble(system: _System, state: _State) -> Assembled:
 
 
 def _newton_step(
-    system: _System, state: _State, delta: float
+    system: IndentationSystem, state: _State, delta: float
 ) -> tuple[FloatArray, FloatArray, FloatArray, contact.Constraints]:
     """One linearised solve: (du, dp, lambda, constraints)."""
     a = _assemble(system, state)
@@ -186,7 +190,11 @@ def solve_saddle(A: sparse.csc_matrix, b: FloatArray) -> FloatArray:
 
 
 def solve_depth(
-    system: _System, start: _State, start_depth: float, delta: float, options: SolverOptions
+    system: IndentationSystem,
+    start: _State,
+    start_depth: float,
+    delta: float,
+    options: SolverOptions,
 ) -> tuple[_State, int]:
     """Equilibrium at depth ``delta`` from the converged ``start`` at ``start_depth``, predicted
     along the last step's tangent: the new state and the iterations spent.
@@ -227,13 +235,13 @@ def solve_depth(
     raise StepError(f"no convergence in {options.max_iterations} Newton/active-set iterations")
 
 
-def _force(system: _System, cons: contact.Constraints, lam: FloatArray) -> float:
+def _force(system: IndentationSystem, cons: contact.Constraints, lam: FloatArray) -> float:
     """Vertical force on the sphere, F / (E R^2): minus the z-reactions on the layer."""
     on_layer = cons.C.T @ lam
     return float(-on_layer[system.surface.dof_z].sum())
 
 
-def _initial_state(system: _System) -> _State:
+def _initial_state(system: IndentationSystem) -> _State:
     n = system.surface.X.size
     return _State(
         np.zeros(system.disc.n_u),
@@ -244,7 +252,7 @@ def _initial_state(system: _System) -> _State:
 
 
 def _advance(
-    system: _System, state: _State, reached: float, target: float, options: SolverOptions
+    system: IndentationSystem, state: _State, reached: float, target: float, options: SolverOptions
 ) -> tuple[_State, int]:
     """From depth ``reached`` to ``target``, halving the step on failure."""
     total = 0
