@@ -1,0 +1,56 @@
+"""Regenerate the force tables shipped with the package: ``python -m sim.fem.generate``.
+
+The shipped problems are the scenes' samples: the paper's phantoms (tip R = 3.5 mm, 10 mm layers
+in a 40 mm radius dish, nu = 0.45, bonded, frictionless; linear and neo-Hookean) and the
+soft-tissue designs (R = 6 mm, 20 mm layers). Each table is solved afresh, written to
+``sim/fem/tables/<key>.npz``, and its key, build time and status printed; tables that no shipped
+problem names any more are removed. Options: ``--only NAME`` (repeatable), ``--list``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from sim.fem.problem import LayerProblem
+from sim.fem.table import SHIPPED_DIR, save_table, solve_table, table_key
+
+_PAPER = {"tip_radius": 3.5e-3, "thickness": 10e-3, "radius": 40e-3, "poisson": 0.45}
+_SOFT = {"tip_radius": 6e-3, "thickness": 20e-3, "radius": 40e-3, "poisson": 0.45}
+
+SHIPPED: dict[str, LayerProblem] = {
+    "paper-linear": LayerProblem.from_dimensions(**_PAPER),
+    "paper-neo-hookean": LayerProblem.from_dimensions(**_PAPER, material="neo-hookean"),
+    "soft-linear": LayerProblem.from_dimensions(**_SOFT),
+    "soft-neo-hookean": LayerProblem.from_dimensions(**_SOFT, material="neo-hookean"),
+}
+"""The problems whose tables ship in ``sim/fem/tables``, by name."""
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m sim.fem.generate", description=__doc__)
+    parser.add_argument("--only", action="append", choices=sorted(SHIPPED), default=None)
+    parser.add_argument("--list", action="store_true", help="print names and keys, solve nothing")
+    args = parser.parse_args(argv)
+    names = args.only or sorted(SHIPPED)
+    if args.list:
+        for name in names:
+            print(f"{name:20s} {table_key(SHIPPED[name])}  {SHIPPED[name]}")
+        return 0
+    status = 0
+    for name in names:
+        table = solve_table(SHIPPED[name])
+        path = save_table(table, SHIPPED_DIR)
+        print(f"{name:20s} {path.name}  {table.build_seconds:6.1f} s  {table.message}", flush=True)
+        status |= 0 if table.success else 1
+    if args.only is None:
+        wanted = {f"{table_key(p)}.npz" for p in SHIPPED.values()}
+        for stale in SHIPPED_DIR.glob("*.npz"):
+            if stale.name not in wanted:
+                stale.unlink()
+                print(f"removed {stale.name}")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
