@@ -2,8 +2,9 @@
 
 :class:`DynamixelBus` satisfies :class:`robot.motors.MotorBus`. It takes its transport in the
 constructor: a port path (``"/dev/ttyUSB0"``, or the pty of ``sim.dynamixel.EmulatedBus``) or an
-already constructed ``dynamixel_sdk.PortHandler``. Nothing is patched and nothing is built behind
-the caller's back, so a test hands it the emulator's port.
+already constructed ``dynamixel_sdk.PortHandler`` (and, optionally, an object with the SDK
+packet handler's calls: the simulator's register-level path). Nothing is patched and nothing is
+built behind the caller's back, so a test hands it the emulator's port.
 
 Per control tick it makes one sync write of the goals (:meth:`DynamixelBus.write_goals`) and one
 sync read of Moving .. Present_Position (:meth:`DynamixelBus.read_state`). The sync read is made
@@ -92,6 +93,7 @@ class DynamixelBus:
         retries: int = 3,
         timeout: float = 0.02,
         max_goal_step: float = math.radians(10.0),
+        packet_handler: Any | None = None,
     ) -> None:
         names = [m.name for m in motors]
         ids = [m.id for m in motors]
@@ -106,7 +108,9 @@ class DynamixelBus:
         self._by_id = {m.id: m for m in motors}
         self._ids = [m.id for m in motors]  # the sync read's parameter (made once, not per tick)
         self._port = _TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
-        self._ph = sdk.PacketHandler(2.0)
+        # the SDK's Protocol 2.0 packet handler, or one with its calls (the simulator's
+        # register-level fast path, ``sim.dynamixel.direct``): this class decides the same
+        self._ph = sdk.PacketHandler(2.0) if packet_handler is None else packet_handler
         self._baudrate = baudrate
         self._retries = retries
         self.max_goal_step = max_goal_step
@@ -114,8 +118,11 @@ class DynamixelBus:
         self._connected = False
 
     @classmethod
-    def from_config(cls, cfg: ServoBusConfig, port: str | Any | None = None) -> Self:
-        """The drive's three servos; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty)."""
+    def from_config(
+        cls, cfg: ServoBusConfig, port: str | Any | None = None, packet_handler: Any | None = None
+    ) -> Self:
+        """The drive's three servos; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty),
+        ``packet_handler`` the SDK's (see :meth:`__init__`)."""
         motors = [
             Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
             Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
@@ -128,6 +135,7 @@ class DynamixelBus:
             retries=cfg.retries,
             timeout=cfg.timeout,
             max_goal_step=cfg.max_goal_step,
+            packet_handler=packet_handler,
         )
 
     @property

@@ -30,7 +30,7 @@ import threading
 import time
 import tty
 from collections.abc import Callable, Iterable
-from typing import Self
+from typing import NamedTuple, Self
 
 from config.schema import ServoBusConfig
 from sim.clock import VirtualClock
@@ -44,6 +44,20 @@ _REALTIME_POLL_S = 0.01
 _ID_ADDRESS = tables.X_SERIES_CONTROL_TABLE["ID"][0]
 _LEVEL_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Status_Return_Level"][0]
 _HW_ERROR_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Hardware_Error_Status"][0]
+
+
+class Reply(NamedTuple):
+    """One status packet before it is encoded: who answers, the error byte (Alert bit included),
+    the parameters, and whether an injected fault corrupts it on the wire."""
+
+    servo_id: int
+    error: int
+    params: bytes
+    corrupt: bool = False
+
+    def encode(self) -> bytes:
+        raw = protocol.encode_status(self.servo_id, self.error, self.params)
+        return raw[:-1] + bytes([raw[-1] ^ 0xFF]) if self.corrupt else raw
 
 
 class EmulatedBus:
@@ -67,7 +81,7 @@ class EmulatedBus:
         self.port = ""
         self.packets_handled = 0
         # instructions for the servo(s) the packet's ID addresses
-        self._handlers: dict[int, Callable[[protocol.Packet, list[EmulatedServo]], list[bytes]]] = {
+        self._handlers: dict[int, Callable[[protocol.Packet, list[EmulatedServo]], list[Reply]]] = {
             protocol.INST_PING: self._ping,
             protocol.INST_READ: self._read,
             protocol.INST_WRITE: self._write,
@@ -78,7 +92,7 @@ class EmulatedBus:
             protocol.INST_CLEAR: self._clear,
         }
         # sync and bulk instructions name their servos in the parameters, not in the ID
-        self._group_handlers: dict[int, Callable[[protocol.Packet], list[bytes]]] = {
+        self._group_handlers: dict[int, Callable[[protocol.Packet], list[Reply]]] = {
             protocol.INST_SYNC_READ: self._sync_read,
             protocol.INST_SYNC_WRITE: self._sync_write,
             protocol.INST_BULK_READ: self._bulk_read,
@@ -143,10 +157,19 @@ class EmulatedBus:
             out: list[bytes] = []
             for packet in self._reader.feed(data):
                 self.packets_handled += 1
-                out += self._dispatch(packet)
+                out += [r.encode() for r in self._dispatch(packet)]
             return b"".join(out)
 
-    def _dispatch(self, packet: protocol.Packet | protocol.BadPacket) -> list[bytes]:
+    def exchange(self, packet: protocol.Packet) -> list[Reply]:
+        """Answer one decoded request without bytes: the status packets as :class:`Reply`
+        records, in the order they would go on the wire (``sim.dynamixel.direct``)."""
+        with self._lock:
+            if self._clock is None:
+                self._advance_all(self.now())
+            self.packets_handled += 1
+            return self._dispatch(packet)
+
+    def _dispatch(self, packet: protocol.Packet | protocol.BadPacket) -> list[Reply]:
         if isinstance(packet, protocol.BadPacket):
             target = self._find(packet.servo_id)
             return self._status(target, tables.ERR_CRC, b"", _OTHER) if target else []
@@ -174,7 +197,7 @@ class EmulatedBus:
         return None
 
     @staticmethod
-    def _status(servo: EmulatedServo, error: int, params: bytes, kind: int) -> list[bytes]:
+    def _status(servo: EmulatedServo, error: int, params: bytes, kind: int) -> list[Reply]:
         memory = servo.memory  # one-byte items: no lock needed
         if kind > memory[_LEVEL_ADDRESS]:
             return []
@@ -183,21 +206,18 @@ class EmulatedBus:
         fault = servo.take_reply_fault()
         if fault == "drop":
             return []
-        raw = protocol.encode_status(servo.id, error, params)
-        if fault == "corrupt":
-            raw = raw[:-1] + bytes([raw[-1] ^ 0xFF])
-        return [raw]
+        return [Reply(servo.id, error & 0xFF, bytes(params), fault == "corrupt")]
 
     # --- instruction handlers: (packet, addressed servos) -> status packets --------------------
     # (the sync and bulk handlers at the end take the packet alone)
-    def _ping(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
-        out: list[bytes] = []
+    def _ping(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
+        out: list[Reply] = []
         for s in targets:
             params = protocol.u16(s.model_number) + bytes([s.item("Firmware_Version")])
             out += self._status(s, 0, params, _PING)
         return out
 
-    def _read(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _read(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         if packet.servo_id == protocol.BROADCAST_ID or not targets:
             return []
         s = targets[0]
@@ -207,10 +227,10 @@ class EmulatedBus:
         error, data = s.read(address, length)
         return self._status(s, error, data, _READ)
 
-    def _write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         return self._writes(packet, targets, EmulatedServo.write)
 
-    def _reg_write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _reg_write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         return self._writes(packet, targets, EmulatedServo.reg_write)
 
     def _writes(
@@ -218,7 +238,7 @@ class EmulatedBus:
         packet: protocol.Packet,
         targets: list[EmulatedServo],
         op: Callable[[EmulatedServo, int, bytes], int],
-    ) -> list[bytes]:
+    ) -> list[Reply]:
         if len(packet.params) < 3:
             error = tables.ERR_DATA_LENGTH
             results = [error for _ in targets]
@@ -229,12 +249,12 @@ class EmulatedBus:
             return []
         return self._status(targets[0], results[0], b"", _OTHER)
 
-    def _action(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _action(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         for s in targets:
             s.action()
         return []
 
-    def _factory_reset(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _factory_reset(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         if packet.servo_id == protocol.BROADCAST_ID or not targets:
             return []  # a broadcast factory reset is ignored, as on the hardware
         s = targets[0]
@@ -246,15 +266,15 @@ class EmulatedBus:
         s.factory_reset(packet.params[0])
         return reply
 
-    def _reboot(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
-        out: list[bytes] = []
+    def _reboot(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
+        out: list[Reply] = []
         if packet.servo_id != protocol.BROADCAST_ID and targets:
             out = self._status(targets[0], 0, b"", _OTHER)
         for s in targets:
             s.reboot()
         return out
 
-    def _clear(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _clear(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         if packet.params != _CLEAR_KEY:
             errors = [tables.ERR_DATA_RANGE for _ in targets]
         else:
@@ -263,11 +283,11 @@ class EmulatedBus:
             return []
         return self._status(targets[0], errors[0], b"", _OTHER)
 
-    def _sync_read(self, packet: protocol.Packet) -> list[bytes]:
+    def _sync_read(self, packet: protocol.Packet) -> list[Reply]:
         if packet.servo_id != protocol.BROADCAST_ID or len(packet.params) < 5:
             return []
         address, length = _word(packet.params, 0), _word(packet.params, 2)
-        out: list[bytes] = []
+        out: list[Reply] = []
         for servo_id in packet.params[4:]:
             s = self._find(servo_id)
             if s is not None:
@@ -275,7 +295,7 @@ class EmulatedBus:
                 out += self._status(s, error, data, _READ)
         return out
 
-    def _sync_write(self, packet: protocol.Packet) -> list[bytes]:
+    def _sync_write(self, packet: protocol.Packet) -> list[Reply]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID or len(params) < 4:
             return []
@@ -289,11 +309,11 @@ class EmulatedBus:
                 s.write_unanswered(address, params[i + 1 : i + chunk])
         return []
 
-    def _bulk_read(self, packet: protocol.Packet) -> list[bytes]:
+    def _bulk_read(self, packet: protocol.Packet) -> list[Reply]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID or not params or len(params) % 5:
             return []
-        out: list[bytes] = []
+        out: list[Reply] = []
         for i in range(0, len(params), 5):
             s = self._find(params[i])
             if s is not None:
@@ -301,7 +321,7 @@ class EmulatedBus:
                 out += self._status(s, error, data, _READ)
         return out
 
-    def _bulk_write(self, packet: protocol.Packet) -> list[bytes]:
+    def _bulk_write(self, packet: protocol.Packet) -> list[Reply]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID:
             return []
