@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
-from config.scene import SceneConfig
+from config.scene import FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
 from estimation.jointfit import JointFit
 from estimation.stiffness import StiffnessEstimate
@@ -50,6 +50,7 @@ from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 from sim.dynamixel.direct import direct_transport
+from sim.dynamixel.timing import BusTiming
 from sim.inprocess import FramePipe, InProcessPort, MemorySerial
 from sim.world import World
 from wire.dynamixel import TICKS_PER_REV
@@ -151,6 +152,7 @@ def _emulators(
     clock: VirtualClock,
     world: World,
     hook: EmulatorHook | None = None,
+    timing: BusTiming | None = None,
 ) -> Iterator[tuple[EmulatedBus, BoardEmulator, Any, Any, Any]]:
     """The emulators of one trial and the control stack's ends of them: (bus, board, servo
     port, packet handler or None for the SDK's, board port)."""
@@ -158,6 +160,7 @@ def _emulators(
         bus = EmulatedBus.from_config(stack.servos, clock=clock)
     else:
         bus = hook.make_bus(stack.servos, clock)
+    bus.timing = timing
     faults = None if hook is None else hook.board_faults
     layout = layout_from_config(stack.sensor, stack.board)
     rate = stack.board.rate_hz
@@ -214,7 +217,8 @@ def run_sim_trial(
     world = trial_world(spec, scene, stack, geo, servos)
     series: dict[str, list[float]] = {}
     on_tick = _series_recorder(world, series) if keep_series else None
-    with _emulators(transport, stack, clock, world, hook) as emulators:
+    timing = bus_timing(scene.fidelity, stack.servos)
+    with _emulators(transport, stack, clock, world, hook, timing) as emulators:
         bus, board, servo_port, handler, board_port = emulators
         servos.bus = bus
         driver = DynamixelBus.from_config(stack.servos, port=servo_port, packet_handler=handler)
@@ -236,6 +240,14 @@ def run_sim_trial(
                     log.write(end_record(result))
     log_path = None if log is None else str(log.path)
     return _outcome(spec, geo, result, estimate, log_path, series)
+
+
+def bus_timing(fidelity: FidelityConfig, servos: ServoBusConfig) -> BusTiming | None:
+    """The servo bus's timing model for a scene's fidelity (None: ideal, replies at once)."""
+    if fidelity.bus_timing == "ideal":
+        return None
+    baud = fidelity.bus_baudrate if fidelity.bus_baudrate is not None else servos.baudrate
+    return BusTiming(baudrate=baud, latency_timer_s=fidelity.latency_timer_ms * 1e-3)
 
 
 def _rig_settings(

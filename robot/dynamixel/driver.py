@@ -21,16 +21,19 @@ turns torque off on every servo before releasing the port, whatever happened bef
 from __future__ import annotations
 
 import contextlib
+import logging
 import math
 import struct
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Self, TypeVar
 
 import dynamixel_sdk as sdk
 
 from config.schema import ServoBusConfig
 from robot.dynamixel import units
+from robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
 from robot.motors import (
     MotorState,
     ServoFaultError,
@@ -41,6 +44,7 @@ from sensor.ports import open_failure
 from wire import dynamixel as tables
 
 R = TypeVar("R")
+log = logging.getLogger(__name__)
 
 _STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
 _STATE_END = sum(tables.X_SERIES_CONTROL_TABLE["Present_Position"])
@@ -94,6 +98,7 @@ class DynamixelBus:
         timeout: float = 0.02,
         max_goal_step: float = math.radians(10.0),
         packet_handler: Any | None = None,
+        usb_serial_sysfs: Path = USB_SERIAL_SYSFS,
     ) -> None:
         names = [m.name for m in motors]
         ids = [m.id for m in motors]
@@ -116,6 +121,7 @@ class DynamixelBus:
         self.max_goal_step = max_goal_step
         self._last_goals: dict[str, float] = {}
         self._connected = False
+        self._sysfs = usb_serial_sysfs  # where Linux shows the USB adapter's latency timer
 
     @classmethod
     def from_config(
@@ -163,6 +169,9 @@ class DynamixelBus:
             raise ServoTransportError(open_failure("servo bus", name, exc)) from exc
         if not opened:
             raise ServoTransportError(f"cannot open {self._port.getPortName()}")
+        warning = latency_warning(str(self._port.getPortName()), self._sysfs)
+        if warning:
+            log.warning("%s", warning)
         self._connected = True
         try:
             for m in self._motors.values():

@@ -18,24 +18,29 @@ bit (0x80) is set while Hardware_Error_Status is non-zero; a packet with a bad C
 servo gets CRC Error; an unknown instruction gets Instruction Error. Fast sync/bulk read are not
 emulated (Instruction Error).
 
+Bus timing: ideal by default (every reply at once). With ``timing`` (a
+:class:`sim.dynamixel.timing.BusTiming`: baud rate, the servos' Return Delay Time, the USB
+adapter's latency timer) and a virtual clock, the host gets each reply when a real U2D2 bus would
+hand it over: the bus advances the clock to that time before the reply is seen (the host is
+blocked on the read meanwhile). Without a clock (real time) the timing is not applied.
+
 Layering: the control table comes from :mod:`wire.dynamixel`, the leaf the driver in ``robot/``
 reads too; ``sim/`` never imports ``robot/``.
 """
 
 from __future__ import annotations
 
-import os
-import select
 import threading
 import time
-import tty
 from collections.abc import Callable, Iterable
 from typing import NamedTuple, Self
 
 from config.schema import ServoBusConfig
 from sim.clock import VirtualClock
 from sim.dynamixel import protocol
+from sim.dynamixel.pty import PtyLink
 from sim.dynamixel.servo import EmulatedServo
+from sim.dynamixel.timing import RETURN_DELAY_UNIT_S, BusTiming
 from wire import dynamixel as tables
 
 _PING, _READ, _OTHER = 0, 1, 2  # reply kinds, compared with Status_Return_Level
@@ -44,6 +49,7 @@ _REALTIME_POLL_S = 0.01
 _ID_ADDRESS = tables.X_SERIES_CONTROL_TABLE["ID"][0]
 _LEVEL_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Status_Return_Level"][0]
 _HW_ERROR_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Hardware_Error_Status"][0]
+_RETURN_DELAY_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Return_Delay_Time"][0]
 
 
 class Reply(NamedTuple):
@@ -69,15 +75,17 @@ class EmulatedBus:
         *,
         clock: VirtualClock | None = None,
         wall_time: Callable[[], float] = time.monotonic,
+        timing: BusTiming | None = None,
     ) -> None:
         self._clock = clock
         self._wall_time = wall_time
+        self.timing = timing
+        self._line_free = 0.0  # bus time at which the line is idle (realistic timing)
         self._t0 = wall_time()
         self._servos: list[EmulatedServo] = []
         self._lock = threading.Lock()
         self._reader = protocol.PacketReader()
-        self._thread: threading.Thread | None = None
-        self._fds: tuple[int, int, int, int] | None = None
+        self._link: PtyLink | None = None
         self.port = ""
         self.packets_handled = 0
         # instructions for the servo(s) the packet's ID addresses
@@ -100,17 +108,22 @@ class EmulatedBus:
         }
         for servo in servos:
             self.add(servo)
-        self._io_lock = threading.Lock()
         if clock is not None:
             clock.on_advance(self._on_clock)
 
     @classmethod
-    def from_config(cls, cfg: ServoBusConfig, *, clock: VirtualClock | None = None) -> Self:
+    def from_config(
+        cls,
+        cfg: ServoBusConfig,
+        *,
+        clock: VirtualClock | None = None,
+        timing: BusTiming | None = None,
+    ) -> Self:
         """The three servos of the roller-gear drive with the IDs and models of ``cfg``."""
         servos = [
             EmulatedServo(s.id, s.model) for s in (cfg.outer_roll, cfg.inner_roll, cfg.translation)
         ]
-        return cls(servos, clock=clock)
+        return cls(servos, clock=clock, timing=timing)
 
     # --- the servos --------------------------------------------------------------------------
     def add(self, servo: EmulatedServo) -> EmulatedServo:
@@ -154,11 +167,14 @@ class EmulatedBus:
         with self._lock:
             if self._clock is None:
                 self._advance_all(self.now())
-            out: list[bytes] = []
+            replies: list[Reply] = []
             for packet in self._reader.feed(data):
                 self.packets_handled += 1
-                out += [r.encode() for r in self._dispatch(packet)]
-            return b"".join(out)
+                replies += self._dispatch(packet)
+            out = [r.encode() for r in replies]
+            due = self._timed(len(data), replies, out)
+        self._wait_until(due)
+        return b"".join(out)
 
     def exchange(self, packet: protocol.Packet) -> list[Reply]:
         """Answer one decoded request without bytes: the status packets as :class:`Reply`
@@ -167,7 +183,36 @@ class EmulatedBus:
             if self._clock is None:
                 self._advance_all(self.now())
             self.packets_handled += 1
-            return self._dispatch(packet)
+            replies = self._dispatch(packet)
+            due = None
+            if self.timing is not None:  # sizes as on the wire: encode only to count the bytes
+                raw = protocol.encode(packet.servo_id, packet.instruction, packet.params)
+                due = self._timed(len(raw), replies, [r.encode() for r in replies])
+        self._wait_until(due)
+        return replies
+
+    # --- bus timing (sim.dynamixel.timing) ---------------------------------------------------
+    def _timed(self, request_bytes: int, replies: list[Reply], raw: list[bytes]) -> float | None:
+        """When the host has these replies (None: at once, or nothing to wait for)."""
+        timing = self.timing
+        if timing is None or self._clock is None:
+            return None
+        answers = []
+        for reply, packet in zip(replies, raw, strict=True):
+            servo = self._find(reply.servo_id)
+            units = 0 if servo is None else servo.memory[_RETURN_DELAY_ADDRESS]
+            answers.append((len(packet), units * RETURN_DELAY_UNIT_S))
+        self._line_free, due = timing.exchange(self.now(), self._line_free, request_bytes, answers)
+        return due
+
+    def _wait_until(self, due: float | None) -> None:
+        """The host waits for its reply: virtual time runs on to ``due`` (outside the locks:
+        the clock's listeners, this bus among them, run during the advance)."""
+        if due is None or self._clock is None:
+            return
+        dt = due - self._clock.now()
+        if dt > 0:
+            self._clock.advance(dt)
 
     def _dispatch(self, packet: protocol.Packet | protocol.BadPacket) -> list[Reply]:
         if isinstance(packet, protocol.BadPacket):
@@ -337,34 +382,20 @@ class EmulatedBus:
             i += 5 + length
         return []
 
-    # --- the pseudo-terminal -----------------------------------------------------------------
+    # --- the pseudo-terminal (sim.dynamixel.pty) ---------------------------------------------
     def open(self) -> str:
         """Create the pty and start answering; returns the port path (also ``self.port``)."""
-        if self._thread is not None:
-            return self.port
-        master, slave = os.openpty()
-        tty.setraw(slave)
-        os.set_blocking(master, False)
-        stop_r, stop_w = os.pipe()
-        self._fds = (master, slave, stop_r, stop_w)
-        self.port = os.ttyname(slave)
-        self._thread = threading.Thread(
-            target=self._serve, name=f"dynamixel-emulator {self.port}", daemon=True
-        )
-        self._thread.start()
+        if self._link is None:
+            idle = self._catch_up if self._clock is None else None
+            self._link = PtyLink(self.handle, idle, _REALTIME_POLL_S)
+            self.port = self._link.port
         return self.port
 
     def close(self) -> None:
         """Stop the thread and close the pty (idempotent)."""
-        if self._thread is None or self._fds is None:
-            return
-        master, slave, stop_r, stop_w = self._fds
-        os.write(stop_w, b"x")
-        self._thread.join(timeout=5.0)
-        for fd in (master, slave, stop_r, stop_w):
-            os.close(fd)
-        self._thread = None
-        self._fds = None
+        if self._link is not None:
+            self._link.close()
+            self._link = None
 
     def __enter__(self) -> Self:
         self.open()
@@ -373,42 +404,14 @@ class EmulatedBus:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def _serve(self) -> None:
-        fds = self._fds
-        if fds is None:
-            return
-        master, _, stop_r, _ = fds
-        poll = _REALTIME_POLL_S if self._clock is None else None
-        while True:
-            ready, _, _ = select.select([master, stop_r], [], [], poll)
-            if stop_r in ready:
-                return
-            if master in ready:
-                self._pump()
-            else:
-                with self._lock:
-                    self._advance_all(self.now())
+    def _catch_up(self) -> None:
+        """Real-time mode, nothing on the line: the servos move on to wall time."""
+        with self._lock:
+            self._advance_all(self.now())
 
     def _pump(self) -> None:
-        """Answer every packet waiting on the pty master (non-blocking)."""
-        with self._io_lock:
-            fds = self._fds
-            if fds is None:
-                return
-            master = fds[0]
-            while True:
-                try:
-                    data = os.read(master, 4096)
-                except (BlockingIOError, OSError):
-                    return
-                if not data:
-                    return
-                view = memoryview(self.handle(data))
-                while view:
-                    try:
-                        view = view[os.write(master, view) :]
-                    except BlockingIOError:
-                        select.select([], [master], [], 1.0)
+        if self._link is not None:
+            self._link.pump()
 
 
 def _word(data: bytes, offset: int) -> int:
