@@ -42,6 +42,12 @@ class FidelityConfig:
     tissue_model: Literal["fe", "closed-form"] = "closed-form"
     viscoelastic: bool = False  # the samples' standard-linear-solid relaxation (off: elastic)
     gravity: bool = False  # gravity on the sensor beam and the tubes (pre-bend, tip sag)
+    # The servo bus's time on the virtual clock (sim/dynamixel/timing.py): "ideal" answers at
+    # once; "realistic" adds wire time at the baud rate (null: the robot's servos.baudrate), each
+    # servo's Return_Delay_Time and the USB adapter's latency timer (Linux FTDI default 16 ms).
+    bus_timing: Literal["ideal", "realistic"] = "ideal"
+    bus_baudrate: int | None = field(default=None, metadata=limits(gt=0, le=10_500_000))
+    latency_timer_ms: float = field(default=16.0, metadata=limits(ge=1, le=255))
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,11 @@ COMMANDS: dict[str, Command] = {
         "palpate.commands.sim",
         "Run a simulated campaign (the paper's robot or bench-top experiment): no hardware needed.",
     ),
+    "study": Command(
+        "palpate.commands.study",
+        "Coverage study: N seeded repeats of a scene's campaign; error and interval coverage "
+        "with bounds.",
+    ),
     "bench": Command(
         "palpate.commands.bench",
         "Speed against error of the mechanics, the signal chain and the servo bus.",

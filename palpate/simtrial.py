@@ -4,8 +4,11 @@ The world (``sim.world``, built by :mod:`palpate.simworld`) feeds the servo emul
 board emulator on one virtual clock; the control stack drives the servos through dynamixel-sdk
 and reads FBG frames through the frame reader, and the trial core (:mod:`robot.trial`, the same
 as on the bench) plans, runs, estimates and records the trial. ``transport="wire"`` puts both
-emulators on pseudo-terminals; ``"fast"`` keeps the same SDK, driver, reader and parser and only
-replaces the ptys by in-process transports (``sim.inprocess``).
+emulators on pseudo-terminals (dynamixel-sdk's packets, pyserial's bytes). ``"fast"`` keeps the
+same driver, drive, rig, reader and trial loop and skips the bytes no one looks at: the driver's
+SDK calls go to the emulated servos' control tables (``sim.dynamixel.direct``). With a fault hook
+(``palpate sim --faults``), whose faults act on bytes, ``"fast"`` keeps the SDK and the parsers
+and only replaces the ptys by in-process transports (``sim.inprocess``).
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
-from config.scene import SceneConfig
+from config.scene import FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
 from estimation.jointfit import JointFit
 from estimation.stiffness import StiffnessEstimate
@@ -46,7 +49,9 @@ from sensor.strain import StrainChain
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
-from sim.inprocess import InProcessPort, MemorySerial
+from sim.dynamixel.direct import direct_transport
+from sim.dynamixel.timing import BusTiming
+from sim.inprocess import FramePipe, InProcessPort, MemorySerial
 from sim.world import World
 from wire.dynamixel import TICKS_PER_REV
 
@@ -147,33 +152,43 @@ def _emulators(
     clock: VirtualClock,
     world: World,
     hook: EmulatorHook | None = None,
-) -> Iterator[tuple[EmulatedBus, BoardEmulator, Any, Any]]:
+    timing: BusTiming | None = None,
+) -> Iterator[tuple[EmulatedBus, BoardEmulator, Any, Any, Any]]:
+    """The emulators of one trial and the control stack's ends of them: (bus, board, servo
+    port, packet handler or None for the SDK's, board port)."""
     if hook is None:
         bus = EmulatedBus.from_config(stack.servos, clock=clock)
     else:
         bus = hook.make_bus(stack.servos, clock)
+    bus.timing = timing
     faults = None if hook is None else hook.board_faults
     layout = layout_from_config(stack.sensor, stack.board)
     rate = stack.board.rate_hz
+    handler: Any = None
     if transport == "wire":
         board = BoardEmulator(world.sample, layout, rate_hz=rate, clock=clock, faults=faults)
         port = bus.open()
         servo_port: Any = port
         board_port: Any = board.port
-    else:
+    elif hook is None:  # nothing needs the bytes: registers and frames in memory
+        frames = FramePipe()
+        board = BoardEmulator(world.sample, layout, rate_hz=rate, clock=clock, frame_sink=frames)
+        board_port = frames
+        servo_port, handler = direct_transport(bus)
+    else:  # the faults act on bytes: SDK packets and encoded frames, in memory
         pipe = MemorySerial()
         board = BoardEmulator(
             world.sample, layout, rate_hz=rate, clock=clock, sink=pipe, faults=faults
         )
-        servo_port, board_port = InProcessPort(bus), pipe
-        if hook is not None:
-            # in-process a reply is there at once or never: with injected packet loss, do not
-            # spin 20 ms of wall time per lost reply (simulated time is not affected)
-            servo_port.reply_timeout_ms = 1.0
+        board_port = pipe
+        servo_port = InProcessPort(bus)
+        # in-process a reply is there at once or never: with injected packet loss, do not
+        # spin 20 ms of wall time per lost reply (simulated time is not affected)
+        servo_port.reply_timeout_ms = 1.0
     if hook is not None:
         hook.attach(clock, bus, board, world)
     try:
-        yield bus, board, servo_port, board_port
+        yield bus, board, servo_port, handler, board_port
     finally:
         if hook is not None:
             hook.detach()
@@ -202,9 +217,11 @@ def run_sim_trial(
     world = trial_world(spec, scene, stack, geo, servos)
     series: dict[str, list[float]] = {}
     on_tick = _series_recorder(world, series) if keep_series else None
-    with _emulators(transport, stack, clock, world, hook) as (bus, board, servo_port, board_port):
+    timing = bus_timing(scene.fidelity, stack.servos)
+    with _emulators(transport, stack, clock, world, hook, timing) as emulators:
+        bus, board, servo_port, handler, board_port = emulators
         servos.bus = bus
-        driver = DynamixelBus.from_config(stack.servos, port=servo_port)
+        driver = DynamixelBus.from_config(stack.servos, port=servo_port, packet_handler=handler)
         reader = FrameReader.from_config(board_port, stack.sensor, stack.board, clock=clock)
         settings = _rig_settings(
             spec, scene, stack, fast_faults=hook is not None and transport == "fast"
@@ -223,6 +240,14 @@ def run_sim_trial(
                     log.write(end_record(result))
     log_path = None if log is None else str(log.path)
     return _outcome(spec, geo, result, estimate, log_path, series)
+
+
+def bus_timing(fidelity: FidelityConfig, servos: ServoBusConfig) -> BusTiming | None:
+    """The servo bus's timing model for a scene's fidelity (None: ideal, replies at once)."""
+    if fidelity.bus_timing == "ideal":
+        return None
+    baud = fidelity.bus_baudrate if fidelity.bus_baudrate is not None else servos.baudrate
+    return BusTiming(baudrate=baud, latency_timer_s=fidelity.latency_timer_ms * 1e-3)
 
 
 def _rig_settings(

@@ -51,6 +51,13 @@ class SerialLike(Protocol):
     def close(self) -> None: ...
 
 
+class FrameTransport(SerialLike, Protocol):
+    """A transport that hands over decoded frames (the simulator's in-process fast path,
+    ``sim.inprocess.FramePipe``): the reader takes them instead of parsing bytes."""
+
+    def take_frames(self) -> list[Frame]: ...
+
+
 @dataclass
 class ReaderCounters:
     """Running totals; ``bytes_received == frames * size + bytes_discarded + pending``."""
@@ -145,6 +152,15 @@ class FrameParser:
             return False
         return True
 
+    def accept(self, frames: list[Frame]) -> list[Frame]:
+        """Frames that arrived decoded: counted and sequence-checked as if parsed from bytes."""
+        c = self.counters
+        c.bytes_received += len(frames) * self.layout.size
+        for frame in frames:
+            self._track_seq(frame.seq)
+        c.frames += len(frames)
+        return frames
+
     def _track_seq(self, seq: int) -> None:
         last = self._last_seq
         self._last_seq = seq
@@ -198,6 +214,10 @@ class FrameReader:
         else:
             self.port_name = str(getattr(port, "port", None) or getattr(port, "name", "") or port)
             self._serial = port
+        # decoded frames, no bytes: the simulator's fast path (FrameTransport)
+        self._frames_in: FrameTransport | None = (
+            port if hasattr(port, "take_frames") else None  # type: ignore[assignment]
+        )
         self._last_arrival = self.clock.now()
         self._stale = False
         self.last_frame: Frame | None = None
@@ -222,6 +242,8 @@ class FrameReader:
 
     def poll(self) -> list[Frame]:
         """Parse whatever bytes are already waiting; never blocks."""
+        if self._frames_in is not None:
+            return self._arrived(self._parser.accept(self._frames_in.take_frames()))
         try:
             waiting = self._serial.in_waiting
             data = self._serial.read(waiting) if waiting else b""
@@ -231,6 +253,8 @@ class FrameReader:
 
     def read(self) -> list[Frame]:
         """Block up to the read timeout for the first byte, then parse all that is waiting."""
+        if self._frames_in is not None:  # in memory: there is nothing to wait for
+            return self.poll()
         try:
             data = self._serial.read(max(1, self._serial.in_waiting))
             waiting = self._serial.in_waiting
@@ -257,7 +281,9 @@ class FrameReader:
         return frames
 
     def _ingest(self, data: bytes) -> list[Frame]:
-        frames = self._parser.feed(data) if data else []
+        return self._arrived(self._parser.feed(data) if data else [])
+
+    def _arrived(self, frames: list[Frame]) -> list[Frame]:
         if frames:
             self._last_arrival = self.clock.now()
             self._stale = False

@@ -5,6 +5,11 @@
   parses every Protocol 2.0 packet and the real driver still runs; only the pty is gone.
 - :class:`MemorySerial` is a byte pipe with the pyserial calls the frame reader uses
   (``in_waiting``, ``read``, ``close``); the board emulator writes encoded frames into it.
+- :class:`FramePipe` hands the board emulator's frames to the frame reader as they are, with no
+  encoding and no parsing (the simulator's fast path, where nothing needs the bytes); the reader
+  still counts them and checks their sequence (``sensor.reader.FrameReader``).
+
+The register-level servo path (no packets at all) is ``sim.dynamixel.direct``.
 
 Tests run the same trial on both paths and compare the results.
 """
@@ -17,6 +22,7 @@ from typing import Any
 import dynamixel_sdk as sdk
 
 from sim.dynamixel.bus import EmulatedBus
+from wire.frame import Frame
 
 
 class InProcessPort(sdk.PortHandler):  # type: ignore[misc]  # the SDK is untyped
@@ -86,6 +92,37 @@ class MemorySerial:
             out = bytes(self._buf[:size])
             del self._buf[:size]
         return out
+
+    def close(self) -> None:
+        self.closed = True
+
+
+class FramePipe:
+    """A thread-safe in-memory frame queue: a board emulator's frame sink and a frame reader's
+    transport (``take_frames``); as a serial object it never has bytes waiting."""
+
+    def __init__(self, name: str = "memory://board-frames") -> None:
+        self.name = name
+        self.port = name
+        self._frames: list[Frame] = []
+        self._lock = threading.Lock()
+        self.closed = False
+
+    def put_frames(self, frames: list[Frame]) -> None:
+        with self._lock:
+            self._frames += frames
+
+    def take_frames(self) -> list[Frame]:
+        with self._lock:
+            out, self._frames = self._frames, []
+        return out
+
+    @property
+    def in_waiting(self) -> int:
+        return 0
+
+    def read(self, size: int = 1) -> bytes:
+        return b""
 
     def close(self) -> None:
         self.closed = True

@@ -280,7 +280,8 @@ def frame_from_si(
     )
 
 
-def _check_ranges(frame: Frame) -> None:
+def check_ranges(frame: Frame) -> None:
+    """ValueError if a field of ``frame`` does not fit its type (what :func:`encode` checks)."""
     checks = (
         ("seq", frame.seq, 0, U32_MAX),
         ("timestamp_us", frame.timestamp_us, 0, U64_MAX),
@@ -298,7 +299,7 @@ def _check_ranges(frame: Frame) -> None:
 def encode(frame: Frame) -> bytes:
     """The bytes of one frame, CRC included; ValueError if a field does not fit its type."""
     layout = frame.layout
-    _check_ranges(frame)
+    check_ranges(frame)
     optional = (frame.reference_fm,) * layout.has_reference + (frame.force_un,) * layout.has_force
     body = layout.struct.pack(
         *layout.header,

@@ -2,8 +2,9 @@
 
 :class:`DynamixelBus` satisfies :class:`robot.motors.MotorBus`. It takes its transport in the
 constructor: a port path (``"/dev/ttyUSB0"``, or the pty of ``sim.dynamixel.EmulatedBus``) or an
-already constructed ``dynamixel_sdk.PortHandler``. Nothing is patched and nothing is built behind
-the caller's back, so a test hands it the emulator's port.
+already constructed ``dynamixel_sdk.PortHandler`` (and, optionally, an object with the SDK
+packet handler's calls: the simulator's register-level path). Nothing is patched and nothing is
+built behind the caller's back, so a test hands it the emulator's port.
 
 Per control tick it makes one sync write of the goals (:meth:`DynamixelBus.write_goals`) and one
 sync read of Moving .. Present_Position (:meth:`DynamixelBus.read_state`). The sync read is made
@@ -20,16 +21,19 @@ turns torque off on every servo before releasing the port, whatever happened bef
 from __future__ import annotations
 
 import contextlib
+import logging
 import math
 import struct
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Self, TypeVar
 
 import dynamixel_sdk as sdk
 
 from config.schema import ServoBusConfig
 from robot.dynamixel import units
+from robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
 from robot.motors import (
     MotorState,
     ServoFaultError,
@@ -40,6 +44,7 @@ from sensor.ports import open_failure
 from wire import dynamixel as tables
 
 R = TypeVar("R")
+log = logging.getLogger(__name__)
 
 _STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
 _STATE_END = sum(tables.X_SERIES_CONTROL_TABLE["Present_Position"])
@@ -92,6 +97,8 @@ class DynamixelBus:
         retries: int = 3,
         timeout: float = 0.02,
         max_goal_step: float = math.radians(10.0),
+        packet_handler: Any | None = None,
+        usb_serial_sysfs: Path = USB_SERIAL_SYSFS,
     ) -> None:
         names = [m.name for m in motors]
         ids = [m.id for m in motors]
@@ -106,16 +113,22 @@ class DynamixelBus:
         self._by_id = {m.id: m for m in motors}
         self._ids = [m.id for m in motors]  # the sync read's parameter (made once, not per tick)
         self._port = _TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
-        self._ph = sdk.PacketHandler(2.0)
+        # the SDK's Protocol 2.0 packet handler, or one with its calls (the simulator's
+        # register-level fast path, ``sim.dynamixel.direct``): this class decides the same
+        self._ph = sdk.PacketHandler(2.0) if packet_handler is None else packet_handler
         self._baudrate = baudrate
         self._retries = retries
         self.max_goal_step = max_goal_step
         self._last_goals: dict[str, float] = {}
         self._connected = False
+        self._sysfs = usb_serial_sysfs  # where Linux shows the USB adapter's latency timer
 
     @classmethod
-    def from_config(cls, cfg: ServoBusConfig, port: str | Any | None = None) -> Self:
-        """The drive's three servos; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty)."""
+    def from_config(
+        cls, cfg: ServoBusConfig, port: str | Any | None = None, packet_handler: Any | None = None
+    ) -> Self:
+        """The drive's three servos; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty),
+        ``packet_handler`` the SDK's (see :meth:`__init__`)."""
         motors = [
             Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
             Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
@@ -128,6 +141,7 @@ class DynamixelBus:
             retries=cfg.retries,
             timeout=cfg.timeout,
             max_goal_step=cfg.max_goal_step,
+            packet_handler=packet_handler,
         )
 
     @property
@@ -155,6 +169,9 @@ class DynamixelBus:
             raise ServoTransportError(open_failure("servo bus", name, exc)) from exc
         if not opened:
             raise ServoTransportError(f"cannot open {self._port.getPortName()}")
+        warning = latency_warning(str(self._port.getPortName()), self._sysfs)
+        if warning:
+            log.warning("%s", warning)
         self._connected = True
         try:
             for m in self._motors.values():

@@ -3,9 +3,13 @@
 One file per trial. Line 1 is the header (format name and version, trial id, what ran, the plan,
 the sensor model the estimator needs). Then one record per line, each with a ``kind``:
 ``sample`` (one control tick), ``transition`` (state machine), ``estimate`` (the result) and
-``end`` (the trial closed, with its final state and reason). Every line is flushed (and fsync'ed
-on request) as it is written, so a crash or SIGKILL keeps every record written before it; a
-reader tells a complete log (has ``end``) from a truncated one.
+``end`` (the trial closed, with its final state and reason). Lines are flushed (and fsync'ed on
+request) in batches: at every record that is not a ``sample`` (a state change, the estimate, the
+end) and whenever the pending samples span ``flush_every_s`` (0.1 s) of their own time ``t``, so a
+crash or SIGKILL keeps every record up to the last state change and loses at most 0.1 s of
+samples after it; :attr:`TrialLogWriter.records` counts the lines on disk. A reader tells a
+complete log (has ``end``) from a truncated one. (Batching: one flush per 25 ticks at 250 Hz
+instead of one per line, about 5 % of a bench trial's CPU.)
 
 Floats are written with ``repr`` precision (JSON's default), so replay is exact.
 """
@@ -38,30 +42,60 @@ def _clean(value: Any) -> Any:
 class TrialLogWriter:
     """Writes one trial's log. Use as a context manager; ``close`` is idempotent."""
 
-    def __init__(self, path: str | Path, header: dict[str, Any], *, fsync: bool = False) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        header: dict[str, Any],
+        *,
+        fsync: bool = False,
+        flush_every_s: float = 0.1,
+    ) -> None:
+        if not flush_every_s >= 0:
+            raise ValueError(f"flush_every_s must be >= 0, got {flush_every_s}")
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._fsync = fsync
-        self.records = 0  # lines written (header included), each flushed to the OS
+        self._every = flush_every_s
+        self.records = 0  # lines flushed to the OS (header included): what a crash keeps
+        self.written = 0  # lines handed to write(), flushed or pending
+        self._pending: list[str] = []
+        self._pending_t0 = math.inf  # time ``t`` of the oldest pending sample
         self._fh: IO[str] | None = open(self.path, "x", encoding="utf-8")  # noqa: SIM115
         self.write({"kind": "header", "format": FORMAT, "version": VERSION, **header})
 
     def write(self, record: dict[str, Any]) -> None:
+        """Append one record; flushed at once unless it is a sample (see the module docstring)."""
         if self._fh is None:
             raise ValueError(f"trial log {self.path} is closed")
         try:  # the common case: nothing to clean, one pass
             line = json.dumps(record, separators=(",", ":"), allow_nan=False)
         except ValueError:  # a NaN or an infinity somewhere: written as null
             line = json.dumps(_clean(record), separators=(",", ":"), allow_nan=False)
-        self._fh.write(line)
-        self._fh.write("\n")
+        self._pending.append(line)
+        self.written += 1
+        t = record.get("t")
+        if record.get("kind") != "sample" or not isinstance(t, float | int):
+            self.flush()
+            return
+        self._pending_t0 = min(self._pending_t0, t)
+        if t - self._pending_t0 >= self._every:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the pending lines and flush them to the OS (fsync'ed on request)."""
+        if self._fh is None or not self._pending:
+            return
+        self._fh.write("\n".join(self._pending) + "\n")
         self._fh.flush()
         if self._fsync:
             os.fsync(self._fh.fileno())
-        self.records += 1
+        self.records += len(self._pending)
+        self._pending.clear()
+        self._pending_t0 = math.inf
 
     def close(self) -> None:
         if self._fh is not None:
+            self.flush()
             self._fh.close()
             self._fh = None
 

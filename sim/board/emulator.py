@@ -10,6 +10,12 @@ Two ways to run:
   samples whose times fall in the elapsed interval ``(t_prev, t]``; nothing depends on wall time;
 - free-running (``clock=None``): a thread emits samples in real time (``palpate emulate``).
 
+Three ways out: a pty (the hardware path), a byte sink (``sink``: encoded frames in memory), or
+a frame sink (``frame_sink``: the frames themselves, range-checked as :func:`wire.frame.encode`
+would, never encoded; for the simulator's fast path, where nothing needs the bytes). A frame sink
+cannot carry the byte-level faults (drops, garbage, bit flips, truncation, stalls): those need
+bytes, and the constructor says so.
+
 Writes go through a writer thread, so a clock advance never blocks on a full pty buffer; a
 bounded queue models the board's transmit buffer (when full, samples are dropped and the next
 frame carries ``Status.OVERRUN``). The faults are drawn per sample by
@@ -28,14 +34,14 @@ import threading
 import time
 import tty
 from types import TracebackType
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from sim.board.faults import BoardFaults, BoardStats, FaultInjector
 from sim.board.source import SampleSource
 from sim.clock import VirtualClock
-from wire.frame import Frame, FrameLayout, Status, encode, frame_from_si
+from wire.frame import Frame, FrameLayout, Status, check_ranges, encode, frame_from_si
 
 
 class ByteSink(Protocol):
@@ -45,6 +51,15 @@ class ByteSink(Protocol):
     def name(self) -> str: ...
 
     def write(self, data: bytes) -> int: ...
+
+
+class FrameSink(Protocol):
+    """Where the fast path puts frames without encoding them (``sim.inprocess.FramePipe``)."""
+
+    @property
+    def name(self) -> str: ...
+
+    def put_frames(self, frames: list[Frame]) -> None: ...
 
 
 class BoardEmulator:
@@ -61,9 +76,13 @@ class BoardEmulator:
         record: bool = False,
         queue_chunks: int = 4096,
         sink: ByteSink | None = None,
+        frame_sink: FrameSink | None = None,
     ) -> None:
         if not rate_hz > 0:
             raise ValueError(f"rate_hz must be > 0, got {rate_hz}")
+        if frame_sink is not None and (sink is not None or (faults and faults.random)):
+            raise ValueError("a frame sink takes no byte sink and no byte-level board faults")
+        self._frame_sink = frame_sink
         self.source = source
         self.layout = layout
         self.rate_hz = float(rate_hz)
@@ -77,14 +96,15 @@ class BoardEmulator:
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._sink = sink
-        if sink is None:
+        self._in_process = sink is not None or frame_sink is not None
+        if not self._in_process:
             self._master, self._slave = pty.openpty()
             tty.setraw(self._slave)  # no echo, no CR/LF mapping, no signals: bytes pass as they are
             os.set_blocking(self._master, False)  # the writer polls: stop() never hangs on a write
             self.port: str = os.ttyname(self._slave)
         else:  # the in-process fast path: frames go straight into the sink, no pty, no thread
             self._master = self._slave = -1
-            self.port = str(getattr(sink, "name", "memory"))
+            self.port = str(getattr(frame_sink or sink, "name", "memory"))
         self._t0 = 0.0
         self._next = 1  # index of the next sample time t0 + k / rate
         self._seq = 0
@@ -109,7 +129,7 @@ class BoardEmulator:
             raise RuntimeError("board emulator was stopped; create a new one")
         self._t0 = self.clock.now() if self.clock is not None else time.monotonic()
         self._running = True
-        if self._sink is None:
+        if not self._in_process:
             writer = threading.Thread(target=self._write_loop, name="board-writer", daemon=True)
             self._threads.append(writer)
             writer.start()
@@ -166,7 +186,7 @@ class BoardEmulator:
             if not self._running:
                 return 0
             due = math.floor((t - self._t0) * self.rate_hz + 1e-9)
-            chunks: list[bytes] = []
+            chunks: list[Any] = []  # encoded frames, or frames for a frame sink
             taken = 0
             sent_before = self.stats.frames_sent
             disconnect_at = self.faults.disconnect_after_s
@@ -184,23 +204,36 @@ class BoardEmulator:
                     continue
                 chunks.append(self._sample(ts))
                 taken += 1
-            data = b"".join(chunks)
             intact = self.stats.frames_sent - sent_before
             stop_after = not self._running
+            if self._frame_sink is not None:
+                self._frame_sink.put_frames(chunks)
+                chunks = []
+        data = b"".join(chunks)
         if data:
             self._enqueue(data, intact)
         if stop_after:
             self._signal_writer()
         return taken
 
-    def _sample(self, ts: float) -> bytes:
+    def _sample(self, ts: float) -> bytes | Frame:
         seq = self._seq
         self._seq = (seq + 1) % 2**32
         self.stats.samples += 1
+        if self._frame_sink is not None:  # no byte faults here (checked in the constructor)
+            frame = self._frame_of(seq, ts)
+            check_ranges(frame)
+            self._injector.log(seq, "sent", 0)
+            self.stats.frames_sent += 1
+            return frame
         return self._injector.sample(seq, ts, self._frame)
 
     def _frame(self, seq: int, ts: float) -> bytes:
         """The encoded frame of sample ``seq`` taken at ``ts`` from the source."""
+        return self._encode(self._frame_of(seq, ts))
+
+    def _frame_of(self, seq: int, ts: float) -> Frame:
+        """The frame of sample ``seq`` taken at ``ts`` from the source."""
         s = self.source(ts)
         flags = s.flags | (Status.OVERRUN if self._overrun else 0)
         self._overrun = False
@@ -216,12 +249,12 @@ class BoardEmulator:
             force=s.force if self.layout.has_force else None,
             flags=flags,
         )
-        return self._encode(frame)
-
-    def _encode(self, frame: Frame) -> bytes:
         layout = frame.layout
         if layout is not self.layout and layout != self.layout:
             raise ValueError(f"source gave {layout}, the board streams {self.layout}")
+        return frame
+
+    def _encode(self, frame: Frame) -> bytes:
         return encode(frame)
 
     def _enqueue(self, data: bytes, intact: int) -> None:

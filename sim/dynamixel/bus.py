@@ -18,24 +18,29 @@ bit (0x80) is set while Hardware_Error_Status is non-zero; a packet with a bad C
 servo gets CRC Error; an unknown instruction gets Instruction Error. Fast sync/bulk read are not
 emulated (Instruction Error).
 
+Bus timing: ideal by default (every reply at once). With ``timing`` (a
+:class:`sim.dynamixel.timing.BusTiming`: baud rate, the servos' Return Delay Time, the USB
+adapter's latency timer) and a virtual clock, the host gets each reply when a real U2D2 bus would
+hand it over: the bus advances the clock to that time before the reply is seen (the host is
+blocked on the read meanwhile). Without a clock (real time) the timing is not applied.
+
 Layering: the control table comes from :mod:`wire.dynamixel`, the leaf the driver in ``robot/``
 reads too; ``sim/`` never imports ``robot/``.
 """
 
 from __future__ import annotations
 
-import os
-import select
 import threading
 import time
-import tty
 from collections.abc import Callable, Iterable
-from typing import Self
+from typing import NamedTuple, Self
 
 from config.schema import ServoBusConfig
 from sim.clock import VirtualClock
 from sim.dynamixel import protocol
+from sim.dynamixel.pty import PtyLink
 from sim.dynamixel.servo import EmulatedServo
+from sim.dynamixel.timing import RETURN_DELAY_UNIT_S, BusTiming
 from wire import dynamixel as tables
 
 _PING, _READ, _OTHER = 0, 1, 2  # reply kinds, compared with Status_Return_Level
@@ -44,6 +49,21 @@ _REALTIME_POLL_S = 0.01
 _ID_ADDRESS = tables.X_SERIES_CONTROL_TABLE["ID"][0]
 _LEVEL_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Status_Return_Level"][0]
 _HW_ERROR_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Hardware_Error_Status"][0]
+_RETURN_DELAY_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Return_Delay_Time"][0]
+
+
+class Reply(NamedTuple):
+    """One status packet before it is encoded: who answers, the error byte (Alert bit included),
+    the parameters, and whether an injected fault corrupts it on the wire."""
+
+    servo_id: int
+    error: int
+    params: bytes
+    corrupt: bool = False
+
+    def encode(self) -> bytes:
+        raw = protocol.encode_status(self.servo_id, self.error, self.params)
+        return raw[:-1] + bytes([raw[-1] ^ 0xFF]) if self.corrupt else raw
 
 
 class EmulatedBus:
@@ -55,19 +75,21 @@ class EmulatedBus:
         *,
         clock: VirtualClock | None = None,
         wall_time: Callable[[], float] = time.monotonic,
+        timing: BusTiming | None = None,
     ) -> None:
         self._clock = clock
         self._wall_time = wall_time
+        self.timing = timing
+        self._line_free = 0.0  # bus time at which the line is idle (realistic timing)
         self._t0 = wall_time()
         self._servos: list[EmulatedServo] = []
         self._lock = threading.Lock()
         self._reader = protocol.PacketReader()
-        self._thread: threading.Thread | None = None
-        self._fds: tuple[int, int, int, int] | None = None
+        self._link: PtyLink | None = None
         self.port = ""
         self.packets_handled = 0
         # instructions for the servo(s) the packet's ID addresses
-        self._handlers: dict[int, Callable[[protocol.Packet, list[EmulatedServo]], list[bytes]]] = {
+        self._handlers: dict[int, Callable[[protocol.Packet, list[EmulatedServo]], list[Reply]]] = {
             protocol.INST_PING: self._ping,
             protocol.INST_READ: self._read,
             protocol.INST_WRITE: self._write,
@@ -78,7 +100,7 @@ class EmulatedBus:
             protocol.INST_CLEAR: self._clear,
         }
         # sync and bulk instructions name their servos in the parameters, not in the ID
-        self._group_handlers: dict[int, Callable[[protocol.Packet], list[bytes]]] = {
+        self._group_handlers: dict[int, Callable[[protocol.Packet], list[Reply]]] = {
             protocol.INST_SYNC_READ: self._sync_read,
             protocol.INST_SYNC_WRITE: self._sync_write,
             protocol.INST_BULK_READ: self._bulk_read,
@@ -86,17 +108,22 @@ class EmulatedBus:
         }
         for servo in servos:
             self.add(servo)
-        self._io_lock = threading.Lock()
         if clock is not None:
             clock.on_advance(self._on_clock)
 
     @classmethod
-    def from_config(cls, cfg: ServoBusConfig, *, clock: VirtualClock | None = None) -> Self:
+    def from_config(
+        cls,
+        cfg: ServoBusConfig,
+        *,
+        clock: VirtualClock | None = None,
+        timing: BusTiming | None = None,
+    ) -> Self:
         """The three servos of the roller-gear drive with the IDs and models of ``cfg``."""
         servos = [
             EmulatedServo(s.id, s.model) for s in (cfg.outer_roll, cfg.inner_roll, cfg.translation)
         ]
-        return cls(servos, clock=clock)
+        return cls(servos, clock=clock, timing=timing)
 
     # --- the servos --------------------------------------------------------------------------
     def add(self, servo: EmulatedServo) -> EmulatedServo:
@@ -140,13 +167,54 @@ class EmulatedBus:
         with self._lock:
             if self._clock is None:
                 self._advance_all(self.now())
-            out: list[bytes] = []
+            replies: list[Reply] = []
             for packet in self._reader.feed(data):
                 self.packets_handled += 1
-                out += self._dispatch(packet)
-            return b"".join(out)
+                replies += self._dispatch(packet)
+            out = [r.encode() for r in replies]
+            due = self._timed(len(data), replies, out)
+        self._wait_until(due)
+        return b"".join(out)
 
-    def _dispatch(self, packet: protocol.Packet | protocol.BadPacket) -> list[bytes]:
+    def exchange(self, packet: protocol.Packet) -> list[Reply]:
+        """Answer one decoded request without bytes: the status packets as :class:`Reply`
+        records, in the order they would go on the wire (``sim.dynamixel.direct``)."""
+        with self._lock:
+            if self._clock is None:
+                self._advance_all(self.now())
+            self.packets_handled += 1
+            replies = self._dispatch(packet)
+            due = None
+            if self.timing is not None:  # sizes as on the wire: encode only to count the bytes
+                raw = protocol.encode(packet.servo_id, packet.instruction, packet.params)
+                due = self._timed(len(raw), replies, [r.encode() for r in replies])
+        self._wait_until(due)
+        return replies
+
+    # --- bus timing (sim.dynamixel.timing) ---------------------------------------------------
+    def _timed(self, request_bytes: int, replies: list[Reply], raw: list[bytes]) -> float | None:
+        """When the host has these replies (None: at once, or nothing to wait for)."""
+        timing = self.timing
+        if timing is None or self._clock is None:
+            return None
+        answers = []
+        for reply, packet in zip(replies, raw, strict=True):
+            servo = self._find(reply.servo_id)
+            units = 0 if servo is None else servo.memory[_RETURN_DELAY_ADDRESS]
+            answers.append((len(packet), units * RETURN_DELAY_UNIT_S))
+        self._line_free, due = timing.exchange(self.now(), self._line_free, request_bytes, answers)
+        return due
+
+    def _wait_until(self, due: float | None) -> None:
+        """The host waits for its reply: virtual time runs on to ``due`` (outside the locks:
+        the clock's listeners, this bus among them, run during the advance)."""
+        if due is None or self._clock is None:
+            return
+        dt = due - self._clock.now()
+        if dt > 0:
+            self._clock.advance(dt)
+
+    def _dispatch(self, packet: protocol.Packet | protocol.BadPacket) -> list[Reply]:
         if isinstance(packet, protocol.BadPacket):
             target = self._find(packet.servo_id)
             return self._status(target, tables.ERR_CRC, b"", _OTHER) if target else []
@@ -174,7 +242,7 @@ class EmulatedBus:
         return None
 
     @staticmethod
-    def _status(servo: EmulatedServo, error: int, params: bytes, kind: int) -> list[bytes]:
+    def _status(servo: EmulatedServo, error: int, params: bytes, kind: int) -> list[Reply]:
         memory = servo.memory  # one-byte items: no lock needed
         if kind > memory[_LEVEL_ADDRESS]:
             return []
@@ -183,21 +251,18 @@ class EmulatedBus:
         fault = servo.take_reply_fault()
         if fault == "drop":
             return []
-        raw = protocol.encode_status(servo.id, error, params)
-        if fault == "corrupt":
-            raw = raw[:-1] + bytes([raw[-1] ^ 0xFF])
-        return [raw]
+        return [Reply(servo.id, error & 0xFF, bytes(params), fault == "corrupt")]
 
     # --- instruction handlers: (packet, addressed servos) -> status packets --------------------
     # (the sync and bulk handlers at the end take the packet alone)
-    def _ping(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
-        out: list[bytes] = []
+    def _ping(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
+        out: list[Reply] = []
         for s in targets:
             params = protocol.u16(s.model_number) + bytes([s.item("Firmware_Version")])
             out += self._status(s, 0, params, _PING)
         return out
 
-    def _read(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _read(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         if packet.servo_id == protocol.BROADCAST_ID or not targets:
             return []
         s = targets[0]
@@ -207,10 +272,10 @@ class EmulatedBus:
         error, data = s.read(address, length)
         return self._status(s, error, data, _READ)
 
-    def _write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         return self._writes(packet, targets, EmulatedServo.write)
 
-    def _reg_write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _reg_write(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         return self._writes(packet, targets, EmulatedServo.reg_write)
 
     def _writes(
@@ -218,7 +283,7 @@ class EmulatedBus:
         packet: protocol.Packet,
         targets: list[EmulatedServo],
         op: Callable[[EmulatedServo, int, bytes], int],
-    ) -> list[bytes]:
+    ) -> list[Reply]:
         if len(packet.params) < 3:
             error = tables.ERR_DATA_LENGTH
             results = [error for _ in targets]
@@ -229,12 +294,12 @@ class EmulatedBus:
             return []
         return self._status(targets[0], results[0], b"", _OTHER)
 
-    def _action(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _action(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         for s in targets:
             s.action()
         return []
 
-    def _factory_reset(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _factory_reset(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         if packet.servo_id == protocol.BROADCAST_ID or not targets:
             return []  # a broadcast factory reset is ignored, as on the hardware
         s = targets[0]
@@ -246,15 +311,15 @@ class EmulatedBus:
         s.factory_reset(packet.params[0])
         return reply
 
-    def _reboot(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
-        out: list[bytes] = []
+    def _reboot(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
+        out: list[Reply] = []
         if packet.servo_id != protocol.BROADCAST_ID and targets:
             out = self._status(targets[0], 0, b"", _OTHER)
         for s in targets:
             s.reboot()
         return out
 
-    def _clear(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[bytes]:
+    def _clear(self, packet: protocol.Packet, targets: list[EmulatedServo]) -> list[Reply]:
         if packet.params != _CLEAR_KEY:
             errors = [tables.ERR_DATA_RANGE for _ in targets]
         else:
@@ -263,11 +328,11 @@ class EmulatedBus:
             return []
         return self._status(targets[0], errors[0], b"", _OTHER)
 
-    def _sync_read(self, packet: protocol.Packet) -> list[bytes]:
+    def _sync_read(self, packet: protocol.Packet) -> list[Reply]:
         if packet.servo_id != protocol.BROADCAST_ID or len(packet.params) < 5:
             return []
         address, length = _word(packet.params, 0), _word(packet.params, 2)
-        out: list[bytes] = []
+        out: list[Reply] = []
         for servo_id in packet.params[4:]:
             s = self._find(servo_id)
             if s is not None:
@@ -275,7 +340,7 @@ class EmulatedBus:
                 out += self._status(s, error, data, _READ)
         return out
 
-    def _sync_write(self, packet: protocol.Packet) -> list[bytes]:
+    def _sync_write(self, packet: protocol.Packet) -> list[Reply]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID or len(params) < 4:
             return []
@@ -289,11 +354,11 @@ class EmulatedBus:
                 s.write_unanswered(address, params[i + 1 : i + chunk])
         return []
 
-    def _bulk_read(self, packet: protocol.Packet) -> list[bytes]:
+    def _bulk_read(self, packet: protocol.Packet) -> list[Reply]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID or not params or len(params) % 5:
             return []
-        out: list[bytes] = []
+        out: list[Reply] = []
         for i in range(0, len(params), 5):
             s = self._find(params[i])
             if s is not None:
@@ -301,7 +366,7 @@ class EmulatedBus:
                 out += self._status(s, error, data, _READ)
         return out
 
-    def _bulk_write(self, packet: protocol.Packet) -> list[bytes]:
+    def _bulk_write(self, packet: protocol.Packet) -> list[Reply]:
         params = packet.params
         if packet.servo_id != protocol.BROADCAST_ID:
             return []
@@ -317,34 +382,20 @@ class EmulatedBus:
             i += 5 + length
         return []
 
-    # --- the pseudo-terminal -----------------------------------------------------------------
+    # --- the pseudo-terminal (sim.dynamixel.pty) ---------------------------------------------
     def open(self) -> str:
         """Create the pty and start answering; returns the port path (also ``self.port``)."""
-        if self._thread is not None:
-            return self.port
-        master, slave = os.openpty()
-        tty.setraw(slave)
-        os.set_blocking(master, False)
-        stop_r, stop_w = os.pipe()
-        self._fds = (master, slave, stop_r, stop_w)
-        self.port = os.ttyname(slave)
-        self._thread = threading.Thread(
-            target=self._serve, name=f"dynamixel-emulator {self.port}", daemon=True
-        )
-        self._thread.start()
+        if self._link is None:
+            idle = self._catch_up if self._clock is None else None
+            self._link = PtyLink(self.handle, idle, _REALTIME_POLL_S)
+            self.port = self._link.port
         return self.port
 
     def close(self) -> None:
         """Stop the thread and close the pty (idempotent)."""
-        if self._thread is None or self._fds is None:
-            return
-        master, slave, stop_r, stop_w = self._fds
-        os.write(stop_w, b"x")
-        self._thread.join(timeout=5.0)
-        for fd in (master, slave, stop_r, stop_w):
-            os.close(fd)
-        self._thread = None
-        self._fds = None
+        if self._link is not None:
+            self._link.close()
+            self._link = None
 
     def __enter__(self) -> Self:
         self.open()
@@ -353,42 +404,14 @@ class EmulatedBus:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def _serve(self) -> None:
-        fds = self._fds
-        if fds is None:
-            return
-        master, _, stop_r, _ = fds
-        poll = _REALTIME_POLL_S if self._clock is None else None
-        while True:
-            ready, _, _ = select.select([master, stop_r], [], [], poll)
-            if stop_r in ready:
-                return
-            if master in ready:
-                self._pump()
-            else:
-                with self._lock:
-                    self._advance_all(self.now())
+    def _catch_up(self) -> None:
+        """Real-time mode, nothing on the line: the servos move on to wall time."""
+        with self._lock:
+            self._advance_all(self.now())
 
     def _pump(self) -> None:
-        """Answer every packet waiting on the pty master (non-blocking)."""
-        with self._io_lock:
-            fds = self._fds
-            if fds is None:
-                return
-            master = fds[0]
-            while True:
-                try:
-                    data = os.read(master, 4096)
-                except (BlockingIOError, OSError):
-                    return
-                if not data:
-                    return
-                view = memoryview(self.handle(data))
-                while view:
-                    try:
-                        view = view[os.write(master, view) :]
-                    except BlockingIOError:
-                        select.select([], [master], [], 1.0)
+        if self._link is not None:
+            self._link.pump()
 
 
 def _word(data: bytes, offset: int) -> int:

@@ -28,6 +28,7 @@ from sim.clock import VirtualClock
 from sim.dynamixel import protocol
 from sim.dynamixel.bus import EmulatedBus
 from sim.dynamixel.servo import EmulatedServo
+from sim.dynamixel.timing import BusTiming
 
 _HEAD = len(protocol.HEADER) + 3  # header, id, two length bytes
 
@@ -87,8 +88,9 @@ class FaultyBus(EmulatedBus):
         *,
         clock: VirtualClock | None = None,
         wall_time: Callable[[], float] = time.monotonic,
+        timing: BusTiming | None = None,
     ) -> None:
-        super().__init__(servos, clock=clock, wall_time=wall_time)
+        super().__init__(servos, clock=clock, wall_time=wall_time, timing=timing)
         self.packet_faults = PacketFaults()
         self.link_stats = LinkStats()
         self._rng = np.random.default_rng(0)

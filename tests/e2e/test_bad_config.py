@@ -18,7 +18,8 @@ from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoTransportError
 from sensor.ports import open_failure
 from sensor.reader import FrameReader, SensorPortError
-from sim.dynamixel.bus import EmulatedBus
+from sim.dynamixel.bus import EmulatedBus, Reply
+from sim.dynamixel.protocol import Packet
 from wire.frame import layout_of
 
 ROBOT = resolve("robot.yaml").read_text(encoding="utf-8")
@@ -27,19 +28,25 @@ SCENE = resolve("scenes/robot.yaml").read_text(encoding="utf-8")
 
 @pytest.fixture
 def moves(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[str]]:
-    """Records every servo packet handled and every driver connect in this process."""
+    """Records every servo packet handled (as bytes, or decoded on the fast path) and every
+    driver connect in this process."""
     seen: list[str] = []
-    handle, connect = EmulatedBus.handle, DynamixelBus.connect
+    handle, exchange, connect = EmulatedBus.handle, EmulatedBus.exchange, DynamixelBus.connect
 
     def spy_handle(self: EmulatedBus, data: bytes) -> bytes:
         seen.append("packet")
         return handle(self, data)
+
+    def spy_exchange(self: EmulatedBus, packet: Packet) -> list[Reply]:
+        seen.append("packet")
+        return exchange(self, packet)
 
     def spy_connect(self: DynamixelBus) -> None:
         seen.append("connect")
         connect(self)
 
     monkeypatch.setattr(EmulatedBus, "handle", spy_handle)
+    monkeypatch.setattr(EmulatedBus, "exchange", spy_exchange)
     monkeypatch.setattr(DynamixelBus, "connect", spy_connect)
     return seen
 

@@ -71,6 +71,8 @@ def test_a_torn_last_line_is_counted_not_fatal(tmp_path: Path) -> None:
     path = tmp_path / "t.jsonl"
     with TrialLogWriter(path, {"trial": "x"}) as w:
         w.write({"kind": "sample", "t": 0.0})
+        assert w.written == 2
+        w.flush()
         assert w.records == 2
     with path.open("a", encoding="utf-8") as fh:
         fh.write('{"kind": "sam')

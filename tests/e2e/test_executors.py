@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from concurrent.futures import Executor
@@ -11,7 +12,7 @@ import pytest
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.campaign import campaign_trials, run_campaign
+from palpate.campaign import campaign_trials, run_campaign, summarize_campaign
 from palpate.cli import main
 from palpate.executors import EXECUTORS, ExecutorUnavailableError, SerialExecutor, open_executor
 from palpate.simtrial import TrialOutcome, TrialSpec
@@ -23,10 +24,12 @@ SPECS: list[TrialSpec] = campaign_trials(BENCH, STACK, seed=4)[::7][:3]
 
 
 def _fingerprint(outcomes: list[TrialOutcome]) -> list[tuple[object, ...]]:
-    """What must not depend on the executor: trial, state, estimate, encoder ticks, sim time."""
-    rows = []
+    """What must not depend on the executor: trial, state, both estimates (the joint fit with
+    its interval), control ticks, simulated time; then the campaign's table, row by row."""
+    rows: list[tuple[object, ...]] = []
     for o in outcomes:
         est = o.estimate
+        jf = o.joint
         rows.append(
             (
                 o.spec.trial_id,
@@ -34,10 +37,15 @@ def _fingerprint(outcomes: list[TrialOutcome]) -> list[tuple[object, ...]]:
                 None if est is None else est.modulus,
                 None if est is None else est.delta,
                 None if est is None else est.force,
+                None if jf is None else (jf.modulus, jf.ci_low, jf.ci_high, jf.contact),
                 o.ticks,
                 o.sim_time,
             )
         )
+    outlier = BENCH.campaign.outlier_above_kpa * 1e3
+    for method in ("joint", "paper"):
+        for row in summarize_campaign(outcomes, outlier, method):
+            rows.append((method, row.sample, row.trials, dataclasses.astuple(row.summary)))
     return rows
 
 
@@ -47,9 +55,11 @@ def serial() -> list[tuple[object, ...]]:
 
 
 def test_the_reference_run_estimates_every_trial(serial: list[tuple[object, ...]]) -> None:
-    assert [r[0] for r in serial] == [s.trial_id for s in SPECS]
+    trials, table = serial[: len(SPECS)], serial[len(SPECS) :]
+    assert [r[0] for r in trials] == [s.trial_id for s in SPECS]
     assert len({s.sample for s in SPECS}) == 3
-    assert all(r[1] == "done" and r[2] is not None for r in serial)
+    assert all(r[1] == "done" and r[2] is not None and r[5] is not None for r in trials)
+    assert [r[:3] for r in table] == [(m, s.sample, 1) for m in ("joint", "paper") for s in SPECS]
 
 
 @pytest.mark.parametrize("kind", ["serial", "thread", "process"])
@@ -63,17 +73,37 @@ def test_results_do_not_depend_on_the_executor(kind: str, serial: list[tuple[obj
     assert sorted(seen) == sorted(s.trial_id for s in SPECS)  # progress once per trial
 
 
-def test_a_local_dask_cluster_gives_the_same_results(serial: list[tuple[object, ...]]) -> None:
+@pytest.fixture(scope="module")
+def pooled() -> list[tuple[object, ...]]:
+    """The campaign through a local process pool of two workers."""
+    with open_executor("process", workers=2) as executor:
+        return _fingerprint(run_campaign(SPECS, BENCH, STACK, executor=executor))
+
+
+def test_a_local_dask_cluster_gives_the_process_pools_table(
+    pooled: list[tuple[object, ...]], serial: list[tuple[object, ...]]
+) -> None:
+    # Dask distributed is in the dev extras: this runs in CI. An in-process cluster (worker
+    # threads, no spawned processes) keeps it quick; the timeouts are generous for a loaded
+    # machine, and nothing here measures time.
     distributed = pytest.importorskip("distributed")
+    seen: list[str] = []
     with (
         distributed.LocalCluster(
-            n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+            n_workers=1,
+            threads_per_worker=2,
+            processes=False,
+            dashboard_address=None,
+            scheduler_port=0,
         ) as cluster,
-        distributed.Client(cluster) as client,
+        distributed.Client(cluster, timeout="120s") as client,
     ):
         executor: Executor = client.get_executor()
-        outcomes = run_campaign(SPECS, BENCH, STACK, executor=executor)
-    assert _fingerprint(outcomes) == serial
+        outcomes = run_campaign(
+            SPECS, BENCH, STACK, executor=executor, progress=lambda o: seen.append(o.spec.trial_id)
+        )
+    assert _fingerprint(outcomes) == pooled == serial  # estimates, ticks, sim time, the table
+    assert sorted(seen) == sorted(s.trial_id for s in SPECS)
 
 
 def test_serial_executor_reports_errors_through_the_future() -> None:

@@ -27,13 +27,24 @@ def bench_spec(seed: int = 3) -> TrialSpec:
 
 
 def test_wire_and_fast_paths_give_the_same_trial(tmp_path: Path) -> None:
-    fast = run_sim_trial(bench_spec(), BENCH, STACK, transport="fast")
-    wire = run_sim_trial(bench_spec(), BENCH, STACK, transport="wire")
+    # wire: dynamixel-sdk's packets and the board's bytes over ptys; fast: the driver's calls on
+    # the servos' registers and the board's frames in memory. The same trial, record by record.
+    fast = run_sim_trial(bench_spec(), BENCH, STACK, transport="fast", log_dir=tmp_path / "f")
+    wire = run_sim_trial(bench_spec(), BENCH, STACK, transport="wire", log_dir=tmp_path / "w")
     assert fast.state == wire.state == "done"
     assert fast.estimate is not None
     assert wire.estimate is not None
     assert fast.estimate.modulus == wire.estimate.modulus
+    assert fast.joint is not None
+    assert wire.joint is not None
+    assert fast.joint.modulus == wire.joint.modulus
     assert fast.ticks == wire.ticks
+    assert fast.sim_time == wire.sim_time
+    fast_log = read_log(Path(str(fast.log_path)))
+    wire_log = read_log(Path(str(wire.log_path)))
+    assert fast_log.complete
+    assert wire_log.complete
+    assert fast_log.records == wire_log.records
 
 
 def test_seed_reproduces_and_changes_the_noise() -> None:

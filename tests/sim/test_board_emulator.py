@@ -8,6 +8,7 @@ import pytest
 from sensor.reader import FrameReader, SensorPortError
 from sim.board import BoardEmulator, BoardFaults, BoardSample, constant_source
 from sim.clock import VirtualClock
+from sim.inprocess import FramePipe, MemorySerial
 from wire.frame import FrameLayout, Status
 
 LAYOUT = FrameLayout(3)
@@ -196,3 +197,49 @@ class _Sink:
     def write(self, data: bytes) -> int:
         self.data += data
         return len(data)
+
+
+def _stream(in_memory: str) -> tuple[list[object], dict[str, int]]:
+    """Two seconds of a moving source through bytes in memory or through a frame pipe."""
+    clock = VirtualClock()
+
+    def source(t: float) -> BoardSample:
+        w = tuple(x * (1.0 + 1e-4 * np.sin(40 * t + k)) for k, x in enumerate(WAVELENGTHS))
+        return BoardSample(wavelengths=w, encoder=round(t * 1e4) - 7, force=-0.25 + t, flags=1)
+
+    layout = FrameLayout(3, has_reference=True, has_force=True)
+
+    def src(t: float) -> BoardSample:
+        return source(t)._replace(reference=1550e-9)
+
+    if in_memory == "frames":
+        pipe: FramePipe | MemorySerial = FramePipe()
+        emu = BoardEmulator(src, layout, rate_hz=500, clock=clock, frame_sink=pipe)
+    else:
+        pipe = MemorySerial()
+        emu = BoardEmulator(src, layout, rate_hz=500, clock=clock, sink=pipe)
+    frames: list[object] = []
+    with emu, FrameReader(pipe, layout, clock=clock) as reader:
+        for _ in range(500):
+            clock.advance(0.004)
+            frames += reader.poll()
+    return frames, reader.counters.as_dict()
+
+
+def test_a_frame_sink_delivers_what_the_bytes_deliver() -> None:
+    by_bytes, counted_bytes = _stream("bytes")
+    by_frames, counted_frames = _stream("frames")
+    assert len(by_bytes) == 1000
+    assert by_frames == by_bytes
+    assert counted_frames == counted_bytes
+
+
+def test_a_frame_sink_refuses_byte_faults() -> None:
+    with pytest.raises(ValueError, match="frame sink"):
+        BoardEmulator(
+            constant_source(WAVELENGTHS),
+            LAYOUT,
+            clock=VirtualClock(),
+            frame_sink=FramePipe(),
+            faults=BoardFaults(drop_probability=0.1),
+        )
