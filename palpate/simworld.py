@@ -31,6 +31,7 @@ from sim.world import Surface, World
 from wire.dynamixel import TICKS_PER_REV
 
 BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
+RIGID_MODULUS = 1e12  # Pa: a ``rigid: true`` sample (sinks ~0.1 um under the sensor's P_cr)
 VERTICAL = np.array([0.0, 0.0, -1.0])
 
 
@@ -51,7 +52,18 @@ class TrialSpec:
 
 
 def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
-    """The simulated tissue's force law for a scene's sample and fidelity switches."""
+    """The simulated tissue's force law for a scene's sample and fidelity switches (a rigid
+    reference sample is a half-space of RIGID_MODULUS)."""
+    if sample.rigid:
+        return TissueModel(
+            modulus=RIGID_MODULUS,
+            poisson=sample.poisson,
+            thickness=math.inf,
+            bonded=True,
+            tip_radius=tip_radius,
+            finite_thickness=False,
+            large_indentation=False,
+        )
     return TissueModel(
         modulus=sample.modulus,
         poisson=sample.poisson,
