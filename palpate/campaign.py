@@ -220,26 +220,36 @@ def summarize_campaign(
     outcomes: Iterable[TrialOutcome], outlier_above: float, method: str = "joint"
 ) -> list[SampleRow]:
     """Per sample: mean, RMSE, IQR and relative error of the estimates (Tables I/II), by
-    ``method``: "joint" (the contact-point-free fit, the default) or "paper" (Eqs. 13-14)."""
+    ``method``: "joint" (the contact-point-free fit, the default: over the trials whose
+    verdict is ``ok`` only) or "paper" (Eqs. 13-14). Rigid references are left out."""
     by_sample: dict[str, list[TrialOutcome]] = {}
     for o in outcomes:
-        by_sample.setdefault(o.spec.sample, []).append(o)
+        if o.calibration is None:
+            by_sample.setdefault(o.spec.sample, []).append(o)
     rows = []
     for name, outs in by_sample.items():
-        estimates = [o.modulus(method) for o in outs]
+        estimates = [_kept(o, method) for o in outs]
         rows.append(
             SampleRow(name, summarize(estimates, outs[0].spec.modulus, outlier_above), len(outs))
         )
     return rows
 
 
+def _kept(o: TrialOutcome, method: str) -> float | None:
+    """The estimate a summary keeps: the joint fit's only when its verdict is ``ok``."""
+    if method == "joint" and o.status != "ok":
+        return None
+    return o.modulus(method)
+
+
 def median_abs_relative_error(
     outcomes: Iterable[TrialOutcome], method: str = "joint"
 ) -> float | None:
+    """Median |relative error| of ``method``'s estimates (the joint fit's: ``ok`` only)."""
     errs = sorted(
         abs(m - o.spec.modulus) / o.spec.modulus
         for o in outcomes
-        if (m := o.modulus(method)) is not None
+        if o.calibration is None and (m := _kept(o, method)) is not None
     )
     if not errs:
         return None
