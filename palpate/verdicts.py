@@ -64,7 +64,7 @@ def estimating(outcomes: Iterable[TrialOutcome]) -> list[TrialOutcome]:
 def tally(outcomes: Iterable[TrialOutcome]) -> Tally:
     """The :class:`Tally` of ``outcomes`` (rigid references are left out)."""
     outs = estimating(outcomes)
-    counts = {s: sum(1 for o in outs if o.status == s) for s in STATUSES}
+    counts: dict[str, int] = {s: sum(1 for o in outs if o.status == s) for s in STATUSES}
     numbered = [o for o in outs if o.status != "none" and o.joint is not None]
     errors = {id(o): _error(o) for o in numbered}
     ok = [abs(errors[id(o)]) for o in numbered if o.status == "ok"]

@@ -11,6 +11,7 @@ from pathlib import Path
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import StackConfig
+from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.campaign import (
     CampaignRun,
     campaign_trials,
@@ -22,7 +23,6 @@ from palpate.campaign import (
 from palpate.executors import add_executor_arguments, open_executor
 from palpate.preflight import check_campaign, check_reachable
 from palpate.progress import progress_bar
-from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec
 from palpate.verdicts import Tally, by_sample, summary_lines, tally
 
