@@ -93,7 +93,9 @@ class FbgConfig:
     strain_coefficient_pm_per_ue: float = field(default=0.424, metadata=limits(gt=0, le=10))
     bare_strain_coefficient_pm_per_ue: float = field(default=1.2, metadata=limits(gt=0, le=10))
     temperature_coefficient_pm_per_degc: float = field(default=10.0, metadata=limits(ge=0, le=100))
-    temperature_compensation: Literal["none", "measured", "reference"] = "none"
+    # "measured" (a separately measured dT) is not offered: the board's frame protocol carries
+    # no temperature, so nothing could supply it (sensor.strain keeps it for offline use)
+    temperature_compensation: Literal["none", "reference"] = "none"
     base_wavelengths_nm: tuple[float, ...] = (1530.0, 1535.0, 1540.0, 1545.0, 1550.0)
     reference_wavelength_nm: float | None = None
     strain_limit_ue: float = field(default=5000.0, metadata=limits(gt=0, le=20000))

@@ -8,19 +8,21 @@ these uncertainties besides the FBG noise.
 
 The grids, and why they are shaped so:
 
-- Poisson's ratio: the ends and the middle of its range. E enters the law as E/(1 - nu^2) times
-  a thin-layer bracket whose coefficients are smooth in nu, so E(nu) is monotone and nearly
-  linear: its ends bound it.
+Every grid is as fine as E's sensitivity requires: neighbouring hypotheses move E by about
+E_STEP (2 %), less than E's statistical half-width, so the union of their intervals has no gap
+between grid points (a coarser grid missed the truth between its points).
+
+- Poisson's ratio: uniform, E_STEP apart in 1/(1 - nu^2) (E enters the law as E/(1 - nu^2),
+  times a thin-layer bracket whose coefficients are smooth in nu).
 - thickness: uniform in 1/h, because the thin-layer bracket is a series in chi = sqrt(R delta)/h,
   i.e. in 1/h, at most CHI_STEP apart in chi at the record's deepest point (the bracket then
-  changes by about 2 % between neighbours, less than E's statistical half-width, so the union
-  of their intervals has no gap; a coarser grid missed layers between its points), from the
-  range's thickest to its thinnest layer; ``unknown`` runs from the half-space (1/h = 0) to the
-  thinnest layer the series covers there (chi = CHI_MAX).
+  changes by about 2 %), from the range's thickest to its thinnest layer; ``unknown`` runs from
+  the half-space (1/h = 0) to the thinnest layer the series covers there (chi = CHI_MAX).
 - bonding: each allowed value.
-- compliance (tube tip or stage, m/N): the ends and the middle of its range; a calibrated
-  compliance is a value (or the calibration's interval), an uncalibrated one the range
-  ``[0, c_max]``. It shifts the depth by c P (``delta = u - e - c P - x0``).
+- compliance (tube tip or stage, m/N): uniform, each step shifting the deepest indentation by
+  E_STEP / 1.5 of itself at the largest load (E ~ delta^-1.5); a calibrated compliance is a
+  value (or the calibration's interval), an uncalibrated one the range ``[0, c_max]``. It
+  shifts the depth by c P (``delta = u - e - c P - x0``).
 
 The hypotheses are the Cartesian product; the provisional one (the middle of every range) is
 fitted first and gives the noise model, and the profile over all of them gives the estimate and
@@ -38,9 +40,11 @@ import numpy as np
 
 from estimation.corrections import CHI_MAX, ContactLaw
 
+E_STEP = 0.02
 CHI_STEP = 0.02
 MAX_THICKNESS_POINTS = 51
-RANGE_POINTS = 3  # Poisson's ratio and compliance ranges: the ends and the middle
+MAX_POINTS = 25  # Poisson's ratio and compliance
+RANGE_POINTS = 3  # a range before the record's depth and load are known
 
 Range = tuple[float, float]
 
@@ -143,11 +147,18 @@ class Belief:
             0.5 * (self.compliance[0] + self.compliance[1]),
         )
 
-    def hypotheses(self, max_depth: float) -> tuple[Hypothesis, ...]:
-        """The grid (see the module docstring); ``max_depth`` (m), the deepest indentation of the
-        provisional fit, places the thinnest layer of an ``unknown`` thickness."""
+    def hypotheses(
+        self, max_depth: float, max_force: float | None = None
+    ) -> tuple[Hypothesis, ...]:
+        """The grid (see the module docstring); ``max_depth`` (m) and ``max_force`` (N), the
+        deepest indentation and the largest load of the provisional fit, set the grids'
+        steps and the thinnest layer of an ``unknown`` thickness."""
         inv = _inverse_thickness(self.thickness, max_depth, self.tip_radius)
-        grid = itertools.product(inv, self.bonded, _points(self.poisson), _points(self.compliance))
+        c = self.compliance
+        n_c = RANGE_POINTS
+        if max_force is not None and max_depth > 0:
+            n_c = _count(1.5 * (c[1] - c[0]) * max_force / max_depth / E_STEP)
+        grid = itertools.product(inv, self.bonded, _poisson_points(self.poisson), _points(c, n_c))
         return tuple(self._hypothesis(*point) for point in grid)
 
     def _hypothesis(
@@ -160,10 +171,25 @@ class Belief:
         return Hypothesis(law, compliance)
 
 
-def _points(r: Range) -> tuple[float, ...]:
+def _count(steps: float) -> int:
+    """Grid points for a range ``steps`` E_STEPs wide: ends included, 2..MAX_POINTS."""
+    return min(max(math.ceil(steps) + 1, 2), MAX_POINTS)
+
+
+def _poisson_points(r: Range) -> tuple[float, ...]:
+    """Poisson ratios uniform in log 1/(1 - nu^2), E_STEP apart at most."""
     if r[0] == r[1]:
         return (r[0],)
-    return tuple(float(x) for x in np.linspace(r[0], r[1], RANGE_POINTS))
+    y0, y1 = (-math.log(1.0 - nu * nu) for nu in r)
+    ys = np.linspace(y0, y1, _count((y1 - y0) / E_STEP))
+    inner = [math.sqrt(1.0 - math.exp(-y)) for y in ys[1:-1]]
+    return (r[0], *inner, r[1])
+
+
+def _points(r: Range, n: int) -> tuple[float, ...]:
+    if r[0] == r[1]:
+        return (r[0],)
+    return tuple(float(x) for x in np.linspace(r[0], r[1], n))
 
 
 def _inverse_thickness(r: Range, max_depth: float | None, tip_radius: float) -> tuple[float, ...]:

@@ -83,7 +83,7 @@ def joint_fit(
         require_significance(fit, noise)
         # 4. profile every hypothesis of the belief in every form; the estimate at the best one
         span = profile_span(fit, noise.scale2, start.hi - start.lo)
-        hypotheses = belief.hypotheses(float(fit.depth.max()))
+        hypotheses = belief.hypotheses(float(fit.depth.max()), float(record.force.max()))
         refit = _Refit(record, start, fit, encoder_resolution, f_scale, max_nfev)
 
         def weights_at(compliance: float) -> FloatArray:
