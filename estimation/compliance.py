@@ -8,11 +8,14 @@ shortening e (read from the strains, ``estimation.beamstate``) and the clamp's g
     u - e = x0 + c P        (P > 0, in contact)
 
 a straight line in P whose slope is the compliance c (m/N) and whose intercept is the contact
-position. :func:`fit_compliance` fits it by least squares on the samples clearly in contact
-(between LOAD_WINDOW of the record's largest load: below, the contact's onset; the upper end
-keeps the buckled plateau, where P hardly changes, from dominating). The interval is the
-slope's, with the residuals' scatter inflated by their lag-1 autocorrelation (an AR(1) misfit
-shortens the effective sample, as in ``estimation.jointfit.noise``). A rigid rig gives c ~ 0.
+position. :func:`fit_compliance` fits it by least squares on the rising part of the record
+between LOAD_WINDOW of its largest load (below, the contact's onset; above, the buckled plateau,
+where the load hardly changes and the strain-inferred shortening's small errors would set the
+slope). The interval is the slope's, with the residuals' scatter inflated by their lag-1
+autocorrelation (an AR(1) misfit shortens the effective sample, as in
+``estimation.jointfit.noise``). A stiff rig's load rises within a few samples (fewer than
+MIN_POINTS): its compliance is then bounded, not resolved, by the advance the rise took (plus
+one sample's step) over the load it gained: c in [0, that bound].
 
 The estimate of every other trial then subtracts c P from the depth (``estimation.belief``);
 an uncalibrated rig is profiled over a plausible range instead, and its verdict says so.
@@ -28,9 +31,11 @@ from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from estimation.jointfit.noise import lag1
+
+FloatArray = NDArray[np.float64]
 
 LOAD_WINDOW = (0.2, 0.95)
 MIN_POINTS = 10
@@ -81,11 +86,11 @@ def fit_compliance(
     if u.size == 0 or not float(np.max(P)) > 0.0:
         return ComplianceFit(False, "no contact: the load never rises", confidence=confidence)
     lo, hi = LOAD_WINDOW
-    sel = (lo * P.max() < P) & (hi * P.max() > P)
+    top = int(np.argmax(P >= hi * P.max()))  # the rise ends where the load first reaches hi
+    sel = (lo * P.max() < P) & (np.arange(P.size) < top)
     n = int(np.count_nonzero(sel))
     if n < MIN_POINTS:
-        msg = f"too few samples in contact: {n} between {lo:g} and {hi:g} of the largest load"
-        return ComplianceFit(False, msg, n_points=n, confidence=confidence)
+        return _bounded(u, P, top, n, confidence)
     x, y = P[sel], (u - e)[sel]
     A = np.column_stack([x, np.ones(n)])
     coef, *_ = np.linalg.lstsq(A, y, rcond=None)
@@ -96,6 +101,21 @@ def fit_compliance(
     half = NormalDist().inv_cdf(0.5 + 0.5 * confidence) * math.sqrt(max(var_c, 0.0))
     c = float(coef[0])
     return ComplianceFit(True, "ok", c, c - half, c + half, float(coef[1]), n, confidence)
+
+
+def _bounded(u: FloatArray, P: FloatArray, top: int, n: int, confidence: float) -> ComplianceFit:
+    """A stiff rig: c in [0, (advance over the rise + one step) / load gained]."""
+    lo = LOAD_WINDOW[0]
+    start = int(np.argmax(P > lo * P.max()))
+    steps = np.diff(u)
+    step = float(np.median(steps[steps > 0])) if np.any(steps > 0) else 0.0
+    gained = float(P[top] - P[start])
+    if top <= start or gained <= 0.0:
+        msg = "no rising load in contact: the compliance is undetermined"
+        return ComplianceFit(False, msg, n_points=n, confidence=confidence)
+    bound = (float(u[top] - u[start]) + step) / gained
+    msg = f"ok (a stiff rig: the load rose within {n} samples; the compliance is bounded)"
+    return ComplianceFit(True, msg, 0.5 * bound, 0.0, bound, None, n, confidence)
 
 
 def pooled(fits: Sequence[ComplianceFit]) -> tuple[float, float] | None:

@@ -40,6 +40,7 @@ FloatArray = NDArray[np.float64]
 
 X0_POINTS = 400
 TABLE_POINTS = 4000
+MIN_R_SQUARED = 0.9  # below, the shifts do not follow the elastica: no buckling in the record
 
 
 def read_frames(path: str | Path, stack: StackConfig) -> FrameBlock:
@@ -92,9 +93,15 @@ def calibrate_frames(
             best = (rss, strain)
     if best is None or not np.any(best[1] != 0.0):
         raise ValueError("the record never reaches buckling: no strain to calibrate against")
-    return fit_strain_coefficient(
+    fit = fit_strain_coefficient(
         best[1].reshape(-1), shift.reshape(-1), confidence=confidence, through_origin=True
     )
+    if fit.r_squared < MIN_R_SQUARED:
+        raise ValueError(
+            f"the record never reaches buckling: the shifts do not follow the elastica's "
+            f"strains (R^2 = {fit.r_squared:.3f} < {MIN_R_SQUARED})"
+        )
+    return fit
 
 
 def _strain_table(beam: Beam, intervals: FloatArray, span: float) -> tuple[FloatArray, FloatArray]:
