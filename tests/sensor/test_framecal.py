@@ -19,16 +19,18 @@ STACK = StackConfig()
 L = 44e-3
 
 
-def stream(k_pm_per_ue: float, x0: float, rng: np.random.Generator, noise_pm: float) -> bytes:
-    """Frames of the stage advancing 1.5 mm past a rigid reference's contact at x0, the peaks
-    shifted by k times the elastica's grating strains at e = u - x0, plus noise."""
+def stream(
+    k_pm_per_ue: float, x0: float, rng: np.random.Generator, noise_pm: float, end: float = 1.5e-3
+) -> bytes:
+    """Frames of the stage advancing to ``end`` past a rigid reference's contact at x0, the
+    peaks shifted by k times the elastica's grating strains at e = u - x0, plus noise."""
     s = STACK.sensor
     sec = composite_section(
         s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
     )
     beam = Beam.from_section(sec, L)
     step = STACK.drive.lead / TICKS_PER_REV
-    counts = np.round(np.linspace(x0 - 0.5e-3, x0 + 1.5e-3, 1500) / step).astype(np.int32)
+    counts = np.round(np.linspace(x0 - 2.5e-3, x0 + end, 1500) / step).astype(np.int32)
     counts = np.concatenate([np.full(40, counts[0]), counts])  # at rest first
     e = np.clip(counts * step - x0, 0.0, None)
     strain = beam.grating_strains(e, grating_intervals(s, L), include_axial=True)
@@ -65,6 +67,6 @@ def test_a_stream_without_buckling_or_frames_is_refused(tmp_path: Path) -> None:
         read_frames(empty, STACK)
     rng = np.random.default_rng(1)
     path = tmp_path / "free.bin"
-    path.write_bytes(stream(0.424, 1.0, rng, noise_pm=1.0))  # contact far beyond the record
+    path.write_bytes(stream(0.424, 30e-3, rng, noise_pm=1.0, end=-0.5e-3))  # never touches
     with pytest.raises(ValueError, match="never reaches buckling"):
         calibrate_frames(read_frames(path, STACK), STACK, 42 * MM)
