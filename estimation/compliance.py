@@ -86,7 +86,7 @@ def fit_compliance(
     if u.size == 0 or not float(np.max(P)) > 0.0:
         return ComplianceFit(False, "no contact: the load never rises", confidence=confidence)
     lo, hi = LOAD_WINDOW
-    top = int(np.argmax(P >= hi * P.max()))  # the rise ends where the load first reaches hi
+    top = int(np.argmax(hi * P.max() <= P))  # the rise ends where the load first reaches hi
     sel = (lo * P.max() < P) & (np.arange(P.size) < top)
     n = int(np.count_nonzero(sel))
     if n < MIN_POINTS:
@@ -106,7 +106,7 @@ def fit_compliance(
 def _bounded(u: FloatArray, P: FloatArray, top: int, n: int, confidence: float) -> ComplianceFit:
     """A stiff rig: c in [0, (advance over the rise + one step) / load gained]."""
     lo = LOAD_WINDOW[0]
-    start = int(np.argmax(P > lo * P.max()))
+    start = int(np.argmax(lo * P.max() < P))
     steps = np.diff(u)
     step = float(np.median(steps[steps > 0])) if np.any(steps > 0) else 0.0
     gained = float(P[top] - P[start])

@@ -53,27 +53,16 @@ class TrialSpec:
 
 def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
     """The simulated tissue's force law for a scene's sample and fidelity switches (a rigid
-    reference sample is a half-space of RIGID_MODULUS)."""
-    if sample.rigid:
-        return TissueModel(
-            modulus=RIGID_MODULUS,
-            poisson=sample.poisson,
-            thickness=math.inf,
-            bonded=True,
-            tip_radius=tip_radius,
-            finite_thickness=False,
-            large_indentation=False,
-        )
+    reference sample is a Hertz half-space of RIGID_MODULUS)."""
+    layered = bool(sample.thickness and fidelity.finite_thickness) and not sample.rigid
     return TissueModel(
-        modulus=sample.modulus,
+        modulus=RIGID_MODULUS if sample.rigid else sample.modulus,
         poisson=sample.poisson,
-        thickness=(
-            sample.thickness if (sample.thickness and fidelity.finite_thickness) else math.inf
-        ),
+        thickness=sample.thickness if layered and sample.thickness else math.inf,
         bonded=sample.bonded,
         tip_radius=tip_radius,
-        finite_thickness=fidelity.finite_thickness,
-        large_indentation=fidelity.large_indentation,
+        finite_thickness=fidelity.finite_thickness and not sample.rigid,
+        large_indentation=fidelity.large_indentation and not sample.rigid,
     )
 
 

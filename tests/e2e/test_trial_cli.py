@@ -69,21 +69,28 @@ def simulated(loaded: LoadedBench, clock: VirtualClock) -> SimulatedBench:
     )
 
 
+def run_on(
+    sim: SimulatedBench, loaded: LoadedBench, clock: VirtualClock, log_dir: Path
+) -> list[BenchOutcome]:
+    """Every trial of the bench file through ``run_session`` on the simulated bench's ports."""
+    return run_session(
+        loaded,
+        plan_bench_trials(loaded),
+        log_dir,
+        servo_port=sim.servo_port,
+        board_port=sim.board_port,
+        clock=clock,
+        sync_to_clock=True,
+    )
+
+
 def session_on_ptys(tmp_path: Path, trials: str) -> tuple[list[BenchOutcome], list[bool], int]:
     """Run a bench file's trials through ``run_session`` on the emulators' ptys; return the
     outcomes, each servo's torque and the stage encoder after the session closed the bus."""
     loaded = load_bench(bench_file(tmp_path, trials))
     clock = VirtualClock()
     with simulated(loaded, clock) as sim:
-        outcomes = run_session(
-            loaded,
-            plan_bench_trials(loaded),
-            tmp_path / "logs",
-            servo_port=sim.servo_port,
-            board_port=sim.board_port,
-            clock=clock,
-            sync_to_clock=True,
-        )
+        outcomes = run_on(sim, loaded, clock, tmp_path / "logs")
         torque = [s.torque_enabled for s in sim.bus.servos]
         return outcomes, torque, sim.servo("translation").position_ticks
 
