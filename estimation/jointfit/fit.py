@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from estimation.belief import Belief, Hypothesis
 from estimation.corrections import ContactLaw
 from estimation.jointfit.envelope import Found, envelope, profile_hypotheses
-from estimation.jointfit.noise import frozen_noise, profile_span, require_significance
+from estimation.jointfit.noise import Noise, frozen_noise, profile_span, require_significance
 from estimation.jointfit.record import Record, check_options, checked_record
 from estimation.jointfit.refine import Refined, refine, require_contact
 from estimation.jointfit.result import FitFailed, JointFit
@@ -82,30 +82,44 @@ def joint_fit(
         noise = frozen_noise(fit, f_scale, confidence)
         require_significance(fit, noise)
         # 4. profile every hypothesis of the belief in every form; the estimate at the best one
-        span = profile_span(fit, noise.scale2, start.hi - start.lo)
-        hypotheses = belief.hypotheses(float(fit.depth.max()), float(record.force.max()))
         refit = _Refit(record, start, fit, encoder_resolution, f_scale, max_nfev)
-
-        def weights_at(compliance: float) -> FloatArray:
-            return refit.weights_at(compliance, noise.weights, confidence)
-
-        found = profile_hypotheses(hypotheses, record, start, fit, noise, span, weights_at)
-        best = hypotheses[found.best_hypothesis[0]]
-        if best != fit.hypothesis:
-            fit = refit.at_best(best, found)
-            require_contact(fit, min_contact_points)
-        return envelope(
-            fit,
-            noise,
-            found,
-            confidence,
-            misalignment,
-            float(record.advance.min()),
-            belief.open_keys,
-            len(hypotheses),
-        )
+        return _profiled(belief, refit, noise, confidence, misalignment, min_contact_points)
     except FitFailed as failure:
         return failure.result(record.n, confidence, provisional.law.name)
+
+
+def _profiled(
+    belief: Belief,
+    refit: _Refit,
+    noise: Noise,
+    confidence: float,
+    misalignment: float | None,
+    min_contact_points: int,
+) -> JointFit:
+    """Step 4 and the result: every hypothesis of ``belief`` profiled (each compliance with
+    its own weights), the estimate refined at the best one, the envelope."""
+    fit, record = refit.fit, refit.record
+    span = profile_span(fit, noise.scale2, refit.start.hi - refit.start.lo)
+    hypotheses = belief.hypotheses(float(fit.depth.max()), float(record.force.max()))
+
+    def weights_at(compliance: float) -> FloatArray:
+        return refit.weights_at(compliance, noise.weights, confidence)
+
+    found = profile_hypotheses(hypotheses, record, refit.start, fit, noise, span, weights_at)
+    best = hypotheses[found.best_hypothesis[0]]
+    if best != fit.hypothesis:
+        fit = refit.at_best(best, found)
+        require_contact(fit, min_contact_points)
+    return envelope(
+        fit,
+        noise,
+        found,
+        confidence,
+        misalignment,
+        float(record.advance.min()),
+        belief.open_keys,
+        len(hypotheses),
+    )
 
 
 @dataclass(frozen=True)
