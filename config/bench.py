@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Literal
 
 from config.loader import ConfigError, limits, load, resolve
+from config.sample import AssumedConfig
 from config.scene import CampaignConfig
 from config.schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
 
@@ -42,7 +43,14 @@ class PortConfig:
 
 @dataclass(frozen=True)
 class BenchTrialConfig:
-    """One trial of the bench campaign: a stored pose and what is under it."""
+    """One trial of the bench campaign: a stored pose and what is under it.
+
+    ``assumed``: what the operator believes about the sample (``config.sample.AssumedConfig``:
+    thickness, bonding, Poisson's ratio, each a value, a range or ``unknown``); a key left out
+    is ``unknown`` for the thickness and the bonding, and ``poisson`` for the Poisson ratio.
+    ``rigid``: the pose faces a rigid reference; the trial calibrates the tube's (the stage's)
+    compliance for the session's later trials instead of estimating a modulus.
+    """
 
     target: str  # a name in the targets file: the stand-off pose (tube, roll, translation)
     sample: str = ""  # a label for the table and the log
@@ -50,6 +58,8 @@ class BenchTrialConfig:
     poisson: float = field(default=0.45, metadata=limits(ge=0, le=0.5))
     # bench-top (vertical stage) only: the fixed exposed length; null = sensor.exposed_length_mm
     exposed_length_mm: float | None = field(default=None, metadata=limits(gt=0, le=500))
+    assumed: AssumedConfig | None = None
+    rigid: bool = False
 
     @property
     def modulus(self) -> float | None:

@@ -93,7 +93,9 @@ class FbgConfig:
     strain_coefficient_pm_per_ue: float = field(default=0.424, metadata=limits(gt=0, le=10))
     bare_strain_coefficient_pm_per_ue: float = field(default=1.2, metadata=limits(gt=0, le=10))
     temperature_coefficient_pm_per_degc: float = field(default=10.0, metadata=limits(ge=0, le=100))
-    temperature_compensation: Literal["none", "measured", "reference"] = "none"
+    # "measured" (a separately measured dT) is not offered: the board's frame protocol carries
+    # no temperature, so nothing could supply it (sensor.strain keeps it for offline use)
+    temperature_compensation: Literal["none", "reference"] = "none"
     base_wavelengths_nm: tuple[float, ...] = (1530.0, 1535.0, 1540.0, 1545.0, 1550.0)
     reference_wavelength_nm: float | None = None
     strain_limit_ue: float = field(default=5000.0, metadata=limits(gt=0, le=20000))
@@ -258,6 +260,11 @@ class TubeConfig:
 
     ``flush_translation_mm`` is the stage translation at which the centre of the sensor's tip
     sphere is at the tube tip (exposed length L = 0); L = translation - flush translation.
+
+    ``compliance_mm_per_n``: the tube tip's axial compliance (mm of tip travel per N of load),
+    calibrated on a rigid reference (``palpate calibrate``): a value or the calibration's
+    ``[min, max]``; null = not calibrated (the estimate then spans
+    ``calibration.uncalibrated_compliance_max_mm_per_n`` and says so).
     """
 
     name: str
@@ -265,10 +272,14 @@ class TubeConfig:
     straight_length_mm: float = field(default=40.0, metadata=limits(ge=0, le=1000))
     arc_length_mm: float = field(default=40.0, metadata=limits(ge=0, le=1000))
     flush_translation_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
+    compliance_mm_per_n: float | tuple[float, float] | None = field(
+        default=None, metadata=limits(ge=0, le=100)
+    )
 
     def validate(self) -> None:
         if self.tip_angle_deg > 0 and self.arc_length_mm <= 0:
             raise ValueError(f"tube {self.name!r}: a bent tube needs arc_length_mm > 0")
+        check_compliance("compliance_mm_per_n", self.compliance_mm_per_n)
 
     @property
     def tip_angle(self) -> float:
@@ -285,6 +296,36 @@ class TubeConfig:
     @property
     def flush_translation(self) -> float:
         return self.flush_translation_mm * MM
+
+
+def check_compliance(key: str, value: float | tuple[float, float] | None) -> None:
+    """ValueError naming ``key`` unless a [min, max] compliance has min <= max."""
+    if isinstance(value, tuple) and not value[0] <= value[1]:
+        raise ValueError(f"{key}: a range [min, max] needs min <= max, got {list(value)}")
+
+
+def compliance_range(value: float | tuple[float, float] | None) -> tuple[float, float] | None:
+    """A compliance key as (min, max) in m/N; None when not calibrated."""
+    if value is None:
+        return None
+    lo, hi = value if isinstance(value, tuple) else (value, value)
+    return lo * MM, hi * MM
+
+
+@dataclass(frozen=True)
+class CalibrationConfig:
+    """What is calibrated besides the tubes: the bench-top stage's compliance (as a tube's
+    ``compliance_mm_per_n``; null = not calibrated) and the range an uncalibrated compliance is
+    taken to span, ``[0, uncalibrated_compliance_max_mm_per_n]`` (0.1 mm/N: a tip as compliant
+    as 10 N/mm, the printed tube the paper blames for its robot errors)."""
+
+    stage_compliance_mm_per_n: float | tuple[float, float] | None = field(
+        default=None, metadata=limits(ge=0, le=100)
+    )
+    uncalibrated_compliance_max_mm_per_n: float = field(default=0.1, metadata=limits(gt=0, le=100))
+
+    def validate(self) -> None:
+        check_compliance("stage_compliance_mm_per_n", self.stage_compliance_mm_per_n)
 
 
 DEFAULT_TUBES: tuple[TubeConfig, ...] = (
@@ -305,6 +346,7 @@ class StackConfig:
     servos: ServoBusConfig = ServoBusConfig()
     drive: DriveConfig = DriveConfig()
     tubes: tuple[TubeConfig, ...] = DEFAULT_TUBES
+    calibration: CalibrationConfig = CalibrationConfig()
 
     def validate(self) -> None:
         names = [t.name for t in self.tubes]
@@ -315,6 +357,20 @@ class StackConfig:
                 f"fbg.base_wavelengths_nm lists {len(self.fbg.base_wavelengths_nm)} gratings, "
                 f"sensor.grating_count is {self.sensor.grating_count}"
             )
+
+    def compliance(self, tube: str | None) -> tuple[tuple[float, float], bool]:
+        """The compliance (min, max) in m/N between the stage encoder and the sensor's clamp of
+        ``tube`` (None: the bench-top stage), and whether it is calibrated (else the
+        uncalibrated range)."""
+        value = (
+            self.calibration.stage_compliance_mm_per_n
+            if tube is None
+            else self.tube(tube).compliance_mm_per_n
+        )
+        calibrated = compliance_range(value)
+        if calibrated is not None:
+            return calibrated, True
+        return (0.0, self.calibration.uncalibrated_compliance_max_mm_per_n * MM), False
 
     def tube(self, name: str) -> TubeConfig:
         for t in self.tubes:

@@ -1,74 +1,54 @@
 """Scripted trials on the bench: stored poses -> trial plans -> the same trial loop as simulation.
 
-:func:`plan_bench_trials` turns the bench file's trial list and the stored targets into
-:class:`robot.indentation.TrialPlan` s, checked against the drive's limits before anything moves.
-:func:`run_bench_trials` runs them in order on opened interfaces (:mod:`palpate.hardware`) with
-:func:`robot.trial.run.run_trial` and the :class:`robot.rig.ServoFbgRig`, writes one crash-safe
-log per trial as it goes (readable by ``palpate replay``) and estimates the modulus with the same
-trial core (:mod:`robot.trial`) as ``palpate sim``.
-
-A stored pose is the stand-off pose: the trial rolls there with the sensor back, advances to it,
-approaches the expected surface ``standoff_mm`` further on at the approach speed, indents until
-the buckling detector fires, records ``post_buckling_mm`` more and retracts.
+:func:`plan_bench_trials` (``palpate.benchplan``) turns the bench file's trial list and the
+stored targets into :class:`robot.indentation.TrialPlan` s, checked against the drive's limits
+before anything moves. :func:`run_bench_trials` runs them in order on opened interfaces
+(:mod:`palpate.hardware`) with :func:`robot.trial.run.run_trial` and the
+:class:`robot.rig.ServoFbgRig`, writes one crash-safe log per trial as it goes (readable by
+``palpate replay``) and estimates the modulus with the same trial core (:mod:`robot.trial`) as
+``palpate sim``: the joint fit with its verdict (the paper's estimate beside it), or on a rigid
+reference the compliance, which the session's later trials then use.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
-from config.bench import BenchTrialConfig, LoadedBench
-from config.loader import ConfigError
-from config.schema import MM, TubeConfig
-from config.targets import TargetConfig, TargetsFile, load_targets
+from config.bench import LoadedBench
+from config.sample import UNKNOWN
+from config.schema import MM, StackConfig
+from estimation.compliance import ComplianceFit
+from estimation.jointfit import JointFit
 from estimation.section import Section
 from estimation.stiffness import StiffnessEstimate
+from estimation.verdict import Verdict
+from palpate.benchplan import BenchTrial, plan_bench_trials
+from palpate.calibration import calibrate, rig_key, with_compliance
 from palpate.hardware import Hardware
-from robot.drive import JointLimitError, JointState, RollerGearDrive
-from robot.indentation import State, TrialPlan
+from robot.indentation import State
 from robot.rig import ServoFbgRig
-from robot.trial.estimate import estimate_trial
+from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from robot.trial.inputs import belief_fields
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import end_record, estimate_record, header_common
 from robot.trial.run import run_trial
-from robot.trial.setup import detector_for, guards_for, rig_settings, sensor_section, trial_plan
+from robot.trial.setup import (
+    detector_for,
+    guards_for,
+    position_tolerance,
+    rig_settings,
+    sensor_section,
+)
 from sensor.strain import StrainChain
 
+__all__ = ["SKIPPED", "BenchOutcome", "BenchTrial", "plan_bench_trials", "run_bench_trials"]
+
 SKIPPED = "skipped"
-
-
-@dataclass(frozen=True)
-class BenchTrial:
-    """One planned trial: the pose it starts from and the plan the state machine follows."""
-
-    trial_id: str
-    kind: Literal["bench", "robot"]
-    target: TargetConfig
-    tube: TubeConfig
-    sample: str
-    modulus: float | None  # Pa, when the sample's reference modulus is known
-    poisson: float
-    exposed_length: float  # m at the expected contact
-    plan: TrialPlan
-
-    def describe(self) -> dict[str, Any]:
-        p = self.plan
-        return {
-            "trial": self.trial_id,
-            "target": self.target.name,
-            "sample": self.sample,
-            "tube": self.tube.name,
-            "roll_deg": math.degrees(p.roll),
-            "standoff_translation_mm": (p.contact_advance - p.standoff) / MM,
-            "contact_translation_mm": p.contact_advance / MM,
-            "retract_translation_mm": p.home_advance / MM,
-            "exposed_length_mm": self.exposed_length / MM,
-        }
 
 
 @dataclass
@@ -76,167 +56,54 @@ class BenchOutcome:
     trial: BenchTrial
     state: str
     reason: str
-    estimate: StiffnessEstimate | None = None
+    estimate: StiffnessEstimate | None = None  # the paper's (Eqs. 13-14)
     exposed_length_at_buckling: float | None = None
     duration: float = 0.0
     log_path: str | None = None
+    joint: JointFit | None = None  # the joint fit: the headline estimate
+    verdict: Verdict | None = None
+    calibration: ComplianceFit | None = None  # on a rigid reference
+
+    @property
+    def status(self) -> str:
+        """The verdict's status ("none" without one)."""
+        return "none" if self.verdict is None else self.verdict.status
+
+    def modulus(self) -> float | None:
+        """The joint fit's modulus (Pa), None when its verdict is ``none``."""
+        if self.joint is None or self.status == "none":
+            return None
+        return self.joint.modulus
 
     def as_dict(self) -> dict[str, Any]:
-        est, t = self.estimate, self.trial
-        modulus = None if est is None else est.modulus
+        est, t, jf = self.estimate, self.trial, self.joint
+        paper = None if est is None else est.modulus
+        modulus = self.modulus()
         rel = None
         if modulus is not None and t.modulus is not None:
             rel = (modulus - t.modulus) / t.modulus
+        shown = jf if modulus is not None else None
         return {
             **t.describe(),
             "state": self.state,
             "reason": self.reason,
-            "estimated_kpa": None if modulus is None else modulus / 1e3,
+            "joint_kpa": None if modulus is None else modulus / 1e3,
+            "joint_ci_kpa": None if shown is None else [_kpa(shown.ci_low), _kpa(shown.ci_high)],
+            "verdict": self.status if self.calibration is None else None,
+            "verdict_reasons": [] if self.verdict is None else list(self.verdict.reasons),
+            "estimated_kpa": None if paper is None else paper / 1e3,
             "actual_kpa": None if t.modulus is None else t.modulus / 1e3,
             "relative_error": rel,
             "delta_mm": None if est is None else est.delta / MM,
             "force_n": None if est is None else est.force,
+            "calibration": None if self.calibration is None else self.calibration.as_dict(),
             "duration_s": self.duration,
             "log": self.log_path,
         }
 
 
-def _safe(name: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_") or "trial"
-
-
-def plan_bench_trials(loaded: LoadedBench, only: str | None = None) -> list[BenchTrial]:
-    """The bench file's trials (each ``campaign.repeats`` times), or those at target ``only``.
-
-    Raises ConfigError naming the file and key when a target, a tube or a limit is wrong.
-    """
-    bench, stack = loaded.bench, loaded.stack
-    stored = load_targets(loaded.targets_path)
-    drive = RollerGearDrive(stack.drive)
-    trials: list[BenchTrial] = []
-    for i, entry in _entries(loaded, stored, only):
-        target, tube, where = _target_and_tube(loaded, stored, i, entry)
-        contact = target.translation + bench.campaign.standoff_mm * MM
-        home = bench.retract_translation(target.translation, drive.home.translation)
-        plan = trial_plan(bench.campaign, stack, roll=target.roll, contact=contact, home=home)
-        length = _exposed_length(loaded, entry, tube, contact, where)
-        _check_reach(loaded, drive, target, plan, where)
-        trials += _repeats(loaded, len(trials), entry, target, tube, length, plan)
-    return trials
-
-
-def _entries(
-    loaded: LoadedBench, stored: TargetsFile, only: str | None
-) -> list[tuple[int, BenchTrialConfig]]:
-    """(index in ``trials``, entry) of the bench file's trials to plan; index -1 for a stored
-    pose that ``only`` names and the list omits."""
-    entries = list(enumerate(loaded.bench.trials))
-    if only is not None:
-        entries = [(i, e) for i, e in entries if e.target == only]
-        if not entries:
-            if not any(t.name == only for t in stored.targets):
-                known = sorted(t.name for t in stored.targets)
-                raise ValueError(
-                    f"--target: no target named {only!r} in {loaded.targets_path}; known: {known}"
-                )
-            entries = [(-1, BenchTrialConfig(target=only))]  # a stored pose the list omits
-    if not entries:
-        raise ConfigError(str(loaded.path), "trials", "no trials listed")
-    return entries
-
-
-def _target_and_tube(
-    loaded: LoadedBench, stored: TargetsFile, i: int, entry: BenchTrialConfig
-) -> tuple[TargetConfig, TubeConfig, str]:
-    """The entry's stored pose, its tube, and the pose's key in the targets file."""
-    key = f"trials[{i}].target" if i >= 0 else "--target"
-    try:
-        target = stored.get(entry.target)
-    except KeyError as exc:
-        raise ConfigError(
-            str(loaded.path), key, f"{exc.args[0]} in {loaded.targets_path}"
-        ) from None
-    where = f"targets[{[t.name for t in stored.targets].index(target.name)}]"
-    try:
-        tube = loaded.stack.tube(target.tube)
-    except KeyError as exc:
-        raise ConfigError(str(loaded.targets_path), f"{where}.tube", exc.args[0]) from None
-    return target, tube, where
-
-
-def _exposed_length(
-    loaded: LoadedBench, entry: BenchTrialConfig, tube: TubeConfig, contact: float, where: str
-) -> float:
-    """The sensor's exposed length at the expected contact (m): the entry's (or the sensor's) on
-    the bench stage, the advance past the tube's flush translation on the robot."""
-    if loaded.bench.campaign.kind == "bench":
-        return (entry.exposed_length_mm or loaded.stack.sensor.exposed_length_mm) * MM
-    length = contact - tube.flush_translation
-    if length <= 0:
-        raise ConfigError(
-            str(loaded.targets_path),
-            f"{where}.translation_mm",
-            f"the sensor would still be inside tube {tube.name!r} at contact "
-            f"(exposed length {length / MM:.2f} mm)",
-        )
-    return length
-
-
-def _check_reach(
-    loaded: LoadedBench, drive: RollerGearDrive, target: TargetConfig, plan: TrialPlan, where: str
-) -> None:
-    """The farthest a trial may drive: no contact until the approach window ends, then the
-    travel past contact; both must be inside the drive's limits before anything moves."""
-    past = loaded.bench.campaign.max_travel_past_contact_mm * MM
-    farthest = plan.contact_advance + plan.approach_window + past
-    try:
-        for q in (
-            JointState(target.roll, plan.home_advance),
-            JointState(target.roll, target.translation),
-            JointState(target.roll, farthest),
-        ):
-            drive.check(q)
-    except JointLimitError as exc:
-        raise ConfigError(
-            str(loaded.targets_path),
-            f"{where}.translation_mm",
-            f"target {target.name!r}: the trial may reach {farthest / MM:.2f} mm "
-            f"(contact + approach window + travel past contact): {exc}",
-        ) from None
-
-
-def _repeats(
-    loaded: LoadedBench,
-    planned: int,
-    entry: BenchTrialConfig,
-    target: TargetConfig,
-    tube: TubeConfig,
-    length: float,
-    plan: TrialPlan,
-) -> list[BenchTrial]:
-    """The entry's ``campaign.repeats`` trials, numbered after the ``planned`` ones."""
-    c = loaded.bench.campaign
-    trials: list[BenchTrial] = []
-    for rep in range(c.repeats):
-        parts = [f"{planned + len(trials) + 1:02d}", target.name]
-        if entry.sample:
-            parts.append(entry.sample)
-        if c.repeats > 1:
-            parts.append(f"r{rep}")
-        trials.append(
-            BenchTrial(
-                trial_id=_safe("-".join(parts)),
-                kind=c.kind,
-                target=target,
-                tube=tube,
-                sample=entry.label,
-                modulus=entry.modulus,
-                poisson=entry.poisson,
-                exposed_length=length,
-                plan=plan,
-            )
-        )
-    return trials
+def _kpa(v: float | None) -> float | None:
+    return None if v is None else v / 1e3
 
 
 def run_bench_trials(
@@ -252,10 +119,12 @@ def run_bench_trials(
 
     ``sync_to_clock`` is for emulators on a virtual clock (wait for each tick's frame); on
     hardware it stays False. With ``stop_on_fault`` a trial that does not complete ends the
-    session: the rest are reported as skipped, torque is off.
+    session: the rest are reported as skipped, torque is off. A trial on a rigid reference
+    calibrates the compliance of its tube (the stage) for the session's later trials.
     """
     bench = loaded.bench
     outcomes: list[BenchOutcome] = []
+    session = Session(loaded.stack)
     torque_on = True  # DriveController.start() turned it on
     stopped = False
     for trial in trials:
@@ -265,7 +134,8 @@ def run_bench_trials(
         if not torque_on:
             hw.drive.bus.set_torque(True)
             torque_on = True
-        outcome, rig = _run_one(hw, trial, loaded, log_dir, sync_to_clock)
+        outcome, rig = _run_one(hw, trial, loaded, session.stack, log_dir, sync_to_clock)
+        session.add(trial, outcome)
         outcomes.append(outcome)
         if progress is not None:
             progress(outcome)
@@ -278,11 +148,61 @@ def run_bench_trials(
     return outcomes
 
 
+class Session:
+    """The robot configuration as a session calibrates it: the file's, with the compliances
+    its rigid-reference trials found so far (``palpate.calibration``)."""
+
+    def __init__(self, stack: StackConfig) -> None:
+        self.base = stack
+        self.stack = stack
+        self.fits: list[tuple[str, ComplianceFit | None]] = []
+
+    def add(self, trial: BenchTrial, outcome: BenchOutcome) -> None:
+        if outcome.calibration is None:
+            return
+        self.fits.append((rig_key(trial.kind, trial.tube.name), outcome.calibration))
+        self.stack = with_compliance(self.base, self.found)
+
+    @property
+    def found(self) -> dict[str, tuple[float, float]]:
+        """The calibrated compliance (m/N) per rig key so far."""
+        return calibrate(self.fits)
+
+
+def bench_inputs(trial: BenchTrial, loaded: LoadedBench, stack: StackConfig) -> EstimatorInputs:
+    """What the joint fit is told on the bench: the trial's belief (``assumed:``; thickness and
+    bonding unknown unless stated), the tube's (stage's) calibrated compliance in ``stack``,
+    the campaign's limits. The misalignment is not measured at a stored pose (0)."""
+    c = loaded.bench.campaign
+    robot = trial.kind == "robot"
+    compliance, calibrated = stack.compliance(trial.tube.name if robot else None)
+    belief = belief_fields(trial.assumed, thickness=UNKNOWN, bonded=UNKNOWN, poisson=trial.poisson)
+    return EstimatorInputs(
+        kind=trial.kind,
+        exposed_length=trial.exposed_length,
+        flush_translation=trial.tube.flush_translation,
+        tip_radius=stack.sensor.tip_radius,
+        encoder_resolution=position_tolerance(stack) / 1.5,
+        misalignment=0.0,
+        compliance=compliance,
+        compliance_calibrated=calibrated,
+        misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
+        travel_window=c.max_travel_past_contact_mm * MM,
+        rigid=trial.rigid,
+        **belief,
+    )
+
+
 def _run_one(
-    hw: Hardware, trial: BenchTrial, loaded: LoadedBench, log_dir: Path, sync_to_clock: bool
+    hw: Hardware,
+    trial: BenchTrial,
+    loaded: LoadedBench,
+    stack: StackConfig,
+    log_dir: Path,
+    sync_to_clock: bool,
 ) -> tuple[BenchOutcome, ServoFbgRig]:
     """Zero the strains, run one trial with its log, estimate; the outcome and the rig."""
-    stack, c = loaded.stack, loaded.bench.campaign
+    c = loaded.bench.campaign
     tick = 1.0 / loaded.bench.control_rate_hz
     settings = rig_settings(
         c, stack, tick, sync_to_clock=sync_to_clock, exposed_length=trial.exposed_length
@@ -290,8 +210,9 @@ def _run_one(
     rig = ServoFbgRig(hw.drive, hw.reader, StrainChain.from_config(stack.fbg), hw.clock, settings)
     chain = rig.zero()
     section = sensor_section(stack)
+    inputs = bench_inputs(trial, loaded, stack)
     path = log_dir / f"{trial.trial_id}.jsonl"
-    with TrialLogWriter(path, _header(trial, loaded, section)) as log:
+    with TrialLogWriter(path, _header(trial, loaded, section, inputs)) as log:
         guards = guards_for(c, stack, rig.tick)
         result = run_trial(rig, hw.clock, trial.plan, guards, detector_for(c, chain), log)
         estimate = estimate_trial(
@@ -301,23 +222,39 @@ def _run_one(
             flush_translation=trial.tube.flush_translation,
             stack=stack,
             section=section,
-            poisson=trial.poisson,
+            poisson=inputs.poisson,
+            inputs=inputs,
         )
         log.write(estimate_record(estimate))
         log.write(end_record(result))
-    outcome = BenchOutcome(
+    return _outcome(trial, result.state.value, result.reason, estimate, result.duration, path), rig
+
+
+def _outcome(
+    trial: BenchTrial,
+    state: str,
+    reason: str,
+    estimate: TrialEstimate,
+    duration: float,
+    path: Path,
+) -> BenchOutcome:
+    return BenchOutcome(
         trial,
-        result.state.value,
-        result.reason,
+        state,
+        reason,
         estimate.paper,
         estimate.exposed_length_at_buckling,
-        result.duration,
+        duration,
         str(path),
+        estimate.joint,
+        estimate.verdict,
+        estimate.calibration,
     )
-    return outcome, rig
 
 
-def _header(trial: BenchTrial, loaded: LoadedBench, section: Section) -> dict[str, Any]:
+def _header(
+    trial: BenchTrial, loaded: LoadedBench, section: Section, inputs: EstimatorInputs
+) -> dict[str, Any]:
     """The log header; the keys ``palpate replay`` reads are those of a simulated trial."""
     stack = loaded.stack
     tube = trial.tube if trial.kind == "robot" else None
@@ -335,6 +272,7 @@ def _header(trial: BenchTrial, loaded: LoadedBench, section: Section) -> dict[st
             "target": dataclasses.asdict(trial.target),
             "roll": trial.plan.roll,
             "exposed_length": trial.exposed_length,
+            "rigid": trial.rigid,
         },
-        **header_common(trial.plan, section, stack.sensor, tube, trial.poisson),
+        **header_common(trial.plan, section, stack.sensor, tube, inputs.poisson, inputs),
     }

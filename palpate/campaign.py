@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import time
@@ -14,6 +15,7 @@ from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from config.schema import StackConfig
 from estimation.elastica import fast
 from estimation.stiffness import SampleSummary, summarize
+from palpate.calibration import calibrated, is_reference
 from palpate.executors import SerialExecutor
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
@@ -128,12 +130,9 @@ def run_campaigns(
     """Run several campaigns through one executor, as :func:`run_campaign` runs one.
 
     Every trial of every campaign is submitted at once, so the workers do not idle at a
-    campaign's end waiting for its last trial while the next campaign's trials queue."""
-    jobs = [
-        (i, _Job(s, r.scene, r.stack, r.transport, r.log_dir, s.trial_id == r.series_for))
-        for i, r in enumerate(runs)
-        for s in r.specs
-    ]
+    campaign's end waiting for its last trial while the next campaign's trials queue. Trials on
+    a scene's rigid reference samples go first (all campaigns together): they calibrate the
+    rig's compliance (``palpate.calibration``), which the campaign's other trials then use."""
     warm_up()  # before the pool forks, so every worker inherits the built tables
     t0 = time.perf_counter()
     finished = [0.0] * len(runs)
@@ -147,22 +146,57 @@ def run_campaigns(
     own: Executor | None = None
     if executor is None and workers > 1:
         own = executor = ProcessPoolExecutor(max_workers=workers)
+    results: dict[str, TrialOutcome] = {}
     try:
-        if executor is None or isinstance(executor, SerialExecutor):
-            outcomes = [done(i, _run_job(job)) for i, job in jobs]
-        else:
-            futures = {executor.submit(_run_job, job): i for i, job in jobs}
-            for fut in as_completed(futures):
-                done(futures[fut], fut.result())
-            outcomes = [fut.result() for fut in futures]
+        first = [(i, r, s) for i, r in enumerate(runs) for s in r.specs if is_reference(r.scene, s)]
+        for (i, _, spec), out in zip(first, _execute(first, runs, executor, done), strict=True):
+            results[f"{i}/{spec.trial_id}"] = out
+        stacks = [
+            calibrated(
+                r.scene, r.stack, [results[f"{i}/{s.trial_id}"] for j, _, s in first if j == i]
+            )
+            for i, r in enumerate(runs)
+        ]
+        calibrated_runs = [
+            dataclasses.replace(r, stack=st) for r, st in zip(runs, stacks, strict=True)
+        ]
+        rest = [
+            (i, r, s)
+            for i, r in enumerate(calibrated_runs)
+            for s in r.specs
+            if not is_reference(r.scene, s)
+        ]
+        for (i, _, spec), out in zip(
+            rest, _execute(rest, calibrated_runs, executor, done), strict=True
+        ):
+            results[f"{i}/{spec.trial_id}"] = out
     finally:
         if own is not None:
             own.shutdown()
-    results, start = [], 0
-    for i, r in enumerate(runs):
-        results.append(CampaignResult(outcomes[start : start + len(r.specs)], finished[i]))
-        start += len(r.specs)
-    return results
+    return [
+        CampaignResult([results[f"{i}/{s.trial_id}"] for s in r.specs], finished[i])
+        for i, r in enumerate(runs)
+    ]
+
+
+def _execute(
+    trials: Sequence[tuple[int, CampaignRun, TrialSpec]],
+    runs: Sequence[CampaignRun],
+    executor: Executor | None,
+    done: Callable[[int, TrialOutcome], TrialOutcome],
+) -> list[TrialOutcome]:
+    """Run ``trials`` (campaign index, its run, spec) on ``executor`` (None or serial: here, in
+    order); the outcomes in the order of ``trials``."""
+    jobs = [
+        (i, _Job(s, r.scene, r.stack, r.transport, r.log_dir, s.trial_id == runs[i].series_for))
+        for i, r, s in trials
+    ]
+    if executor is None or isinstance(executor, SerialExecutor):
+        return [done(i, _run_job(job)) for i, job in jobs]
+    futures = {executor.submit(_run_job, job): i for i, job in jobs}
+    for fut in as_completed(futures):
+        done(futures[fut], fut.result())
+    return [fut.result() for fut in futures]
 
 
 def warm_up() -> None:
@@ -186,26 +220,36 @@ def summarize_campaign(
     outcomes: Iterable[TrialOutcome], outlier_above: float, method: str = "joint"
 ) -> list[SampleRow]:
     """Per sample: mean, RMSE, IQR and relative error of the estimates (Tables I/II), by
-    ``method``: "joint" (the contact-point-free fit, the default) or "paper" (Eqs. 13-14)."""
+    ``method``: "joint" (the contact-point-free fit, the default: over the trials whose
+    verdict is ``ok`` only) or "paper" (Eqs. 13-14). Rigid references are left out."""
     by_sample: dict[str, list[TrialOutcome]] = {}
     for o in outcomes:
-        by_sample.setdefault(o.spec.sample, []).append(o)
+        if o.calibration is None:
+            by_sample.setdefault(o.spec.sample, []).append(o)
     rows = []
     for name, outs in by_sample.items():
-        estimates = [o.modulus(method) for o in outs]
+        estimates = [_kept(o, method) for o in outs]
         rows.append(
             SampleRow(name, summarize(estimates, outs[0].spec.modulus, outlier_above), len(outs))
         )
     return rows
 
 
+def _kept(o: TrialOutcome, method: str) -> float | None:
+    """The estimate a summary keeps: the joint fit's only when its verdict is ``ok``."""
+    if method == "joint" and o.status != "ok":
+        return None
+    return o.modulus(method)
+
+
 def median_abs_relative_error(
     outcomes: Iterable[TrialOutcome], method: str = "joint"
 ) -> float | None:
+    """Median |relative error| of ``method``'s estimates (the joint fit's: ``ok`` only)."""
     errs = sorted(
         abs(m - o.spec.modulus) / o.spec.modulus
         for o in outcomes
-        if (m := o.modulus(method)) is not None
+        if o.calibration is None and (m := _kept(o, method)) is not None
     )
     if not errs:
         return None

@@ -60,7 +60,7 @@ COMMANDS: dict[str, Command] = {
     ),
     "calibrate": Command(
         "palpate.commands.calibrate",
-        "Fit the glued fiber's strain coefficient k'_eps from a recorded (strain, shift) file.",
+        "Calibrate what the paper could not: k'_eps, and the tube's or stage's compliance.",
     ),
     "design": Command(
         "palpate.commands.design",

@@ -11,16 +11,28 @@ change) at the joints the servos are at, pressing on a scene's tissue sample.
 A world remembers one touch (its contact table is solved for the exposed length at first
 contact), so once the sensor has left the surface the next sample starts a fresh world: the next
 touch may come with another tube, roll or exposed length.
+
+Several samples may stand in front of the robot (:class:`Station` s, e.g. one per stored pose
+of a bench file, :func:`stations_for`, which ``palpate emulate --scene`` uses): while the sensor
+is free, the station whose roll is nearest the robot's is the one in front of it (its sample,
+surface and tube: the operator mounts the tube the pose names).
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Self
 
 import numpy as np
 
+from config.bench import LoadedBench
+from config.loader import ConfigError
+from config.sample import SampleConfig
 from config.scene import SceneConfig
-from config.schema import StackConfig, TubeConfig
+from config.schema import MM, StackConfig, TubeConfig
+from config.targets import load_targets
 from palpate.simworld import tissue_model
 from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
@@ -48,6 +60,55 @@ def facing_surface(stack: StackConfig, exposed_length: float) -> Surface:
     return surface_at(tube, 0.0, tube.flush_translation + exposed_length, stack.sensor.tip_radius)
 
 
+@dataclass(frozen=True)
+class Station:
+    """A sample in front of the emulated robot: the scene sample's name, its surface, and the
+    tube mounted (by name) when the robot reaches it at ``roll`` (rad)."""
+
+    sample: str
+    surface: Surface
+    tube: str
+    roll: float = 0.0
+
+
+def stations_for(scene: SceneConfig, loaded: LoadedBench) -> list[Station]:
+    """A station per distinct stored pose of the bench file's trials: the scene's sample the
+    trial names (its ``sample`` label), else the scene's rigid reference for a ``rigid`` trial,
+    else the scene's first sample; its surface where the pose expects contact (the stand-off
+    pose plus ``campaign.standoff_mm``), facing the sensor head-on.
+
+    Raises:
+        ConfigError: a trial's target is not in the targets file.
+    """
+    stack, bench = loaded.stack, loaded.bench
+    stored = {t.name: t for t in load_targets(loaded.targets_path).targets}
+    stations: dict[str, Station] = {}
+    for i, entry in enumerate(bench.trials):
+        target = stored.get(entry.target)
+        if target is None:
+            raise ConfigError(
+                str(loaded.path), f"trials[{i}].target", f"no target {entry.target!r}"
+            )
+        if target.name in stations:
+            continue
+        sample = _scene_sample(scene, entry.sample, entry.rigid)
+        contact = target.translation + bench.campaign.standoff_mm * MM
+        surface = surface_at(stack.tube(target.tube), target.roll, contact, stack.sensor.tip_radius)
+        stations[target.name] = Station(sample.name, surface, target.tube, target.roll)
+    return list(stations.values())
+
+
+def _scene_sample(scene: SceneConfig, label: str, rigid: bool) -> SampleConfig:
+    named = [s for s in scene.samples if s.name == label]
+    if named:
+        return named[0]
+    if rigid:
+        refs = [s for s in scene.samples if s.rigid]
+        if refs:
+            return refs[0]
+    return scene.samples[0]
+
+
 class SimulatedBench:
     """Emulated servos and board over a world; a context manager (``start`` / ``close``).
 
@@ -66,6 +127,7 @@ class SimulatedBench:
         clock: VirtualClock | None = None,
         wire: bool = True,
         seed: int = 0,
+        stations: Sequence[Station] | None = None,
     ) -> None:
         names = [s.name for s in scene.samples]
         if not names:
@@ -75,10 +137,14 @@ class SimulatedBench:
             raise ValueError(f"--sample: no sample {chosen!r} in scene {scene.name!r}; {names}")
         self.stack = stack
         self.scene = scene
-        self.sample = next(s for s in scene.samples if s.name == chosen)
-        self.surface = surface or facing_surface(stack, scene.campaign.exposed_length_mm * 1e-3)
-        self.tube = stack.tube(tube) if tube is not None else stack.tubes[0]
-        self._tissue = tissue_model(self.sample, scene.fidelity, stack.sensor.tip_radius)
+        if not stations:
+            place = surface or facing_surface(stack, scene.campaign.exposed_length_mm * 1e-3)
+            stations = [Station(chosen, place, tube or stack.tubes[0].name)]
+        self.stations = list(stations)
+        self._station = 0
+        self.sample = self._sample_config(self.stations[0].sample)
+        self.surface = self.stations[0].surface
+        self.tube = stack.tube(self.stations[0].tube)
         self._section = sensor_section(stack)
         self._rng = np.random.default_rng(seed)
         self._truth = RollerGearDrive(stack.drive)  # the servos power up at the home pose
@@ -121,13 +187,24 @@ class SimulatedBench:
         p = kinematics.forward(self.tube, roll, translation)
         return p.tube_tip, p.tangent, p.exposed_length
 
+    def _sample_config(self, name: str) -> SampleConfig:
+        return next(s for s in self.scene.samples if s.name == name)
+
+    def _nearest_station(self) -> int:
+        """The station whose roll is nearest the robot's (the first of equals)."""
+        if len(self.stations) == 1:
+            return 0
+        roll = self._joints()[0]
+        gaps = [abs(math.remainder(roll - st.roll, math.tau)) for st in self.stations]
+        return gaps.index(min(gaps))
+
     def _new_world(self) -> World:
         return World(
             section=self._section,
             sensor=self.stack.sensor,
             fbg=self.stack.fbg,
             fidelity=self.scene.fidelity,
-            tissue=self._tissue,
+            tissue=tissue_model(self.sample, self.scene.fidelity, self.stack.sensor.tip_radius),
             surface=self.surface,
             pose=self._pose,
             joints=self._joints,
@@ -138,6 +215,8 @@ class SimulatedBench:
         )
 
     def _sample(self, t: float) -> BoardSample:
+        if not self._touched and len(self.stations) > 1:
+            self._face(self._nearest_station())
         world = self._world
         sample = world.sample(t)
         last = world.last
@@ -146,6 +225,17 @@ class SimulatedBench:
         elif self._touched:
             self._world, self._touched = self._new_world(), False
         return sample
+
+    def _face(self, k: int) -> None:
+        """Put station ``k`` in front of the robot (a fresh world) if it is not already."""
+        if k == self._station:
+            return
+        st = self.stations[k]
+        self._station = k
+        self.sample = self._sample_config(st.sample)
+        self.surface = st.surface
+        self.tube = self.stack.tube(st.tube)
+        self._world = self._new_world()
 
     def start(self) -> Self:
         """Solve one contact state first (the mechanics' tables are built on first use, about

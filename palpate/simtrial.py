@@ -23,8 +23,11 @@ from typing import Any, Literal, Protocol
 
 from config.scene import FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
+from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
+from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
+from estimation.verdict import Verdict
 from palpate.simworld import (
     ServoJoints,
     TrialGeometry,
@@ -40,6 +43,7 @@ from robot.dynamixel.driver import DynamixelBus
 from robot.indentation import Observation, State, TrialMarks, TrialPlan
 from robot.rig import RigSettings, ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from robot.trial.inputs import belief_fields
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import end_record, estimate_record, header_common
 from robot.trial.run import TrialResult, run_trial
@@ -84,11 +88,22 @@ class TrialOutcome:
     marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
     joint: JointFit | None = None  # the contact-point-free estimate (robot.trial.estimate)
     joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
+    verdict: Verdict | None = None  # ok, suspect (reasons) or none (why)
+    southwell: SouthwellFit | None = None  # the beam's bow, fitted from the record
+    calibration: ComplianceFit | None = None  # on a rigid reference: the rig's compliance
+
+    @property
+    def status(self) -> str:
+        """The verdict's status ("none" without one)."""
+        return "none" if self.verdict is None else self.verdict.status
 
     def modulus(self, method: str = "joint") -> float | None:
-        """E (Pa) by ``"joint"`` (the whole-record fit) or ``"paper"`` (Eqs. 13-14)."""
+        """E (Pa) by ``"joint"`` (the whole-record fit; None when its verdict is ``none``) or
+        ``"paper"`` (Eqs. 13-14)."""
         if method == "joint":
-            return None if self.joint is None else self.joint.modulus
+            if self.joint is None or self.status == "none":
+                return None
+            return self.joint.modulus
         if method == "paper":
             return None if self.estimate is None else self.estimate.modulus
         raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
@@ -100,6 +115,8 @@ class TrialOutcome:
         def kpa(v: float | None) -> float | None:
             return None if v is None else v / 1e3
 
+        shown = jf if self.status != "none" else None
+        bow = self.southwell
         return {
             "trial": self.spec.trial_id,
             "sample": self.spec.sample,
@@ -110,10 +127,16 @@ class TrialOutcome:
             "estimated_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
             "delta_mm": None if est is None else est.delta * 1e3,
             "force_n": None if est is None else est.force,
-            "joint_kpa": kpa(None if jf is None else jf.modulus),
-            "joint_ci_kpa": None if jf is None else [kpa(jf.ci_low), kpa(jf.ci_high)],
+            "joint_kpa": kpa(None if shown is None else shown.modulus),
+            "joint_ci_kpa": None if shown is None else [kpa(shown.ci_low), kpa(shown.ci_high)],
             "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,
             "joint_message": "no loading record" if jf is None else jf.message,
+            "verdict": self.status,
+            "verdict_reasons": [] if self.verdict is None else list(self.verdict.reasons),
+            "model_form": None if jf is None else jf.model_form,
+            "best_fit": None if jf is None else jf.best,
+            "w0_over_l": None if bow is None else bow.w0_over_l,
+            "calibration": None if self.calibration is None else self.calibration.as_dict(),
             "warnings": [] if jf is None else list(jf.warnings),
             "state": self.state,
             "reason": self.reason,
@@ -308,6 +331,7 @@ def _estimate(
     result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
 ) -> TrialEstimate:
     flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
+    inputs = _estimator_inputs(spec, scene, stack, geo)
     return estimate_trial(
         result,
         kind=spec.kind,
@@ -315,8 +339,8 @@ def _estimate(
         flush_translation=flush,
         stack=stack,
         section=sensor_section(stack),
-        poisson=trial_sample(scene, spec).poisson,
-        inputs=_estimator_inputs(spec, scene, stack, geo),
+        poisson=inputs.poisson,
+        inputs=inputs,
     )
 
 
@@ -342,6 +366,9 @@ def _outcome(
         marks=result.marks,
         joint=estimate.joint,
         joint_seconds=estimate.joint_seconds,
+        verdict=estimate.verdict,
+        southwell=estimate.southwell,
+        calibration=estimate.calibration,
     )
 
 
@@ -359,23 +386,34 @@ def _header(
         "source": "simulation",
         "spec": dataclasses.asdict(spec),
         "scene": scene.name,
-        **header_common(plan, sensor_section(stack), stack.sensor, tube, spec.poisson, inputs),
+        **header_common(plan, sensor_section(stack), stack.sensor, tube, inputs.poisson, inputs),
     }
 
 
 def _estimator_inputs(
     spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
 ) -> EstimatorInputs:
-    """What the joint fit is told: the sample as the user knows it (not the sim's switches)."""
+    """What the joint fit is told: the sample as the operator believes it (the scene's
+    ``assumed:``, else the sample's own values), the rig's calibrated compliance, the
+    campaign's limits; never the simulator's switches."""
     sample = trial_sample(scene, spec)
+    c = scene.campaign
+    robot = spec.kind == "robot"
+    compliance, calibrated = stack.compliance(geo.tube if robot else None)
+    belief = belief_fields(
+        sample.assumed, thickness=sample.thickness, bonded=sample.bonded, poisson=sample.poisson
+    )
     return EstimatorInputs(
         kind=spec.kind,
         exposed_length=spec.exposed_length,
-        flush_translation=stack.tube(geo.tube).flush_translation if spec.kind == "robot" else 0.0,
+        flush_translation=stack.tube(geo.tube).flush_translation if robot else 0.0,
         tip_radius=stack.sensor.tip_radius,
-        poisson=sample.poisson,
-        thickness=sample.thickness,
-        bonded=sample.bonded,
         encoder_resolution=stack.drive.lead / TICKS_PER_REV,
         misalignment=geo.residual,
+        compliance=compliance,
+        compliance_calibrated=calibrated,
+        misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
+        travel_window=c.max_travel_past_contact_mm * 1e-3,
+        rigid=sample.rigid,
+        **belief,
     )

@@ -31,6 +31,7 @@ from sim.world import Surface, World
 from wire.dynamixel import TICKS_PER_REV
 
 BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
+RIGID_MODULUS = 1e12  # Pa: a ``rigid: true`` sample (sinks ~0.1 um under the sensor's P_cr)
 VERTICAL = np.array([0.0, 0.0, -1.0])
 
 
@@ -51,17 +52,17 @@ class TrialSpec:
 
 
 def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
-    """The simulated tissue's force law for a scene's sample and fidelity switches."""
+    """The simulated tissue's force law for a scene's sample and fidelity switches (a rigid
+    reference sample is a Hertz half-space of RIGID_MODULUS)."""
+    layered = bool(sample.thickness and fidelity.finite_thickness) and not sample.rigid
     return TissueModel(
-        modulus=sample.modulus,
+        modulus=RIGID_MODULUS if sample.rigid else sample.modulus,
         poisson=sample.poisson,
-        thickness=(
-            sample.thickness if (sample.thickness and fidelity.finite_thickness) else math.inf
-        ),
+        thickness=sample.thickness if layered and sample.thickness else math.inf,
         bonded=sample.bonded,
         tip_radius=tip_radius,
-        finite_thickness=fidelity.finite_thickness,
-        large_indentation=fidelity.large_indentation,
+        finite_thickness=fidelity.finite_thickness and not sample.rigid,
+        large_indentation=fidelity.large_indentation and not sample.rigid,
     )
 
 

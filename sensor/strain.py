@@ -6,7 +6,9 @@ over the grating (Eq. 12), so the strain returned per peak *is* the grating-aver
 Temperature modes (``FbgConfig.temperature_compensation``):
 
 - ``"none"``: the paper's assumption ``dT = 0``;
-- ``"measured"``: a measured ``dT`` (K, scalar or per sample) is removed as ``S_T * dT``;
+- ``"measured"``: a measured ``dT`` (K, scalar or per sample) is removed as ``S_T * dT``; for
+  offline use only (a dT series from elsewhere): the board's frame protocol carries no
+  temperature, so the configuration (``FbgConfig.temperature_compensation``) does not offer it;
 - ``"reference"``: a strain-free reference grating's shift is ``S_T * dT`` and is subtracted
   from every peak's shift (same ``S_T`` for all gratings; the 1-2 % spread of S_T with Bragg
   wavelength across 1530-1550 nm is neglected).

@@ -2,15 +2,23 @@
 
 from __future__ import annotations
 
-from numpy.typing import ArrayLike
+import dataclasses
+import math
+from dataclasses import dataclass
 
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from estimation.belief import Belief, Hypothesis
 from estimation.corrections import ContactLaw
-from estimation.jointfit.envelope import envelope, profile_forms
-from estimation.jointfit.noise import frozen_noise, profile_span, require_significance
-from estimation.jointfit.record import check_options, checked_record
-from estimation.jointfit.refine import refine, require_contact
+from estimation.jointfit.envelope import Found, envelope, profile_hypotheses
+from estimation.jointfit.noise import Noise, frozen_noise, profile_span, require_significance
+from estimation.jointfit.record import Record, check_options, checked_record
+from estimation.jointfit.refine import Refined, refine, require_contact
 from estimation.jointfit.result import FitFailed, JointFit
-from estimation.jointfit.scan import scan
+from estimation.jointfit.scan import Start, scan
+
+FloatArray = NDArray[np.float64]
 
 MIN_POINTS = 20
 MIN_CONTACT_POINTS = 10
@@ -20,7 +28,7 @@ def joint_fit(
     advance: ArrayLike,
     force: ArrayLike,
     shortening: ArrayLike,
-    law: ContactLaw,
+    law: ContactLaw | Belief,
     *,
     sigma_force: ArrayLike,
     sigma_shortening: ArrayLike = 0.0,
@@ -40,11 +48,13 @@ def joint_fit(
     Args:
         advance, force, shortening: (N,) stage positions u (m) from before contact to the end
             of loading, and the axial loads P (N) and beam end shortenings e (m) from the strains.
-        law: the contact law ``F = E f(delta)``.
+        law: the contact law ``F = E f(delta)``, or a :class:`~estimation.belief.Belief` (what
+            is known of the sample and the rig's compliance, with ranges profiled over).
         sigma_force, sigma_shortening: (N,) or scalar standard deviations of P (N, > 0), e (m).
         encoder_resolution: one encoder count q of stage advance (m): q^2/12 of depth variance.
-        contact_guess: first guess of x0 (m), e.g. ``estimation.detect_contact``'s; None: the
-            middle of the advance. x0 is searched within contact_guess +- ``search`` (m).
+        contact_guess: a first guess of x0 (m), e.g. ``estimation.detect_contact``'s: one more
+            point of the scan, which covers the whole record regardless.
+        search: how far before the record's first stage position x0 may lie (m, >= 0).
         confidence: the interval's level, in (0, 1); f_scale: the robust loss's soft threshold,
             in noise units.
         load_offset: fit a constant load offset P0 (the sensor's zero error) beside E and x0;
@@ -56,19 +66,110 @@ def joint_fit(
     Raises:
         ValueError: non-finite or mismatched arrays, non-positive sigmas, bad options.
     """
+    belief = law if isinstance(law, Belief) else Belief.from_law(law)
     record = checked_record(advance, force, shortening, sigma_force, sigma_shortening)
     check_options(confidence, search, f_scale, encoder_resolution)
+    provisional = belief.provisional()
     try:
         if record.n < min_points:
             raise FitFailed(f"too few points: {record.n} samples, the fit needs {min_points}")
-        # 1. scan x0 (E, P0 in closed form); 2. refine robustly; 3. profile x0; 4. the forms
-        start = scan(law, record, contact_guess, search, load_offset)
-        fit = refine(law, record, start, encoder_resolution, f_scale=f_scale, max_nfev=max_nfev)
+        # 1. scan x0 (E, P0 in closed form); 2. refine robustly; 3. the noise model
+        start = scan(provisional, record, contact_guess, search, load_offset)
+        fit = refine(
+            provisional, record, start, encoder_resolution, f_scale=f_scale, max_nfev=max_nfev
+        )
         require_contact(fit, min_contact_points)
         noise = frozen_noise(fit, f_scale, confidence)
         require_significance(fit, noise)
-        span = profile_span(fit, noise.scale2, search)
-        found = profile_forms(law, record, start, fit, noise, span)
-        return envelope(law, fit, noise, found, confidence, misalignment)
+        # 4. profile every hypothesis of the belief in every form; the estimate at the best one
+        refit = _Refit(record, start, fit, encoder_resolution, f_scale, max_nfev)
+        return _profiled(belief, refit, noise, confidence, misalignment, min_contact_points)
     except FitFailed as failure:
-        return failure.result(record.n, confidence, law.name)
+        return failure.result(record.n, confidence, provisional.law.name)
+
+
+def _profiled(
+    belief: Belief,
+    refit: _Refit,
+    noise: Noise,
+    confidence: float,
+    misalignment: float | None,
+    min_contact_points: int,
+) -> JointFit:
+    """Step 4 and the result: every hypothesis of ``belief`` profiled (each compliance with
+    its own weights), the estimate refined at the best one, the envelope."""
+    fit, record = refit.fit, refit.record
+    span = profile_span(fit, noise.scale2, refit.start.hi - refit.start.lo)
+    hypotheses = belief.hypotheses(float(fit.depth.max()), float(record.force.max()))
+
+    def weights_at(compliance: float) -> FloatArray:
+        return refit.weights_at(compliance, noise.weights, confidence)
+
+    found = profile_hypotheses(hypotheses, record, refit.start, fit, noise, span, weights_at)
+    best = hypotheses[found.best_hypothesis[0]]
+    if best != fit.hypothesis:
+        fit = refit.at_best(best, found)
+        require_contact(fit, min_contact_points)
+    return envelope(
+        fit,
+        noise,
+        found,
+        confidence,
+        misalignment,
+        float(record.advance.min()),
+        belief.open_keys,
+        len(hypotheses),
+    )
+
+
+@dataclass(frozen=True)
+class _Refit:
+    """Refinements beside the provisional fit ``fit``: at another compliance (for its weights)
+    and at the best hypothesis (the estimate)."""
+
+    record: Record
+    start: Start
+    fit: Refined
+    encoder_resolution: float
+    f_scale: float
+    max_nfev: int
+
+    def _refine(self, hypothesis: Hypothesis, theta: FloatArray) -> Refined:
+        s = self.start
+        begin = Start(s.lo, s.hi, hypothesis.compliance, theta, s.p_scale, s.load_offset)
+        return refine(
+            hypothesis,
+            self.record,
+            begin,
+            self.encoder_resolution,
+            f_scale=self.f_scale,
+            max_nfev=self.max_nfev,
+        )
+
+    def weights_at(self, compliance: float, own: FloatArray, confidence: float) -> FloatArray:
+        """The frozen weights at ``compliance`` (m/N): the noise model of the provisional law
+        refined there (``own``, the provisional's, at its compliance or if that fails). The
+        effective variance depends on c through the fitted slope, so each compliance is
+        profiled with the weights its own refinement would use."""
+        if compliance == self.fit.hypothesis.compliance:
+            return own
+        hypothesis = dataclasses.replace(self.fit.hypothesis, compliance=compliance)
+        try:
+            refined = self._refine(hypothesis, self.fit.theta)
+        except FitFailed:
+            return own
+        return frozen_noise(refined, self.f_scale, confidence).weights
+
+    def at_best(self, best: Hypothesis, found: Found) -> Refined:
+        """The estimate at the best hypothesis: refined from its profile's best point (the
+        provisional fit when that does not converge or has no positive modulus)."""
+        prof = found.families[0]
+        if prof is None or prof.modulus <= 0.0:
+            return self.fit
+        theta = np.array(
+            [math.log(prof.modulus), prof.best_contact, prof.best_offset / self.start.p_scale]
+        )
+        try:
+            return self._refine(best, theta[: self.start.theta.size])
+        except FitFailed:
+            return self.fit

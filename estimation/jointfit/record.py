@@ -35,6 +35,13 @@ class Record:
         """N, the number of samples."""
         return self.advance.size
 
+    def depth_base_at(self, compliance: float) -> FloatArray:
+        """u - e - c P (m): ``depth_base`` with the rig's compliance c (m/N) taken out, the
+        clamp having moved back by c P under the load P."""
+        if compliance == 0.0:
+            return self.depth_base
+        return np.asarray(self.depth_base - compliance * self.force)
+
 
 def checked_record(
     advance: ArrayLike,
@@ -58,11 +65,11 @@ def checked_record(
 def check_options(
     confidence: float, search: float, f_scale: float, encoder_resolution: float
 ) -> None:
-    """ValueError unless 0 < confidence < 1, search > 0 (finite), f_scale > 0, q >= 0."""
+    """ValueError unless 0 < confidence < 1, search >= 0 (finite), f_scale > 0, q >= 0."""
     if not (0.0 < confidence < 1.0):
         raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
-    if not (math.isfinite(search) and search > 0 and f_scale > 0 and encoder_resolution >= 0):
-        raise ValueError("search and f_scale must be > 0, encoder_resolution >= 0")
+    if not (math.isfinite(search) and search >= 0 and f_scale > 0 and encoder_resolution >= 0):
+        raise ValueError("search must be >= 0, f_scale > 0, encoder_resolution >= 0")
 
 
 def _vector(name: str, value: ArrayLike, n: int | None) -> FloatArray:

@@ -4,12 +4,13 @@
 standardised by the effective variance::
 
     r_i = (P_i - P0 - E f(delta_i)) / sigma_i,
-    sigma_i^2 = sigma_P,i^2 + (E f'(delta_i))^2 (sigma_e,i^2 + q^2/12),
+    sigma_i^2 = sigma_P,i^2 (1 + c E f'(delta_i))^2 + (E f'(delta_i))^2 (sigma_e,i^2 + q^2/12),
 
 the load's noise plus the depth's (the strain-inferred shortening and the encoder's
-quantisation q), delta_i = depth_base_i - x0. E enters as log E (it stays positive and its
-steps are relative), P0 in units of the median sigma_P and x0 is scaled by the scan's grid step,
-so that the three parameters are of comparable size to the solver.
+quantisation q), delta_i = depth_base_i - c P_i - x0 with the rig's compliance c (the measured
+load's noise then enters the depth too, hence the factor on sigma_P). E enters as log E (it
+stays positive and its steps are relative), P0 in units of the median sigma_P and x0 is scaled
+by the scan's grid step, so that the three parameters are of comparable size to the solver.
 
 Cost: one vectorised law evaluation (value and slope) per residual evaluation; the Jacobian is
 ``least_squares``'s finite differences; at most ``max_nfev`` evaluations.
@@ -24,11 +25,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from estimation.belief import Hypothesis
 from estimation.corrections import ContactLaw
 from estimation.elastica._scipy import least_squares
 from estimation.jointfit.record import Record
 from estimation.jointfit.result import FitFailed
-from estimation.jointfit.scan import SCAN_POINTS, Start
+from estimation.jointfit.scan import SCAN_POINTS, SCAN_STEP, Start
 
 FloatArray = NDArray[np.float64]
 
@@ -41,6 +43,7 @@ class ResidualModel:
         law: the contact law.
         force, depth_base, sigma_force: the record's (N,) arrays (``record.Record``).
         var_depth: (N,) variance of the depth, sigma_e^2 + q^2/12 (m^2).
+        compliance: c (m/N); ``depth_base`` already has c P taken out.
         p_scale: P0 = theta[2] p_scale (N).
         load_offset: whether theta carries P0 (else P0 = 0).
     """
@@ -52,23 +55,24 @@ class ResidualModel:
     var_depth: FloatArray
     p_scale: float
     load_offset: bool
+    compliance: float = 0.0
+
+    def _variance(self, slope: FloatArray) -> FloatArray:
+        load = self.sigma_force * (1.0 + self.compliance * slope)
+        return np.asarray(load * load + slope * slope * self.var_depth)
 
     def sigma(self, theta: FloatArray) -> FloatArray:
         """(N,) effective standard deviations sigma_i (N) at theta."""
         f, df = self.law.shape(self.depth_base - theta[1])
         del f
-        slope = math.exp(theta[0]) * df
-        return np.asarray(np.sqrt(self.sigma_force**2 + slope**2 * self.var_depth))
+        return np.asarray(np.sqrt(self._variance(math.exp(theta[0]) * df)))
 
     def residuals(self, theta: FloatArray) -> FloatArray:
         """(N,) standardised residuals r_i at theta (the refinement's objective)."""
         f, df = self.law.shape(self.depth_base - theta[1])
         E = math.exp(theta[0])
         P0 = theta[2] * self.p_scale if self.load_offset else 0.0
-        return np.asarray(
-            (self.force - P0 - E * f)
-            / np.sqrt(self.sigma_force**2 + (E * df) ** 2 * self.var_depth)
-        )
+        return np.asarray((self.force - P0 - E * f) / np.sqrt(self._variance(E * df)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,6 +80,7 @@ class Refined:
     """The refined fit.
 
     Attributes:
+        hypothesis: the law and compliance it was fitted with.
         model: the residual model it minimised.
         theta: the solution in the model's parameters.
         jac: (N, len(theta)) Jacobian of the standardised residuals there.
@@ -85,6 +90,7 @@ class Refined:
         nfev: residual evaluations.
     """
 
+    hypothesis: Hypothesis
     model: ResidualModel
     theta: FloatArray
     jac: FloatArray
@@ -97,7 +103,7 @@ class Refined:
 
 
 def refine(
-    law: ContactLaw,
+    hypothesis: Hypothesis,
     record: Record,
     start: Start,
     encoder_resolution: float,
@@ -105,28 +111,33 @@ def refine(
     f_scale: float,
     max_nfev: int,
 ) -> Refined:
-    """Robust least squares from the scan's start, x0 bounded to the search window;
-    ``encoder_resolution`` (m) adds its quantisation to the depth's variance.
+    """Robust least squares of ``hypothesis`` from ``start`` (the scan's, or a profile's best
+    point), x0 bounded to the search window; ``encoder_resolution`` (m) adds its quantisation
+    to the depth's variance.
 
     Raises:
         FitFailed: least squares raised or did not converge.
     """
     var_depth = record.sigma_shortening**2 + encoder_resolution**2 / 12.0
+    depth_base = record.depth_base_at(hypothesis.compliance)
     model = ResidualModel(
-        law,
+        hypothesis.law,
         record.force,
-        record.depth_base,
+        depth_base,
         record.sigma_force,
         var_depth,
         start.p_scale,
         start.load_offset,
+        hypothesis.compliance,
     )
     sol = _solve(model, start, f_scale, max_nfev)
     E_hat, x0_hat = math.exp(float(sol.x[0])), float(sol.x[1])
     P0_hat = float(sol.x[2]) * start.p_scale if start.load_offset else 0.0
-    depth = record.depth_base - x0_hat
+    depth = depth_base - x0_hat
     n_contact = int(np.count_nonzero(depth > 0))
-    return Refined(model, sol.x, sol.jac, E_hat, x0_hat, P0_hat, depth, n_contact, int(sol.nfev))
+    return Refined(
+        hypothesis, model, sol.x, sol.jac, E_hat, x0_hat, P0_hat, depth, n_contact, int(sol.nfev)
+    )
 
 
 def require_contact(fit: Refined, min_contact_points: int) -> None:
@@ -143,7 +154,7 @@ def require_contact(fit: Refined, min_contact_points: int) -> None:
 def _solve(model: ResidualModel, start: Start, f_scale: float, max_nfev: int) -> Any:
     """scipy's OptimizeResult of the refinement; FitFailed when it raised or did not converge."""
     lo, hi = start.lo, start.hi
-    x0_scale = max(1e-6, (hi - lo) / SCAN_POINTS)
+    x0_scale = max(1e-6, min((hi - lo) / SCAN_POINTS, SCAN_STEP))
     n_par = start.theta.size
     try:
         sol = least_squares(

@@ -24,6 +24,13 @@ class JointFit:
         noise_scale: s, the factor the nominal noise was inflated by for the interval.
         model_spread: |E(other layer ratio) - E| (Pa), each form fitted with its own x0 and P0
             (0 for a half-space); the interval is the envelope of both forms' intervals.
+        model_form: eps, the relative model-form bound combined into the interval
+            (``jointfit.modelform``).
+        profiled: the belief's properties the interval was profiled over (``thickness``,
+            ``bonded``, ``poisson``, ``compliance``), besides the contact and load offset.
+        hypotheses: how many points of the belief's grid were profiled.
+        best: the best-fitting hypothesis (``estimation.belief.Hypothesis.describe``: thickness
+            m or None, bonded, poisson, compliance m/N), the one the estimate is fitted with.
         nfev: residual evaluations of the refinement.
         law: the contact law's name.
         warnings: validity flags and fit diagnostics, one sentence each.
@@ -45,6 +52,10 @@ class JointFit:
     rms: float | None = None
     noise_scale: float | None = None
     model_spread: float | None = None
+    model_form: float | None = None
+    profiled: tuple[str, ...] = ()
+    hypotheses: int = 0
+    best: dict[str, object] | None = None
     nfev: int = 0
     law: str = ""
     warnings: tuple[str, ...] = field(default=())
@@ -76,6 +87,10 @@ class JointFit:
             "rms": self.rms,
             "noise_scale": self.noise_scale,
             "model_spread": self.model_spread,
+            "model_form": self.model_form,
+            "profiled": list(self.profiled),
+            "hypotheses": self.hypotheses,
+            "best": self.best,
             "nfev": self.nfev,
             "law": self.law,
             "warnings": list(self.warnings),

@@ -11,5 +11,6 @@ SECTIONS: dict[str, str] = {
     "sensor": "palpate.benchmarks.sensor",
     "robot": "palpate.benchmarks.robot",
     "campaign": "palpate.benchmarks.campaign",
+    "estimation": "palpate.benchmarks.estimation",
     "fuzz": "palpate.benchmarks.fuzz",
 }

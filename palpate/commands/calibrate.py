@@ -1,7 +1,17 @@
-"""Fit the glued fiber's strain coefficient k'_eps from a recorded (strain, shift) file.
+"""Calibrate what the paper could not: k'_eps, and the tube's or stage's compliance.
 
-The file is CSV with columns ``strain_ue`` and ``shift_pm`` (see ``sensor/calibration.py``); the
-result is the slope with its confidence interval and R^2, as the paper's Fig. 1d.
+One command, by what it is given:
+
+- a CSV with ``strain_ue`` and ``shift_pm`` columns: k'_eps from paired known strains and
+  measured shifts (``sensor/calibration.py``), as the paper's Fig. 1d;
+- a recorded stream of raw board frames (any other file, e.g. ``cat /dev/ttyACM0 > frames.bin``
+  while the sensor buckles on a rigid reference on the bench-top stage): k'_eps against the
+  elastica's strains (``sensor/framecal.py``; ``--exposed-length-mm``, ``--config``);
+- trial logs (``.jsonl``) of trials on a rigid reference (a scene's ``rigid: true`` sample, a
+  bench trial with ``rigid: true``): the compliance between the stage encoder and the sensor's
+  clamp, per tube (the stage on the bench-top), with the robot configuration lines to store it
+  (``estimation/compliance.py``; the estimate subtracts it and an uncalibrated one is
+  profiled over its plausible range).
 """
 
 from __future__ import annotations
@@ -10,34 +20,114 @@ import argparse
 import json
 from pathlib import Path
 
-from sensor.calibration import fit_strain_coefficient, load_pairs_csv
+from config import load_stack
+from config.schema import MM
+from estimation.compliance import ComplianceFit
+from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.replaylog import replay
+from robot.trial.log import read_log
+from sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
+from sensor.framecal import calibrate_frames, read_frames
 
 
 def register(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("file", type=Path, help="CSV with strain_ue and shift_pm columns")
+    parser.add_argument(
+        "file",
+        type=Path,
+        nargs="+",
+        help="a CSV (strain_ue, shift_pm), a raw frame stream, or rigid-reference trial logs",
+    )
     parser.add_argument(
         "--confidence", type=float, default=0.95, help="confidence level of the interval"
     )
     parser.add_argument(
-        "--through-origin", action="store_true", help="fit shift = k * strain without intercept"
+        "--through-origin", action="store_true", help="CSV: fit shift = k * strain, no intercept"
+    )
+    parser.add_argument(
+        "--config", default="robot.yaml", help="frames: the robot configuration (sensor, board)"
+    )
+    parser.add_argument(
+        "--exposed-length-mm",
+        type=float,
+        help="frames: the sensor's exposed length (default: sensor.exposed_length_mm)",
+    )
+    parser.add_argument(
+        "--rest-frames", type=int, default=20, help="frames: the first N are at rest (zero)"
     )
 
 
 def run(args: argparse.Namespace) -> int:
-    strain, shift = load_pairs_csv(args.file)
-    fit = fit_strain_coefficient(
-        strain, shift, confidence=args.confidence, through_origin=args.through_origin
-    )
+    files: list[Path] = args.file
+    if all(f.suffix == ".jsonl" for f in files):
+        return _compliance(files, args)
+    if len(files) != 1:
+        raise ValueError("give one CSV or one frame stream, or trial logs (.jsonl) only")
+    path = files[0]
+    if path.suffix.lower() == ".csv":
+        strain, shift = load_pairs_csv(path)
+        fit = fit_strain_coefficient(
+            strain, shift, confidence=args.confidence, through_origin=args.through_origin
+        )
+    else:
+        stack = load_stack(args.config)
+        length = (args.exposed_length_mm or stack.sensor.exposed_length_mm) * MM
+        fit = calibrate_frames(
+            read_frames(path, stack),
+            stack,
+            length,
+            rest_frames=args.rest_frames,
+            confidence=args.confidence,
+        )
+    _print_fit(path, fit, args)
+    return 0
+
+
+def _print_fit(path: Path, fit: CalibrationFit, args: argparse.Namespace) -> None:
     if getattr(args, "json", False):
-        print(json.dumps({"file": str(args.file), **fit.as_dict()}, indent=2))
-        return 0
+        print(json.dumps({"file": str(path), **fit.as_dict()}, indent=2))
+        return
     lo, hi = fit.ci_pm_per_ue
     pct = round(100 * fit.confidence)
-    print(f"calibration of {args.file} ({fit.n} points)")
+    print(f"calibration of {path} ({fit.n} points)")
     print(f"  k'_eps     = {fit.k_pm_per_ue:.4f} pm/ue  ({pct}% CI {lo:.4f} .. {hi:.4f})")
     if not fit.through_origin:
         print(f"  intercept  = {fit.intercept * 1e12:.3f} pm")
     print(f"  R^2        = {fit.r_squared:.5f}")
     print(f"  residual   = {fit.residual_std * 1e12:.3f} pm (std)")
     print(f"  config: fbg.strain_coefficient_pm_per_ue: {fit.k_pm_per_ue:.4f}")
-    return 0
+
+
+def _compliance(files: list[Path], args: argparse.Namespace) -> int:
+    """The compliance per tube (stage) from rigid-reference trial logs, re-fitted from their
+    samples (``palpate replay``); exit 1 when none gives one."""
+    fits = []
+    rows: list[dict[str, object]] = []
+    for path in files:
+        report = replay(path)
+        cal = report.get("replayed_calibration")
+        spec = _spec(path)
+        if not isinstance(cal, dict) or spec is None:
+            rows.append({"log": str(path), "message": "not a rigid-reference trial log"})
+            continue
+        fit = ComplianceFit(**cal)
+        fits.append((rig_key(spec["kind"], spec["tube"]), fit))
+        rows.append({"log": str(path), "key": fits[-1][0], **cal})
+    found = calibrate(fits)
+    if getattr(args, "json", False):
+        ranges = {k: [lo / MM, hi / MM] for k, (lo, hi) in found.items()}
+        print(json.dumps({"trials": rows, "compliance_mm_per_n": ranges}, indent=2))
+    else:
+        for r in rows:
+            c = r.get("compliance")
+            what = (
+                r.get("message") if not isinstance(c, float) else f"{c / MM:.4g} mm/N ({r['key']})"
+            )
+            print(f"{r['log']}: {what}")
+        for line in config_lines(found):
+            print(f"config: {line}")
+    return 0 if found else 1
+
+
+def _spec(path: Path) -> dict[str, str] | None:
+    spec = read_log(path).header.get("spec")
+    return spec if isinstance(spec, dict) else None

@@ -30,10 +30,50 @@ def run(args: argparse.Namespace) -> int:
         print(f"final state: {report['state']} ({report['reason']})")
         print(f"replayed estimate: {'-' if m is None else f'{m / 1e3:.3f} kPa'}")
         print(f"recorded estimate: {'-' if r is None else f'{r / 1e3:.3f} kPa'}")
-        j = report.get("joint")
-        if j is not None:
-            jm = j.get("modulus")
-            shown = "-" if jm is None else f"{jm / 1e3:.3f} kPa"
-            print(f"replayed joint fit: {shown} ({j['message']})")
+        _print_joint(report)
         print("identical" if report["identical"] else "DIFFERENT")
     return 0 if report.get("identical") else 1
+
+
+def _num(x: object) -> float | None:
+    return float(x) if isinstance(x, int | float) else None
+
+
+def _fit_text(j: object) -> str:
+    """``148.914 kPa [141.2, 157.3] (95 %)`` or the fit's message."""
+    if not isinstance(j, dict):
+        return "-"
+    E, lo, hi = (_num(j.get(k)) for k in ("modulus", "ci_low", "ci_high"))
+    if E is None:
+        return f"none ({j.get('message')})"
+    text = f"{E / 1e3:.3f} kPa"
+    if lo is not None and hi is not None:
+        level = _num(j.get("confidence")) or 0.95
+        text += f" [{lo / 1e3:.1f}, {hi / 1e3:.1f}] ({round(100 * level)} %)"
+    return text
+
+
+def _verdict_text(v: object) -> str:
+    if not isinstance(v, dict):
+        return "-"
+    reasons = v.get("reasons") or []
+    return str(v.get("status")) + ("".join(f"\n    - {r}" for r in reasons) if reasons else "")
+
+
+def _print_joint(report: dict[str, object]) -> None:
+    """The joint fit, its verdict and the calibration as replayed and as recorded."""
+    cal = report.get("replayed_calibration")
+    if isinstance(cal, dict):
+        c, lo, hi = (_num(cal.get(k)) for k in ("compliance", "ci_low", "ci_high"))
+        if c is not None and lo is not None and hi is not None:
+            print(f"replayed compliance: {c * 1e3:.4g} mm/N [{lo * 1e3:.4g}, {hi * 1e3:.4g}]")
+        else:
+            print(f"replayed compliance: none ({cal.get('message')})")
+    if report.get("joint") is not None:
+        print(f"replayed joint fit: {_fit_text(report['joint'])}")
+        print(f"recorded joint fit: {_fit_text(report.get('recorded_joint'))}")
+    if "replayed_verdict" in report:
+        print(f"replayed verdict: {_verdict_text(report['replayed_verdict'])}")
+        print(f"recorded verdict: {_verdict_text(report.get('recorded_verdict'))}")
+    if "note" in report:
+        print(f"note: {report['note']}")

@@ -11,6 +11,7 @@ from pathlib import Path
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import StackConfig
+from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.campaign import (
     CampaignRun,
     campaign_trials,
@@ -23,6 +24,7 @@ from palpate.executors import add_executor_arguments, open_executor
 from palpate.preflight import check_campaign, check_reachable
 from palpate.progress import progress_bar
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec
+from palpate.verdicts import Tally, by_sample, summary_lines, tally
 
 CAMPAIGNS = {"robot": ("robot",), "bench": ("bench",), "paper": ("bench", "robot")}
 
@@ -196,12 +198,22 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         "speedup": sim_time / wall if wall > 0 else None,
         "figures": figures,
     }
+    payload["verdicts"] = tally(outcomes).as_dict()
+    found = calibrate(
+        (rig_key(o.spec.kind, o.spec.tube), o.calibration)
+        for o in outcomes
+        if o.calibration is not None
+    )
+    if found:
+        payload["calibration"] = {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()}
     if args.json:
         return payload
-    _print_table(scene.name, rows)
+    _print_table(scene.name, rows, by_sample(outcomes))
     print()
-    if mare is not None:
-        print(f"median |relative error| over trials: {100 * mare:.1f} % (joint fit)")
+    for line in summary_lines(outcomes):
+        print(line)
+    for line in config_lines(found):
+        print(f"calibrated on the rigid reference: {line}")
     if paper is not None:
         print(f"  the paper's single-point estimate on the same trials: {100 * paper:.1f} %")
     print(
@@ -228,14 +240,15 @@ def _kpa(d: dict[str, object]) -> dict[str, object]:
     return out
 
 
-def _print_table(name: str, rows: list) -> None:  # type: ignore[type-arg]
+def _print_table(name: str, rows: list, tallies: dict[str, Tally]) -> None:  # type: ignore[type-arg]
     print(
         f"{name} campaign: estimated vs actual Young's modulus (kPa), joint fit (E and contact "
-        "point fitted on the whole record; the paper's estimate is in --json), outliers > 3 MPa "
-        "removed"
+        "point fitted on the whole record; the paper's estimate is in --json) over the trials "
+        "whose verdict is ok, outliers > 3 MPa removed; ok/sus/none: verdicts; cover: 95 % "
+        "intervals holding the truth / trials with a number"
     )
-    cols = [("sample", 8), ("trials", 6), ("estimated", 10), ("actual", 9), ("RMSE", 9)]
-    cols += [("IQR", 9), ("rel.err", 8)]
+    cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("estimated", 10), ("actual", 9)]
+    cols += [("RMSE", 9), ("IQR", 9), ("rel.err", 8), ("cover", 6)]
     head = " ".join(f"{c:>{w}}" for c, w in cols)
     print(head)
     print("-" * len(head))
@@ -246,7 +259,9 @@ def _print_table(name: str, rows: list) -> None:  # type: ignore[type-arg]
             return "-" if v is None else f"{v / 1e3:.2f}"
 
         rel = "-" if s.relative_error is None else f"{100 * s.relative_error:+.1f}%"
+        t = tallies[r.sample]
+        verdicts = "/".join(str(t.counts[v]) for v in ("ok", "suspect", "none"))
         print(
-            f"{r.sample:>8} {r.trials:>6} {k(s.mean):>10} {k(s.actual):>9} {k(s.rmse):>9} "
-            f"{k(s.iqr):>9} {rel:>8}"
+            f"{r.sample:>8} {r.trials:>6} {verdicts:>11} {k(s.mean):>10} {k(s.actual):>9} "
+            f"{k(s.rmse):>9} {k(s.iqr):>9} {rel:>8} {f'{t.covered}/{t.numbers}':>6}"
         )

@@ -9,6 +9,7 @@ targets and the limits and shows the plan without opening a port.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import time
 from collections.abc import Callable
@@ -17,6 +18,7 @@ from typing import Any
 
 from config.bench import LoadedBench, load_bench
 from estimation.stiffness import summarize
+from estimation.verdict import STATUSES
 from palpate.benchtrial import (
     SKIPPED,
     BenchOutcome,
@@ -24,6 +26,7 @@ from palpate.benchtrial import (
     plan_bench_trials,
     run_bench_trials,
 )
+from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.hardware import open_hardware, port_problem, run_on_hardware
 from sensor.clock import Clock
 from sensor.reader import SerialLike
@@ -40,6 +43,10 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--dry-run", action="store_true", help="check and show the plan; open no port"
     )
     parser.add_argument("--log-dir", type=Path, help="overrides log_dir of the bench file")
+    parser.add_argument(
+        "--servo-port", help="overrides servos.port of the bench file (e.g. an emulator's pty)"
+    )
+    parser.add_argument("--board-port", help="overrides board.port of the bench file")
 
 
 def run_session(
@@ -70,8 +77,18 @@ def run_session(
         )
 
 
+def _with_ports(loaded: LoadedBench, servo: str | None, board: str | None) -> LoadedBench:
+    """``loaded`` with the servo and board ports replaced where given."""
+    stack = loaded.stack
+    if servo is not None:
+        stack = dataclasses.replace(stack, servos=dataclasses.replace(stack.servos, port=servo))
+    if board is not None:
+        stack = dataclasses.replace(stack, board=dataclasses.replace(stack.board, port=board))
+    return dataclasses.replace(loaded, stack=stack)
+
+
 def run(args: argparse.Namespace) -> int:
-    loaded = load_bench(args.config)
+    loaded = _with_ports(load_bench(args.config), args.servo_port, args.board_port)
     trials = plan_bench_trials(loaded, args.target)
     if args.dry_run:
         return _dry_run(loaded, trials, args.json)
@@ -96,25 +113,35 @@ def run(args: argparse.Namespace) -> int:
     if code:
         return code
     samples = _summaries(outcomes, loaded.bench.campaign.outlier_above_kpa * 1e3)
+    found = calibrate(
+        (rig_key(o.trial.kind, o.trial.tube.name), o.calibration)
+        for o in outcomes
+        if o.calibration is not None
+    )
     if args.json:
         payload = {
             "bench": str(loaded.path),
             "log_dir": str(log_dir),
             "trials": [o.as_dict() for o in outcomes],
             "samples": samples,
+            "calibration": {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()},
         }
         print(json.dumps(payload, indent=2))
     else:
         for o in outcomes:
             if o.state == SKIPPED:
                 print(_row(o.as_dict()))
+        for line in config_lines(found):
+            print(f"calibrated on the rigid reference (store in {loaded.bench.robot}): {line}")
         for s in samples:
             rel = s["relative_error"]
             print(
                 f"sample {s['sample']}: mean {_kpa(s['mean_kpa'])} kPa vs {s['actual_kpa']:.2f} "
                 f"kPa, RMSE {_kpa(s['rmse_kpa'])}, IQR {_kpa(s['iqr_kpa'])}, relative error "
                 + ("-" if rel is None else f"{100 * rel:+.1f} %")
-                + f" ({s['count']} kept, {s['outliers']} outliers, {s['failed']} failed)"
+                + f" (joint fit, {s['count']} ok kept, {s['outliers']} outliers; verdicts "
+                + ", ".join(f"{n} {v}" for v, n in s["verdicts"].items())
+                + ")"
             )
     return 0 if all(o.state == "done" for o in outcomes) else 1
 
@@ -153,16 +180,18 @@ def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> in
 
 
 def _summaries(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[str, Any]]:
-    """Per sample with a known modulus: mean, RMSE, IQR, relative error (Tables I/II)."""
+    """Per sample with a known modulus: mean, RMSE, IQR, relative error (Tables I/II) of the
+    joint fit over the trials whose verdict is ok, and the verdict counts."""
     by_sample: dict[str, list[BenchOutcome]] = {}
     for o in outcomes:
-        if o.trial.modulus is not None and o.state != SKIPPED:
+        if o.trial.modulus is not None and o.state != SKIPPED and o.calibration is None:
             by_sample.setdefault(o.trial.sample, []).append(o)
     rows = []
     for name, outs in by_sample.items():
         actual = outs[0].trial.modulus
         assert actual is not None
-        s = summarize([o.estimate for o in outs], actual, outlier_above)
+        kept = [o.modulus() if o.status == "ok" else None for o in outs]
+        s = summarize(kept, actual, outlier_above)
         rows.append(
             {
                 "sample": name,
@@ -174,12 +203,16 @@ def _summaries(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[
                 "count": s.count,
                 "outliers": s.outliers,
                 "failed": s.failed,
+                "verdicts": {v: sum(1 for o in outs if o.status == v) for v in STATUSES},
             }
         )
     return rows
 
 
-_HEAD = f"{'trial':<28} {'state':<9} {'E kPa':>9} {'actual':>9} {'rel.err':>8}  reason"
+_HEAD = (
+    f"{'trial':<28} {'state':<9} {'joint fit kPa [95 % interval]':>30} {'verdict':<8} "
+    f"{'paper kPa':>9} {'actual':>9} {'rel.err':>8}  reason"
+)
 
 
 def _kpa(v: float | None) -> str:
@@ -187,8 +220,21 @@ def _kpa(v: float | None) -> str:
 
 
 def _row(d: dict[str, Any]) -> str:
+    """One trial's line: the joint fit with its interval and verdict, the paper's estimate
+    (Eqs. 13-14) beside it, the reference modulus and the joint fit's relative error."""
     rel = "-" if d["relative_error"] is None else f"{100 * d['relative_error']:+.1f}%"
+    joint = _kpa(d["joint_kpa"])
+    if d["joint_ci_kpa"] is not None:
+        lo, hi = d["joint_ci_kpa"]
+        joint += f" [{_kpa(lo)}, {_kpa(hi)}]"
+    verdict = d["verdict"] or "-"
+    why = "; ".join([d["reason"], *d["verdict_reasons"]])
+    cal = d.get("calibration")
+    if cal is not None:
+        c = cal.get("compliance")
+        joint = "-" if c is None else f"c = {1e3 * c:.4g} mm/N"
+        verdict = "calib."
     return (
-        f"{d['trial']:<28} {d['state']:<9} {_kpa(d['estimated_kpa']):>9} "
-        f"{_kpa(d['actual_kpa']):>9} {rel:>8}  {d['reason']}"
+        f"{d['trial']:<28} {d['state']:<9} {joint:>30} {verdict:<8} "
+        f"{_kpa(d['estimated_kpa']):>9} {_kpa(d['actual_kpa']):>9} {rel:>8}  {why}"
     )

@@ -27,62 +27,43 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Iterable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from statistics import NormalDist
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from config.schema import SensorConfig, StackConfig
 from estimation.beam import Beam
-from estimation.beamstate import infer_states
-from estimation.corrections import ContactLaw
+from estimation.beamstate import BeamStates, infer_states
+from estimation.compliance import ComplianceFit, fit_compliance
 from estimation.detect_contact import baseline_deviation
+from estimation.elastica.constants import P_CRIT
 from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from estimation.section import Section
+from estimation.southwell import SouthwellFit, southwell
 from estimation.stiffness import StiffnessEstimate, paper_estimate
+from estimation.verdict import TrialFacts, Verdict, judge
+from robot.trial.inputs import EstimatorInputs
 from robot.trial.run import TrialResult
 from sensor.strain import grating_intervals
+
+__all__ = [
+    "EstimatorInputs",
+    "RecordEstimate",
+    "TrialEstimate",
+    "estimate_from_marks",
+    "estimate_trial",
+    "exposed_length_at",
+    "fit_record",
+    "fit_rows",
+    "loading_rows",
+    "verdict_for",
+]
 
 FloatArray = NDArray[np.float64]
 LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})
 _UNIT_SIGMA = 1e-6  # infer_states is linear in sigma: run at 1e-6, rescale by the measured one
-
-
-@dataclass(frozen=True)
-class EstimatorInputs:
-    """What the joint fit is told besides the record (all SI).
-
-    Attributes:
-        kind: "bench" (exposed length fixed) or "robot" (L = advance - flush translation).
-        exposed_length: L on the bench (m); flush_translation: the tube's, on the robot (m).
-        tip_radius, poisson: the tip and the sample's Poisson ratio.
-        thickness: sample layer thickness (m) on a rigid substrate, None for a half-space.
-        bonded: the layer is glued to its substrate.
-        encoder_resolution: stage advance per encoder count (m).
-        misalignment: angle between the sensor axis and the surface normal (rad), the IK residual.
-    """
-
-    kind: str
-    exposed_length: float
-    flush_translation: float
-    tip_radius: float
-    poisson: float
-    thickness: float | None
-    bonded: bool
-    encoder_resolution: float
-    misalignment: float
-
-    def as_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> EstimatorInputs:
-        return cls(**d)
-
-    def law(self) -> ContactLaw:
-        return ContactLaw(self.tip_radius, self.poisson, self.thickness, self.bonded, True)
 
 
 def loading_rows(
@@ -110,52 +91,109 @@ def strain_sigma(residual: FloatArray, gratings: int) -> float:
     return max(math.sqrt(float(np.median(ss)) / median), 1e-9)
 
 
-def joint_estimate(
+@dataclass(frozen=True)
+class RecordEstimate:
+    """What the record gives: the joint fit and the Southwell fit of the beam's bow (None when
+    the record is too short for either); on a rigid reference, the compliance instead."""
+
+    joint: JointFit | None
+    southwell: SouthwellFit | None = None
+    calibration: ComplianceFit | None = None
+
+
+def fit_record(
     advance: FloatArray,
     strains: FloatArray,
     inputs: EstimatorInputs,
     sensor: SensorConfig,
     section: Section,
-) -> JointFit:
-    """The joint fit of one trial's loading record (see the module docstring)."""
-    law = inputs.law()
-    n, gratings = strains.shape
+) -> RecordEstimate:
+    """The joint fit of one trial's loading record (see the module docstring), and the beam's
+    bow from its pre-buckling part (``estimation.southwell``)."""
+    n = strains.shape[0]
     if n < MIN_POINTS:
-        return JointFit(False, f"too few points: {n} loading samples, the fit needs {MIN_POINTS}")
-    if inputs.kind == "robot":
-        lengths = advance - inputs.flush_translation
-    else:
-        lengths = np.full(n, inputs.exposed_length)
+        msg = f"too few points: {n} loading samples, the fit needs {MIN_POINTS}"
+        if inputs.rigid:
+            return RecordEstimate(None, calibration=ComplianceFit(False, msg, n_points=n))
+        return RecordEstimate(JointFit(False, msg, n_points=n, law=inputs.law().name))
+    lengths = _lengths(advance, inputs)
+    states, k = _states(strains, lengths, sensor, section)
+    if inputs.rigid:
+        return RecordEstimate(None, calibration=fit_compliance(advance, states.P, states.e))
+    guess = baseline_deviation(advance, states.P, baseline_points=min(30, n // 4))
+    joint = joint_fit(
+        advance,
+        states.P,
+        states.e,
+        inputs.belief(),
+        sigma_force=k * states.sigma_P,
+        sigma_shortening=k * states.sigma_e,
+        encoder_resolution=inputs.encoder_resolution,
+        contact_guess=guess.position if guess.success else None,
+        misalignment=inputs.misalignment,
+    )
+    return RecordEstimate(joint, _bow(states, lengths, section))
+
+
+def _states(
+    strains: FloatArray, lengths: FloatArray, sensor: SensorConfig, section: Section
+) -> tuple[BeamStates, float]:
+    """The beam's states along the record at unit strain noise, and the strain noise measured
+    on the record (the states' sigmas scale with it)."""
     intervals = grating_intervals(sensor, 0.0)[None, :, :] + lengths[:, None, None]
     states = infer_states(
         strains, intervals, lengths, section.EA, section.fiber_offset, _UNIT_SIGMA
     )
-    k = strain_sigma(states.residual, gratings) / _UNIT_SIGMA
-    guess = baseline_deviation(advance, states.P, baseline_points=min(30, n // 4))
-    if not guess.success:
-        return JointFit(False, guess.message, n_points=n, law=law.name)
-    return joint_fit(
-        advance,
-        states.P,
-        states.e,
-        law,
-        sigma_force=k * states.sigma_P,
-        sigma_shortening=k * states.sigma_e,
-        encoder_resolution=inputs.encoder_resolution,
-        contact_guess=guess.position,
-        misalignment=inputs.misalignment,
-    )
+    return states, strain_sigma(states.residual, strains.shape[1]) / _UNIT_SIGMA
 
 
-def joint_from_rows(
+def _lengths(advance: FloatArray, inputs: EstimatorInputs) -> FloatArray:
+    if inputs.kind == "robot":
+        return np.asarray(advance - inputs.flush_translation)
+    return np.full(advance.size, inputs.exposed_length)
+
+
+def critical_load(section: Section, length: float) -> float:
+    """P_cr = 20.19 EI / L^2 (N) of the clamped-pinned sensor at exposed length L (m)."""
+    return float(P_CRIT * section.EI / length**2)
+
+
+def _bow(states: BeamStates, lengths: FloatArray, section: Section) -> SouthwellFit:
+    """The Southwell fit at the exposed length of the record's largest load."""
+    length = float(lengths[int(np.argmax(states.P))])
+    if length <= 0:
+        return SouthwellFit(False, "no exposed length at the largest load")
+    return southwell(states.P, states.z, length, critical_load(section, length))
+
+
+def fit_rows(
     rows: Iterable[tuple[str, float, Sequence[float]]],
     inputs: EstimatorInputs,
     stack: StackConfig,
     section: Section,
-) -> JointFit:
-    """The joint fit from (state, advance, strains) rows: the trial's record or a log's samples."""
+) -> RecordEstimate:
+    """The estimates from (state, advance, strains) rows: the trial's record or a log's samples."""
     advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
-    return joint_estimate(advance, strains, inputs, stack.sensor, section)
+    return fit_record(advance, strains, inputs, stack.sensor, section)
+
+
+def verdict_for(
+    joint: JointFit | None, inputs: EstimatorInputs, state: str, reason: str, section: Section
+) -> Verdict:
+    """The trial's verdict (``estimation.verdict``) from its fit, its inputs and how it ended."""
+    length = inputs.exposed_length
+    if inputs.kind == "robot" and joint is not None and joint.contact is not None:
+        length = joint.contact - inputs.flush_translation
+    facts = TrialFacts(
+        state=state,
+        reason=reason,
+        travel_window=inputs.travel_window,
+        critical_load=critical_load(section, length) if length > 0 else None,
+        misalignment=inputs.misalignment,
+        misalignment_tolerance=inputs.misalignment_tolerance,
+        compliance_calibrated=inputs.compliance_calibrated,
+    )
+    return judge(joint, facts, inputs.tip_radius)
 
 
 def exposed_length_at(kind: str, x: float, fixed_length: float, flush_translation: float) -> float:
@@ -199,12 +237,18 @@ class TrialEstimate:
         exposed_length_at_buckling: L (m) at the buckling mark, None without one.
         joint: the joint fit, None when the runner did not ask for it.
         joint_seconds: wall time of the joint fit (for reports, never for tests).
+        southwell: the beam's bow fitted from the record (None without a joint fit).
+        verdict: ok, suspect or none, with reasons (None without a joint fit).
+        calibration: the rig's compliance, on a rigid reference (instead of the joint fit).
     """
 
     paper: StiffnessEstimate | None
     exposed_length_at_buckling: float | None
     joint: JointFit | None = None
     joint_seconds: float | None = None
+    southwell: SouthwellFit | None = None
+    verdict: Verdict | None = None
+    calibration: ComplianceFit | None = None
 
 
 def estimate_trial(
@@ -232,5 +276,11 @@ def estimate_trial(
     if inputs is None:
         return TrialEstimate(paper, length)
     start = time.perf_counter()
-    joint = joint_from_rows(result.record, inputs, stack, section)
-    return TrialEstimate(paper, length, joint, time.perf_counter() - start)
+    fitted = fit_rows(result.record, inputs, stack, section)
+    seconds = time.perf_counter() - start
+    verdict = None
+    if not inputs.rigid:
+        verdict = verdict_for(fitted.joint, inputs, result.state.value, result.reason, section)
+    return TrialEstimate(
+        paper, length, fitted.joint, seconds, fitted.southwell, verdict, fitted.calibration
+    )

@@ -2,7 +2,15 @@
 the end (the per-tick ``sample`` and ``transition`` records are :mod:`robot.trial.run`'s).
 
 The simulator and the bench write the same keys here, so ``palpate replay`` reads either log
-the same way (see :mod:`robot.trial.log` for the file format).
+the same way (see :mod:`robot.trial.log` for the file format). Every key the estimator adds is
+written here, and read back here (:func:`recorded_verdict`), tolerant of logs that predate it:
+
+- header ``estimator``: the joint fit's inputs (``robot.trial.inputs.EstimatorInputs``, with
+  ``version``; version 2 added the belief's ranges, the compliance and the verdict's limits);
+- estimate ``joint``: the joint fit (``JointFit.as_dict``); ``verdict``: ``{status, reasons}``
+  (ok, suspect or none); ``southwell``: the beam's bow fitted from the record. A log without
+  ``verdict`` was written before verdicts existed. On a rigid reference (``estimator.rigid``)
+  the estimate record carries ``calibration`` (``ComplianceFit.as_dict``, m/N) instead.
 """
 
 from __future__ import annotations
@@ -12,12 +20,16 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from config.schema import SensorConfig, TubeConfig
+from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
 from estimation.section import Section
+from estimation.southwell import SouthwellFit
+from estimation.verdict import Verdict
 from robot.indentation import TrialPlan
 
 if TYPE_CHECKING:  # types only: run.py and estimate.py import this module
-    from robot.trial.estimate import EstimatorInputs, TrialEstimate
+    from robot.trial.estimate import TrialEstimate
+    from robot.trial.inputs import EstimatorInputs
     from robot.trial.run import TrialResult
 
 UNITS = "SI (m, N, Pa, rad, s); strains dimensionless"
@@ -55,25 +67,54 @@ def joint_record(fit: JointFit | None) -> dict[str, Any]:
 
 
 def estimate_record(estimate: TrialEstimate) -> dict[str, Any]:
-    """The ``estimate`` record: the paper's estimate and the joint fit."""
-    est, joint = estimate.paper, estimate.joint
+    """The ``estimate`` record: the paper's estimate, the joint fit, its verdict and the bow."""
+    est = estimate.paper
     if est is None:
-        return {
+        record: dict[str, Any] = {
             "kind": "estimate",
             "success": False,
             "message": "no buckling detected",
-            "joint": joint_record(joint),
         }
-    return {
-        "kind": "estimate",
-        "success": est.success,
-        "modulus": est.modulus,
-        "delta": est.delta,
-        "force": est.force,
-        "exposed_length": estimate.exposed_length_at_buckling,
-        "message": est.message,
-        "joint": joint_record(joint),
-    }
+    else:
+        record = {
+            "kind": "estimate",
+            "success": est.success,
+            "modulus": est.modulus,
+            "delta": est.delta,
+            "force": est.force,
+            "exposed_length": estimate.exposed_length_at_buckling,
+            "message": est.message,
+        }
+    record.update(
+        estimator_keys(estimate.joint, estimate.verdict, estimate.southwell, estimate.calibration)
+    )
+    return record
+
+
+def estimator_keys(
+    joint: JointFit | None,
+    verdict: Verdict | None,
+    southwell: SouthwellFit | None,
+    calibration: ComplianceFit | None = None,
+) -> dict[str, Any]:
+    """The estimate record's keys of the joint fit, its verdict and the bow, or of the
+    compliance calibration on a rigid reference (as JSON values); ``palpate replay`` compares
+    its re-run with these."""
+    if calibration is not None:
+        return {"calibration": calibration.as_dict()}
+    out: dict[str, Any] = {"joint": joint_record(joint)}
+    if verdict is not None:
+        out["verdict"] = verdict.as_dict()
+    if southwell is not None:
+        out["southwell"] = southwell.as_dict()
+    return out
+
+
+def recorded_verdict(record: dict[str, Any] | None) -> Verdict | None:
+    """The verdict of a log's estimate record; None for a log written before verdicts."""
+    if record is None or not isinstance(record.get("verdict"), dict):
+        return None
+    return Verdict.from_dict(record["verdict"])
 
 
 def end_record(result: TrialResult) -> dict[str, Any]:

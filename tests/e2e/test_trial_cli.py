@@ -26,7 +26,7 @@ from palpate.cli import main
 from palpate.commands.trial import run_session
 from palpate.hardware import HardwareError, explain, open_hardware
 from palpate.replaylog import replay
-from palpate.simbench import SimulatedBench, surface_at
+from palpate.simbench import SimulatedBench, stations_for, surface_at
 from robot.motors import ServoTransportError
 from robot.trial.log import read_log
 from sim.clock import VirtualClock
@@ -69,21 +69,28 @@ def simulated(loaded: LoadedBench, clock: VirtualClock) -> SimulatedBench:
     )
 
 
+def run_on(
+    sim: SimulatedBench, loaded: LoadedBench, clock: VirtualClock, log_dir: Path
+) -> list[BenchOutcome]:
+    """Every trial of the bench file through ``run_session`` on the simulated bench's ports."""
+    return run_session(
+        loaded,
+        plan_bench_trials(loaded),
+        log_dir,
+        servo_port=sim.servo_port,
+        board_port=sim.board_port,
+        clock=clock,
+        sync_to_clock=True,
+    )
+
+
 def session_on_ptys(tmp_path: Path, trials: str) -> tuple[list[BenchOutcome], list[bool], int]:
     """Run a bench file's trials through ``run_session`` on the emulators' ptys; return the
     outcomes, each servo's torque and the stage encoder after the session closed the bus."""
     loaded = load_bench(bench_file(tmp_path, trials))
     clock = VirtualClock()
     with simulated(loaded, clock) as sim:
-        outcomes = run_session(
-            loaded,
-            plan_bench_trials(loaded),
-            tmp_path / "logs",
-            servo_port=sim.servo_port,
-            board_port=sim.board_port,
-            clock=clock,
-            sync_to_clock=True,
-        )
+        outcomes = run_on(sim, loaded, clock, tmp_path / "logs")
         torque = [s.torque_enabled for s in sim.bus.servos]
         return outcomes, torque, sim.servo("translation").position_ticks
 
@@ -105,6 +112,70 @@ def test_a_session_on_the_emulators_ptys_runs_logs_and_releases(tmp_path: Path) 
     report = replay(Path(str(o.log_path)))
     assert report["identical"] is True
     assert report["modulus"] == o.estimate.modulus
+    # the joint fit, its interval and its verdict are logged and replayed as they were
+    assert o.joint is not None
+    assert o.joint.ci_low is not None
+    assert o.joint.ci_high is not None
+    assert o.joint.ci_low < o.joint.modulus < o.joint.ci_high  # type: ignore[operator]
+    assert o.verdict is not None
+    (estimate,) = log.of_kind("estimate")
+    assert estimate["joint"]["ci_low"] == o.joint.ci_low
+    assert estimate["verdict"] == o.verdict.as_dict()
+    assert report["joint"] == estimate["joint"]
+    assert report["replayed_verdict"] == estimate["verdict"]
+    assert log.header["estimator"]["version"] == 2
+    # on the bench thickness and bonding are unknown unless stated, and this robot file has
+    # no calibrated compliance: all three are profiled, and the verdict says so
+    assert set(o.joint.profiled) == {"thickness", "bonded", "compliance"}
+    assert o.status == "suspect"
+    assert any("not calibrated" in r for r in o.verdict.reasons)
+
+
+COMPLIANT = """name: rehearsal
+samples:
+  - {name: REF, modulus_kpa: 1000000, rigid: true}
+  - {name: S8, modulus_kpa: 314.53, assumed: {thickness_mm: 10, bonded: true}}
+fidelity: {fbg_noise_pm: 1.0, imperfection_w0_over_l: 0.002, tube_tip_stiffness_n_per_mm: 10}
+"""
+REHEARSAL = (
+    "  - {target: up, sample: REF, rigid: true}\n"
+    "  - {target: down, sample: S8, modulus_kpa: 314.53,"
+    " assumed: {thickness_mm: 10, bonded: true}}\n"
+)
+
+
+def test_a_rehearsal_on_the_twin_calibrates_on_the_reference_then_estimates(
+    tmp_path: Path,
+) -> None:
+    # palpate emulate --scene: the scene's samples at the bench file's poses (REF above the
+    # sensor at target up, S8 below it at target down), compliant tube tips
+    scene_path = tmp_path / "scene.yaml"
+    scene_path.write_text(COMPLIANT, encoding="utf-8")
+    scene = load(SceneConfig, scene_path)
+    loaded = load_bench(bench_file(tmp_path, REHEARSAL))
+    stations = stations_for(scene, loaded)
+    assert [(st.sample, st.tube) for st in stations] == [("REF", "bent30"), ("S8", "bent30")]
+    clock = VirtualClock()
+    with SimulatedBench(loaded.stack, scene, clock=clock, wire=True, stations=stations) as sim:
+        ref, s8 = run_session(
+            loaded,
+            plan_bench_trials(loaded),
+            tmp_path / "logs",
+            servo_port=sim.servo_port,
+            board_port=sim.board_port,
+            clock=clock,
+            sync_to_clock=True,
+        )
+    assert ref.state == "done", ref.reason
+    assert ref.calibration is not None
+    assert ref.calibration.compliance == pytest.approx(1e-4, rel=0.1)
+    assert s8.state == "done", s8.reason
+    header = read_log(Path(str(s8.log_path))).header["estimator"]
+    assert header["compliance_calibrated"] is True  # the session's own calibration
+    assert s8.joint is not None
+    assert s8.joint.covers(314.53e3)
+    assert s8.status == "ok"
+    assert replay(Path(str(s8.log_path)))["identical"] is True
 
 
 def test_a_fault_stops_the_session_and_skips_the_rest(tmp_path: Path) -> None:

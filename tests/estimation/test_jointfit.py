@@ -180,9 +180,11 @@ def test_each_steps_failure_names_the_step() -> None:
     # the steps raise FitFailed; the recipe returns it as a result with the step's message
     rng = np.random.default_rng(11)
     u, P, e = curve(400e3, 0.0, rng)
-    past_the_record = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=5e-3)
-    assert not past_the_record.success
-    assert "ends before the contact search window" in past_the_record.message
+    late_guess = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=5e-3)
+    assert late_guess.success  # a guess only seeds the scan, which covers the whole record
+    ends_early = joint_fit(u[:100], P[:100], e[:100], LAW, sigma_force=SIGMA_P)
+    assert not ends_early.success  # the record stops before the contact
+    assert ends_early.message.startswith("no contact")
     out_of_budget = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0, max_nfev=2)
     assert not out_of_budget.success
     assert out_of_budget.message.startswith("least squares did not converge")
@@ -242,7 +244,7 @@ def test_profiles_in_lockstep_are_each_forms_own_profile() -> None:
     args = (u - e, P, w, 0.0, span, 3.84, -1e-3, 1e-3, True)
     together = profiles(laws, *args)
     alone = [profiles([law], *args)[0] for law in laws]
-    assert together == alone
+    assert [dataclasses.replace(p, best=0) for p in together if p is not None] == alone
     for prof in together:
         assert prof is not None
         assert prof.contact_high - prof.contact_low > 2 * span  # it did widen

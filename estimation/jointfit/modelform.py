@@ -1,0 +1,64 @@
+"""Step 5 of the joint fit: the model-form uncertainty, a documented bound on what the
+estimator's closed forms leave out, added to E's interval.
+
+The force law (Sneddon's sphere times the Dimitriadis bracket, ``estimation.corrections``) is
+exact for none of the tissues the sensor meets. What the literature says about its accuracy:
+
+- thin layer (Dimitriadis et al. 2002, Biophys. J. 82:2798, and the exact linear-elastic layer
+  solutions it was checked against): the series is exact to first order in
+  chi = sqrt(R delta)/h; truncated, it departs from the exact layer by about 1 % at chi = 0.2 and
+  by several % at chi = 0.5 (bonded, nu -> 0.5; see DESIGN.md): a relative error of about
+  ``LAYER_SERIES * chi^2`` (0.25: 1 % at 0.2, 6 % at 0.5);
+- depth (Hertz's range): Hertz holds for delta/R <= 0.1 (``estimation.hertz``); Sneddon's
+  sphere removes the geometric part of the error beyond (-0.1 delta/R to first order), but it is
+  still linear elasticity, and soft tissue and gels stiffen at finite strain (neo-Hookean and
+  second-order elastic solutions depart from the linear ones at first order in delta/R: Lin et
+  al. 2009, Biomech. Model. Mechanobiol. 8:345; Du et al. 2022, arXiv:2209.05646): a relative
+  error of about ``FINITE_STRAIN * delta/R`` (0.1: 1 % at Hertz's limit, 3 % at delta/R = 0.3).
+
+The two are independent and combine in quadrature, at the deepest indentation of the record
+(where the load, hence the leverage on E, is largest): ``eps``. It is a bound on a bias of
+unknown sign, not noise, so it is not tuned to any world: E's interval half-widths are combined
+with ``eps E`` in quadrature (as a GUM type-B component), around the estimate. The spread
+between the two equally defensible layer ratios (``envelope``) is kept apart, as the envelope
+of their intervals. ``JointFit.model_form`` reports eps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from estimation.corrections import ContactLaw
+
+LAYER_SERIES = 0.25
+FINITE_STRAIN = 0.1
+
+
+@dataclass(frozen=True)
+class ModelForm:
+    """The relative model-form uncertainty of the force law at one depth, by source."""
+
+    layer_series: float
+    finite_strain: float
+
+    @property
+    def total(self) -> float:
+        """eps, the sources in quadrature."""
+        return math.hypot(self.layer_series, self.finite_strain)
+
+
+def model_form(law: ContactLaw, max_depth: float) -> ModelForm:
+    """The model-form uncertainty of ``law`` at depth ``max_depth`` (m, >= 0)."""
+    if not (math.isfinite(max_depth) and max_depth >= 0.0):
+        raise ValueError(f"max_depth must be finite and >= 0 m, got {max_depth!r}")
+    chi = float(law.layer_ratio(max_depth))
+    return ModelForm(LAYER_SERIES * chi * chi, FINITE_STRAIN * max_depth / law.tip_radius)
+
+
+def widened(modulus: float, ci_low: float, ci_high: float, eps: float) -> tuple[float, float]:
+    """E's interval with the model-form bound ``eps`` (relative) combined in quadrature with
+    each half-width around ``modulus`` (all Pa)."""
+    down = math.hypot(modulus - ci_low, eps * modulus)
+    up = math.hypot(ci_high - modulus, eps * modulus)
+    return modulus - down, modulus + up

@@ -1,0 +1,178 @@
+"""Each trial's verdict on its estimate: ``ok``, ``suspect`` (with reasons) or ``none`` (why).
+
+A number is only as good as what it assumed. The verdict reads the joint fit
+(``estimation.jointfit``) and what the trial itself knows (:class:`TrialFacts`):
+
+- ``none`` (no number): the fit failed (its message says which step and why), or the tissue is
+  too soft for this sensor: the trial used up its travel window without buckling, or the fitted
+  modulus needs more indentation than the window to reach P_cr (the sensor then measures outside
+  the range it was designed for; ``palpate design`` designs one for the range).
+- ``suspect`` (a number, not to be counted as good): the interval is wider than IMPRECISE either
+  side of the estimate (what the belief leaves open, e.g. a thickness range, leaves the modulus
+  undetermined: a number to report with its interval, not on its own), the contact's interval
+  reaches the record's edge, the contact lies before the record, the residuals are correlated
+  (the model misses part of the curve), a validity flag the law does not correct (thin-layer
+  series extrapolated, misalignment past 5 deg), the misalignment beyond the campaign's
+  tolerance, an uncalibrated compliance (the interval was widened over its plausible range),
+  or a trial that did not end ``done``.
+- ``ok``: none of these.
+
+Tables count trials per verdict, take medians over ``ok`` only, and the interval's coverage over
+every trial with a number (``ok`` and ``suspect``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from estimation.corrections import ContactLaw
+from estimation.jointfit import JointFit
+from estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
+
+Status = Literal["ok", "suspect", "none"]
+STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")
+CORRECTED = ("corrected with", "correction applied")
+NO_BUCKLING = "no buckling"  # the state machine's reason when the travel window ran out
+DESIGN_HINT = "see `palpate design`"
+IMPRECISE = 0.15  # relative half-width of the interval beyond which a number is not "ok"
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """``status`` and its reasons (one sentence each; empty for ``ok``)."""
+
+    status: Status
+    reasons: tuple[str, ...] = ()
+
+    @property
+    def has_number(self) -> bool:
+        return self.status != "none"
+
+    def as_dict(self) -> dict[str, object]:
+        return {"status": self.status, "reasons": list(self.reasons)}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, object]) -> Verdict:
+        status = d.get("status")
+        reasons = d.get("reasons") or []
+        if status not in STATUSES or not isinstance(reasons, list | tuple):
+            raise ValueError(f"a verdict is {{status: one of {STATUSES}, reasons: [...]}}, got {d}")
+        return cls(STATUSES[STATUSES.index(status)], tuple(str(r) for r in reasons))
+
+
+@dataclass(frozen=True)
+class TrialFacts:
+    """What the trial knows besides the fit (SI).
+
+    Attributes:
+        state, reason: how the trial ended (``robot.indentation.State`` value and its reason).
+        travel_window: the travel past contact allowed before a fault (m), None if unknown.
+        critical_load: the beam's P_cr at the contact's exposed length (N), None if unknown.
+        misalignment: angle between the sensor axis and the surface normal (rad), if known.
+        misalignment_tolerance: the campaign's tolerance on it (rad), None: not checked.
+        compliance_calibrated: the rig's compliance was calibrated (else profiled over a range).
+    """
+
+    state: str = "done"
+    reason: str = ""
+    travel_window: float | None = None
+    critical_load: float | None = None
+    misalignment: float | None = None
+    misalignment_tolerance: float | None = None
+    compliance_calibrated: bool = True
+
+
+def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
+    """The verdict on ``fit`` (None: no fit was made) for a trial with ``facts``; ``tip_radius``
+    (m) is the sensor's, for the depth buckling needs."""
+    soft = _too_soft(fit, facts, tip_radius)
+    if soft is not None:
+        return Verdict("none", (soft,))
+    if fit is None or not fit.success or fit.modulus is None:
+        return Verdict("none", ("no estimate: " + ("no fit" if fit is None else fit.message),))
+    reasons = [w for w in fit.warnings if _is_suspect(w)]
+    imprecise = _imprecise(fit)
+    if imprecise is not None:
+        reasons.append(imprecise)
+    if not facts.compliance_calibrated:
+        reasons.append(
+            "the rig's compliance is not calibrated: the interval spans its plausible range "
+            "(calibrate on a rigid reference: `palpate calibrate`)"
+        )
+    tol, mis = facts.misalignment_tolerance, facts.misalignment
+    if tol is not None and mis is not None and abs(mis) > tol:
+        reasons.append(
+            f"misalignment {math.degrees(abs(mis)):.1f} deg beyond the campaign's tolerance "
+            f"of {math.degrees(tol):g} deg"
+        )
+    if facts.state != "done":
+        reasons.append(f"the trial ended in {facts.state}: {facts.reason}")
+    return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+
+
+def _imprecise(fit: JointFit) -> str | None:
+    """Why the interval is too wide for "ok", or None."""
+    E, lo, hi = fit.modulus, fit.ci_low, fit.ci_high
+    if E is None or lo is None or hi is None or E <= 0:
+        return None
+    down, up = (E - lo) / E, (hi - E) / E
+    if max(down, up) <= IMPRECISE:
+        return None
+    opened = f" (profiled over {', '.join(fit.profiled)})" if fit.profiled else ""
+    return (
+        f"imprecise: the {round(100 * fit.confidence)} % interval spans -{100 * down:.0f} % / "
+        f"+{100 * up:.0f} %{opened}, beyond +-{100 * IMPRECISE:.0f} %"
+    )
+
+
+def _is_suspect(warning: str) -> bool:
+    if warning.startswith((EDGE_WARNING, BEFORE_WARNING, CORRELATED_WARNING)):
+        return True
+    return not any(c in warning for c in CORRECTED)
+
+
+def _too_soft(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> str | None:
+    """The reason the tissue is too soft for the sensor, or None."""
+    window = facts.travel_window
+    if window is None:
+        return None
+    mm = window * 1e3
+    if facts.reason.startswith(NO_BUCKLING) and (fit is None or not fit.success):
+        return (
+            f"tissue too soft for this sensor: no buckling within the {mm:g} mm travel window; "
+            f"{DESIGN_HINT}"
+        )
+    needed = _depth_to_buckle(fit, facts, tip_radius)
+    if needed is None or needed <= window or fit is None or fit.modulus is None:
+        return None
+    return (
+        f"tissue too soft for this sensor: buckling needs more than the {mm:g} mm travel window "
+        f"({needed * 1e3:.1f} mm at {fit.modulus / 1e3:.0f} kPa); {DESIGN_HINT}"
+    )
+
+
+def _depth_to_buckle(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> float | None:
+    """Stage travel past contact (m) at which the fitted tissue pushes back P_cr: the
+    indentation there plus the rig's compliance times P_cr (None without a fit or P_cr)."""
+    p_cr = facts.critical_load
+    if fit is None or not fit.success or fit.modulus is None or fit.best is None or not p_cr:
+        return None
+    best = fit.best
+    thickness = best.get("thickness")
+    law = ContactLaw(
+        tip_radius,
+        float(best.get("poisson", 0.45)),  # type: ignore[arg-type]
+        None if thickness is None else float(thickness),  # type: ignore[arg-type]
+        bool(best.get("bonded", True)),
+    )
+    depth = np.geomspace(1e-7, 0.02, 600)
+    force = np.maximum.accumulate(law.force(fit.modulus, depth))
+    k = int(np.searchsorted(force, p_cr))
+    if k >= depth.size:
+        return math.inf
+    compliance = float(best.get("compliance", 0.0))  # type: ignore[arg-type]
+    return float(depth[k]) + compliance * p_cr

@@ -1,0 +1,165 @@
+"""What a trial's estimator is told besides its record: :class:`EstimatorInputs`.
+
+The same inputs on every path: the simulator builds them from the scene's ``assumed:`` belief
+(never from the world's truth), the bench from its trial list and the robot configuration's
+calibration; both write them to the log header (``robot.trial.record``) so ``palpate replay``
+re-runs the estimate with exactly them. A log from before ``VERSION`` 2 lacks the belief's
+ranges, the compliance and the verdict's facts: it replays with its point values (no ranges, a
+rigid rig, no verdict limits) and the replay says so (:attr:`EstimatorInputs.version`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+from config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
+from config.schema import MM
+from estimation.belief import Belief
+from estimation.corrections import ContactLaw
+
+VERSION = 2
+DEFAULT_POISSON = 0.45  # the nominal value of an unknown Poisson ratio (the paper's)
+Range = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class EstimatorInputs:
+    """What the joint fit is told besides the record (all SI).
+
+    Attributes:
+        kind: "bench" (exposed length fixed) or "robot" (L = advance - flush translation).
+        exposed_length: L on the bench (m); flush_translation: the tube's, on the robot (m).
+        tip_radius: the sensor tip's radius (m).
+        poisson, thickness, bonded: the belief's nominal values (the paper's estimate uses the
+            Poisson ratio; thickness None is a half-space).
+        encoder_resolution: stage advance per encoder count (m).
+        misalignment: angle between the sensor axis and the surface normal (rad), the IK residual.
+        poisson_range: (min, max) when the belief is a range, None for the nominal value.
+        thickness_range: (min, max) in m when a range; max None reaches the half-space, min 0
+            is ``unknown`` (as thin as the model allows); None for the nominal value.
+        bonded_options: (True, False) when the bonding is unknown; None for the nominal value.
+        compliance: (min, max) compliance of the tube tip or stage (m/N).
+        compliance_calibrated: False when ``compliance`` is the uncalibrated prior range.
+        misalignment_tolerance: the campaign's tolerance (rad), None: not checked.
+        travel_window: the travel past contact allowed (m), None: unknown.
+        rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
+            (``estimation.compliance``) instead of estimating a modulus.
+        version: the inputs' format (VERSION; 1 for logs that predate it).
+    """
+
+    kind: str
+    exposed_length: float
+    flush_translation: float
+    tip_radius: float
+    poisson: float
+    thickness: float | None
+    bonded: bool
+    encoder_resolution: float
+    misalignment: float
+    poisson_range: Range | None = None
+    thickness_range: tuple[float, float | None] | None = None
+    bonded_options: tuple[bool, ...] | None = None
+    compliance: Range = (0.0, 0.0)
+    compliance_calibrated: bool = True
+    misalignment_tolerance: float | None = None
+    travel_window: float | None = None
+    rigid: bool = False
+    version: int = VERSION
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> EstimatorInputs:
+        """From a log header's ``estimator``; keys a log predates take their defaults (a log
+        without ``version`` is version 1), unknown keys raise TypeError."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(d) - known)
+        if unknown:
+            raise TypeError(f"unknown estimator inputs {unknown}")
+        values: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+        values.setdefault("version", 1)
+        return cls(**values)
+
+    def law(self) -> ContactLaw:
+        """The nominal contact law."""
+        return ContactLaw(self.tip_radius, self.poisson, self.thickness, self.bonded, True)
+
+    def belief(self) -> Belief:
+        """What the joint fit profiles over (``estimation.belief``)."""
+        nominal = math.inf if self.thickness is None else self.thickness
+        thickness = (nominal, nominal)
+        if self.thickness_range is not None:
+            lo, hi = self.thickness_range
+            thickness = (lo, math.inf if hi is None else hi)
+        return Belief(
+            self.tip_radius,
+            self.poisson_range or (self.poisson, self.poisson),
+            thickness,
+            self.bonded_options or (self.bonded,),
+            self.compliance,
+        )
+
+
+def belief_fields(
+    assumed: AssumedConfig | None,
+    *,
+    thickness: float | str | None,
+    bonded: bool | str,
+    poisson: float,
+) -> dict[str, Any]:
+    """The :class:`EstimatorInputs` fields of an operator's belief (``poisson``, ``thickness``,
+    ``bonded`` and their ranges): each key of ``assumed`` (``config.sample.AssumedConfig``)
+    that is left out takes the default given here, in the same forms: ``thickness`` in m (None
+    or ``"half-space"``: a half-space; ``"unknown"``), ``bonded`` (or ``"unknown"``),
+    ``poisson``. A scene gives the sample's own values; the bench gives thickness and bonding
+    ``"unknown"`` and the trial's Poisson ratio."""
+    a = assumed or AssumedConfig()
+    h = thickness if a.thickness_mm is None else _thickness_m(a.thickness_mm)
+    b = bonded if a.bonded is None else a.bonded
+    nu = poisson if a.poisson is None else a.poisson
+    out: dict[str, Any] = {}
+    if isinstance(h, tuple):
+        out["thickness_range"] = h
+        out["thickness"] = _middle_thickness(h)
+    elif h == UNKNOWN:
+        out["thickness_range"] = (0.0, None)
+        out["thickness"] = None
+    elif h is None or h == HALF_SPACE:
+        out["thickness"] = None
+    elif isinstance(h, int | float):
+        out["thickness"] = float(h)
+    else:
+        raise ValueError(f"thickness: expected a value, a range or 'unknown', got {h!r}")
+    if b == UNKNOWN:
+        out["bonded_options"] = (True, False)
+        out["bonded"] = True
+    else:
+        out["bonded"] = bool(b)
+    if nu == UNKNOWN:
+        out["poisson_range"] = (0.0, 0.5)
+        out["poisson"] = DEFAULT_POISSON
+    elif isinstance(nu, tuple):
+        out["poisson_range"] = (float(nu[0]), float(nu[1]))
+        out["poisson"] = 0.5 * (nu[0] + nu[1])
+    elif isinstance(nu, int | float):
+        out["poisson"] = float(nu)
+    else:
+        raise ValueError(f"poisson: expected a value, a range or 'unknown', got {nu!r}")
+    return out
+
+
+def _thickness_m(value: object) -> object:
+    """An ``assumed.thickness_mm`` value in m (strings pass through)."""
+    if isinstance(value, tuple):
+        return (value[0] * MM, value[1] * MM)
+    if isinstance(value, int | float):
+        return value * MM
+    return value
+
+
+def _middle_thickness(r: tuple[float, float]) -> float:
+    """The thickness in the middle of a range in 1/h (the thin-layer series' variable)."""
+    return 2.0 / (1.0 / r[0] + 1.0 / r[1])
