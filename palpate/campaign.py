@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import zlib
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -66,13 +67,15 @@ def reported_references(scene: SceneConfig, seed: int = 0) -> dict[str, float | 
     """Per sample, the reference modulus the lab reports (Pa), or None where it is the truth
     (``fidelity.reference_error_sd`` = 0). The paper's "actual" moduli were themselves measured
     (cylindrical indenter): the truth times ``exp(sd z)``, z standard normal drawn per sample
-    from the campaign seed and the sample's place in the scene (the same for all its trials)."""
+    from the campaign seed and the sample's name (the same for all its trials, and in every
+    scene that has the sample: Table II's phantoms are Table I's)."""
     sd = scene.fidelity.reference_error_sd
     if sd <= 0:
         return {s.name: None for s in scene.samples}
     out: dict[str, float | None] = {}
-    for i, s in enumerate(scene.samples):
-        z = float(np.random.default_rng([seed, 104_729, i]).standard_normal())
+    for s in scene.samples:
+        key = zlib.crc32(s.name.encode())
+        z = float(np.random.default_rng([seed, 104_729, key]).standard_normal())
         out[s.name] = s.modulus * math.exp(sd * z)
     return out
 
