@@ -11,5 +11,7 @@ SECTIONS: dict[str, str] = {
     "sensor": "palpate.benchmarks.sensor",
     "robot": "palpate.benchmarks.robot",
     "campaign": "palpate.benchmarks.campaign",
+    "tissue": "palpate.benchmarks.tissue",
+    "tissue-fe": "palpate.benchmarks.tissue_fe",
     "fuzz": "palpate.benchmarks.fuzz",
 }
