@@ -227,6 +227,10 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     if args.json:
         return payload
     _print_table(scene.name, rows)
+    samples = scene.campaign_samples()
+    levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
+    note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
+    print(f"world tissue: {', '.join(levels)}{note}")
     print()
     if mare is not None:
         print(f"median |relative error| over trials: {100 * mare:.1f} % (joint fit)")
