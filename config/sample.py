@@ -66,9 +66,11 @@ class SampleConfig:
     ``bonded`` to it or sliding, ``material`` (linear elastic or neo-Hookean),
     ``lateral_radius_mm`` (the sample's finite lateral size), a standard-linear-solid relaxation
     (``relaxation_time_s``, null = elastic, and ``relaxed_ratio`` = E_inf / E_0, used where the
-    scene's fidelity switches viscoelasticity on), the Coulomb ``friction`` between tip and
-    surface, and ``rigid`` (a rigid reference for calibrating the tube's and stage's
-    compliance: the modulus is then not used).
+    scene's fidelity switches viscoelasticity on; ``modulus_kpa`` is then the relaxed modulus
+    E_inf), the Coulomb ``friction`` between tip and surface (the normal force law takes the
+    nearer of the FE's frictionless and full-stick limits: ``sim.sample_law.contact_condition``),
+    and ``rigid`` (a rigid reference for calibrating the tube's and stage's compliance: the
+    modulus is then not used). How each key reaches the world: docs/world.md.
 
     Surface pose, relative to where the campaign plans the sample (the surface normal against
     the nominal approach): ``tilt_deg`` (angle between the surface normal and the nominal

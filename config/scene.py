@@ -36,11 +36,21 @@ class FidelityConfig:
     large_indentation: bool = True
     tube_tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
     temperature_drift_degc_per_s: float = field(default=0.0, metadata=limits(ge=-10, le=10))
-    # The tissue's force law: "fe" solves each sample's own finite-element model (sim/fem);
-    # "closed-form" is Sneddon's sphere with the thin-layer series, the estimator's own family of
-    # laws (cheap; a scene that picks it judges the estimator on its own model).
-    tissue_model: Literal["fe", "closed-form"] = "closed-form"
-    viscoelastic: bool = False  # the samples' standard-linear-solid relaxation (off: elastic)
+    # The tissue's force law (sim/sample_law.py): "fe", each sample's own finite-element table
+    # (sim/fem; independent of the estimator, so the default: a world that shares the
+    # estimator's model measures self-consistency, not accuracy; tables of the shipped scenes
+    # ship with the package, others are solved once, 6-25 s, and cached); "closed-form",
+    # Sneddon's sphere with the thin-layer series, the estimator's own family of laws (cheap;
+    # a scene that picks it judges the estimator on its own model). finite_thickness: false
+    # makes the FE layer a half-space stand-in; large_indentation applies to the closed form.
+    tissue_model: Literal["fe", "closed-form"] = "fe"
+    # The samples' standard-linear-solid relaxation (relaxation_time_s, relaxed_ratio); off, or a
+    # sample without a relaxation time: elastic. Stepped on the virtual clock (slower per trial).
+    viscoelastic: bool = False
+    # The reported reference moduli (the paper's "actual" column) were themselves measured
+    # (cylindrical indenter, McKee et al. 2011): relative sd of their lognormal error against the
+    # world's truth, drawn per sample from the campaign seed. 0: the reference is the truth.
+    reference_error_sd: float = field(default=0.0, metadata=limits(ge=0, le=1))
     gravity: bool = False  # gravity on the sensor beam and the tubes (pre-bend, tip sag)
     # The servo bus's time on the virtual clock (sim/dynamixel/timing.py): "ideal" answers at
     # once; "realistic" adds wire time at the baud rate (null: the robot's servos.baudrate), each

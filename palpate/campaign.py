@@ -6,10 +6,13 @@ import dataclasses
 import math
 import os
 import time
+import zlib
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from config.schema import StackConfig
@@ -24,6 +27,7 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
     """Trials in a fixed order; each gets its own seed derived from ``seed`` and its index."""
     c = scene.campaign
     specs: list[TrialSpec] = []
+    references = reported_references(scene, seed)
 
     def add(sample_name: str, tube: str, orientation: str, length_mm: float, rep: int) -> None:
         s = next(x for x in scene.samples if x.name == sample_name)
@@ -42,6 +46,7 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
                 roll=math.radians(ORIENTATION_ROLL_DEG[orientation]),
                 exposed_length=length_mm * 1e-3,
                 seed=seed * 1_000_003 + len(specs),
+                reference=references[s.name],
             )
         )
 
@@ -58,6 +63,23 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
                 for orientation in orientations:
                     add(sample.name, tube_name, orientation, c.exposed_length_mm, rep)
     return specs
+
+
+def reported_references(scene: SceneConfig, seed: int = 0) -> dict[str, float | None]:
+    """Per sample, the reference modulus the lab reports (Pa), or None where it is the truth
+    (``fidelity.reference_error_sd`` = 0). The paper's "actual" moduli were themselves measured
+    (cylindrical indenter): the truth times ``exp(sd z)``, z standard normal drawn per sample
+    from the campaign seed and the sample's name (the same for all its trials, and in every
+    scene that has the sample: Table II's phantoms are Table I's)."""
+    sd = scene.fidelity.reference_error_sd
+    if sd <= 0:
+        return {s.name: None for s in scene.samples}
+    out: dict[str, float | None] = {}
+    for s in scene.samples:
+        key = zlib.crc32(s.name.encode())
+        z = float(np.random.default_rng([seed, 104_729, key]).standard_normal())
+        out[s.name] = s.modulus * math.exp(sd * z)
+    return out
 
 
 @dataclass(frozen=True)

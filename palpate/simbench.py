@@ -43,6 +43,7 @@ from sim.board import BoardEmulator, BoardSample
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 from sim.inprocess import InProcessPort, MemorySerial
+from sim.sample_law import relaxation
 from sim.world import Surface, World
 from wire.dynamixel import TICKS_PER_REV
 
@@ -210,6 +211,7 @@ class SimulatedBench:
             joints=self._joints,
             rng=self._rng,
             has_force=self.stack.board.has_force,
+            relaxation=relaxation(self.sample, self.scene.fidelity),
             length_grows=True,
             encoder_step=self.stack.drive.lead / TICKS_PER_REV,
         )

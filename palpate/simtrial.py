@@ -124,6 +124,7 @@ class TrialOutcome:
             "orientation": self.spec.orientation,
             "exposed_length_mm": self.spec.exposed_length * 1e3,
             "actual_kpa": self.spec.modulus / 1e3,
+            "reference_kpa": kpa(self.spec.reference),
             "estimated_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
             "delta_mm": None if est is None else est.delta * 1e3,
             "force_n": None if est is None else est.force,

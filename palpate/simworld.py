@@ -26,12 +26,12 @@ from robot.dynamixel.units import rad_from_ticks
 from robot.trial.estimate import exposed_length_at
 from robot.trial.setup import sensor_section
 from sim.dynamixel.bus import EmulatedBus
-from sim.tissue import TissueModel
+from sim.equilibrium import TissueLaw
+from sim.sample_law import describe, relaxation, world_tissue
 from sim.world import Surface, World
 from wire.dynamixel import TICKS_PER_REV
 
 BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
-RIGID_MODULUS = 1e12  # Pa: a ``rigid: true`` sample (sinks ~0.1 um under the sensor's P_cr)
 VERTICAL = np.array([0.0, 0.0, -1.0])
 
 
@@ -49,21 +49,26 @@ class TrialSpec:
     roll: float  # rad
     exposed_length: float  # m at contact
     seed: int
+    reference: float | None = None  # Pa, the reported reference modulus; None: the truth
+
+    @property
+    def reported(self) -> float:
+        """The modulus the lab reports for the sample (Pa): what the paper's tables compare
+        against. The world's truth is ``modulus``."""
+        return self.modulus if self.reference is None else self.reference
 
 
-def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueModel:
-    """The simulated tissue's force law for a scene's sample and fidelity switches (a rigid
-    reference sample is a Hertz half-space of RIGID_MODULUS)."""
-    layered = bool(sample.thickness and fidelity.finite_thickness) and not sample.rigid
-    return TissueModel(
-        modulus=RIGID_MODULUS if sample.rigid else sample.modulus,
-        poisson=sample.poisson,
-        thickness=sample.thickness if layered and sample.thickness else math.inf,
-        bonded=sample.bonded,
-        tip_radius=tip_radius,
-        finite_thickness=fidelity.finite_thickness and not sample.rigid,
-        large_indentation=fidelity.large_indentation and not sample.rigid,
-    )
+def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueLaw:
+    """The simulated tissue's force law for a scene's sample and fidelity switches
+    (``sim.sample_law``: the finite-element table or the closed forms; the instantaneous law
+    of a viscoelastic sample)."""
+    return world_tissue(sample, fidelity, tip_radius)
+
+
+def tissue_description(scene: SceneConfig, stack: StackConfig, sample: str) -> dict[str, Any]:
+    """What the world's tissue of the scene's ``sample`` is (``tissue_model`` in results)."""
+    s = next(x for x in scene.samples if x.name == sample)
+    return describe(s, scene.fidelity, stack.sensor.tip_radius)
 
 
 @dataclass(frozen=True)
@@ -182,12 +187,13 @@ def trial_world(
     spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry, servos: ServoJoints
 ) -> World:
     """The simulated world of one trial: the scene's sample at the trial's surface, seeded."""
+    sample = trial_sample(scene, spec)
     return World(
         section=sensor_section(stack),
         sensor=stack.sensor,
         fbg=stack.fbg,
         fidelity=scene.fidelity,
-        tissue=tissue_model(trial_sample(scene, spec), scene.fidelity, stack.sensor.tip_radius),
+        tissue=tissue_model(sample, scene.fidelity, stack.sensor.tip_radius),
         surface=geo.surface,
         pose=_pose_fn(stack, spec, geo.tube),
         joints=servos.read,
@@ -195,4 +201,5 @@ def trial_world(
         has_force=stack.board.has_force,
         length_grows=spec.kind == "robot",
         encoder_step=stack.drive.lead / TICKS_PER_REV,
+        relaxation=relaxation(sample, scene.fidelity),
     )

@@ -23,8 +23,7 @@ from numpy.typing import NDArray
 
 from estimation.beam import Beam
 from estimation.elastica import post_buckling
-from sim.equilibrium import ContactEffects, solve_contact
-from sim.tissue import TissueModel
+from sim.equilibrium import ContactEffects, TissueLaw, solve_contact
 
 Vector = NDArray[np.float64]
 
@@ -60,7 +59,7 @@ class GridPhysics(NamedTuple):
     fiber_offset: float
     grating_length: float
     centres_from_tip: tuple[float, ...]
-    tissue: TissueModel
+    tissue: TissueLaw
     effects: ContactEffects
 
 
@@ -81,17 +80,23 @@ def equilibrium_on_grid(
     if not sol.success:
         raise RuntimeError(f"contact equilibrium failed at L = {length:.6g} m: {sol.message}")
     R = np.abs(sol.R)
-    r = R * length**2 / physics.EI
-    g = shortening_for_reaction(r)  # e_g/L of the shape that carries this pin reaction
-    half = 0.5 * physics.grating_length
-    centres = length - np.asarray(physics.centres_from_tip)
-    intervals = np.stack([centres - half, np.minimum(centres + half, length)], axis=-1)
-    eps = beam.bending_strains(g, intervals)
-    eps = eps - (sol.P / physics.EA)[:, None]
-    out = (sol.delta, sol.e, sol.P, R, eps)
+    out = (sol.delta, sol.e, sol.P, R, grating_strains(physics, beam, sol.P, R))
     for a in out:
         a.flags.writeable = False  # shared by every caller of the cache
     return out
+
+
+def grating_strains(
+    physics: GridPhysics, beam: Beam, P: NDArray[np.float64], R: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The gratings' mean strains (M, G) of the beam carrying axial load ``P`` and pin reaction
+    magnitude ``R`` (M,): the bending of the shape with that reaction, minus ``P / EA``."""
+    r = R * beam.length**2 / physics.EI
+    g = shortening_for_reaction(r)  # e_g/L of the shape that carries this pin reaction
+    half = 0.5 * physics.grating_length
+    centres = beam.length - np.asarray(physics.centres_from_tip)
+    intervals = np.stack([centres - half, np.minimum(centres + half, beam.length)], axis=-1)
+    return beam.bending_strains(g, intervals) - (P / physics.EA)[:, None]
 
 
 def _lerp(a: list[float], b: list[float], w: float) -> list[float]:

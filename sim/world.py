@@ -3,11 +3,13 @@
 Each board sample asks the world for its state at time ``t``. The world reads the servos' present
 positions (through injected callables, so ``sim/`` never imports the control code), places the
 sensor with the injected forward kinematics, and solves the quasi-static contact along the sensor
-axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.tissue`), which is not the
-estimator's Hertz model, tabulated along the trial's path (:mod:`sim.contact_table`, which
-also turns the beam state into grating strains). From the beam state it makes what the hardware
-would send: peak wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and temperature drift),
-the force scale reading and the contact event. Gratings still inside the tube read 0.
+axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.sample_law`: the
+sample's finite-element table, or the closed forms where a scene picks them), tabulated along
+the trial's path (:mod:`sim.contact_table`, which also turns the beam state into grating
+strains); a viscoelastic sample is instead stepped on the clock (:mod:`sim.contact_history`).
+From the beam state it makes what the hardware would send: peak wavelengths (Eq. 1 with Eq. 3
+and Eq. 12, plus noise and temperature drift), the force scale reading and the contact event.
+Gratings still inside the tube read 0.
 
 Only what the scene switches on is computed (:class:`config.scene.FidelityConfig`).
 """
@@ -25,9 +27,10 @@ from config.scene import FidelityConfig
 from config.schema import FbgConfig, SensorConfig
 from estimation.section import Section
 from sim.board import BoardSample
+from sim.contact_history import ViscoelasticContact
 from sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
-from sim.equilibrium import ContactEffects
-from sim.tissue import TissueModel
+from sim.equilibrium import ContactEffects, TissueLaw
+from sim.viscoelastic import StandardLinearSolid
 from wire.frame import Status
 
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)
@@ -86,7 +89,7 @@ class World:
         sensor: SensorConfig,
         fbg: FbgConfig,
         fidelity: FidelityConfig,
-        tissue: TissueModel,
+        tissue: TissueLaw,
         surface: Surface,
         pose: PoseFn,
         joints: JointsFn,
@@ -94,10 +97,13 @@ class World:
         has_force: bool = True,
         length_grows: bool = True,
         encoder_step: float | None = None,
+        relaxation: StandardLinearSolid | None = None,
     ) -> None:
         """``encoder_step``: the stage advance per encoder count (m). The stage stops only on
         whole counts, so every sample in contact lies on that lattice; the contact table is
-        then solved on it and needs no interpolation in the advance (None: a 5 um grid)."""
+        then solved on it and needs no interpolation in the advance (None: a 5 um grid).
+        ``relaxation``: the tissue is viscoelastic (``tissue`` is its instantaneous law), so
+        the contact is stepped at every sample instead of tabulated."""
         self.section = section
         self.sensor = sensor
         self.fbg = fbg
@@ -128,6 +134,10 @@ class World:
         self.length_grows = length_grows
         self.encoder_step = encoder_step
         self._table: ContactTable | None = None
+        self._history = (
+            None if relaxation is None else ViscoelasticContact(self._grid(), relaxation)
+        )
+        self._now = 0.0  # the time of the sample being computed
         self._surface = surface
         self._joints: tuple[float, float, int] | None = None  # the reading _physics belongs to
         self._physics: _Physics = (0.0, -math.inf, 0.0, 0.0, 0.0, 0.0, self._free)
@@ -145,7 +155,8 @@ class World:
     # -- physics ------------------------------------------------------------------------------
     def state(self, t: float) -> WorldState:
         joints = self.joints()
-        if joints != self._joints:
+        if joints != self._joints or self._history is not None:  # a history moves with time
+            self._now = t
             self._physics = self._physics_at(joints[0], joints[1])
             self._joints = joints
         roll, translation, encoder = joints
@@ -163,12 +174,16 @@ class World:
         past = (self._tip_radius - centre_height) / cos_a if cos_a > 0.05 else -math.inf
         strains = self._free
         delta = e = P = R = 0.0
-        if past > 0.0 and length > 0.0:
+        if past > 0.0 and length > 0.0 and self._history is not None:
+            delta, e, P, R, strains = self._history.at(self._now, past, length)
+        elif past > 0.0 and length > 0.0:
             if self._table is None:
                 self._table = ContactTable(
                     self, length - past, self.length_grows, lattice=self._lattice(past)
                 )
             delta, e, P, R, strains = self._table.at(past)
+        elif self._history is not None:
+            self._history.release(self._now)
         return length, past, delta, e, P, R, strains
 
     def _lattice(self, past: float) -> tuple[float, float] | None:
@@ -181,7 +196,11 @@ class World:
     def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
         """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R|, strains
         (M, G) (see :func:`equilibrium_on_grid`, which caches it)."""
-        physics = GridPhysics(
+        grid = tuple(np.asarray(u, dtype=np.float64).tolist())
+        return equilibrium_on_grid(self._grid(), grid, length)
+
+    def _grid(self) -> GridPhysics:
+        return GridPhysics(
             self.section.EI,
             self.section.EA,
             self.section.fiber_offset,
@@ -190,7 +209,6 @@ class World:
             self.tissue,
             self.effects,
         )
-        return equilibrium_on_grid(physics, tuple(np.asarray(u, dtype=np.float64).tolist()), length)
 
     # -- what the board sends ----------------------------------------------------------------
     def sample(self, t: float) -> BoardSample:

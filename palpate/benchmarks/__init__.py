@@ -12,5 +12,7 @@ SECTIONS: dict[str, str] = {
     "robot": "palpate.benchmarks.robot",
     "campaign": "palpate.benchmarks.campaign",
     "estimation": "palpate.benchmarks.estimation",
+    "tissue": "palpate.benchmarks.tissue",
+    "tissue-fe": "palpate.benchmarks.tissue_fe",
     "fuzz": "palpate.benchmarks.fuzz",
 }

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from estimation.corrections import dimitriadis_bracket, dimitriadis_coefficients
 from estimation.hertz import hertz_force
+from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from sim.fem.law import curve_from_table
 from sim.fem.problem import LayerProblem
 from sim.fem.solver import solve_indentation
@@ -243,6 +244,37 @@ def timings(directory: str) -> list[str]:
         ["material", "build s (median of 3)", "read + interpolant ms (median of 21)"], rows
     )
     return out
+
+
+def _markdown_tables(lines: list[str]) -> list[Table]:
+    """The markdown tables of a section as ``Table``s, each titled by the text before it."""
+    tables: list[Table] = []
+    title = ""
+    rows: list[list[str]] = []
+    for line in [*lines, ""]:
+        if line.startswith("|"):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            if not set("".join(cells)) <= {"-"}:
+                rows.append(cells)
+            continue
+        if rows:
+            tables.append(Table(title=title, columns=rows[0], rows=list(rows[1:])))
+            rows = []
+        if line.strip():
+            title = line.strip("#: ").strip()
+    return tables
+
+
+def run(ctx: BenchContext) -> BenchSection:
+    """``palpate bench`` section: the FE against Hertz, Sneddon and Dimitriadis, its build and
+    read times (``--quick``), and the mesh convergence and departures of the closed forms."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="palpate-fe-") as tmp:
+        lines = validation() + timings(tmp)
+    if not ctx.quick:
+        lines += convergence((3, 4, 6, 8, 12)) + departures()
+    return BenchSection(name="tissue-fe", tables=_markdown_tables(lines))
 
 
 def main(argv: list[str] | None = None) -> int:

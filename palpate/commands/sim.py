@@ -24,6 +24,7 @@ from palpate.executors import add_executor_arguments, open_executor
 from palpate.preflight import check_campaign, check_reachable
 from palpate.progress import progress_bar
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec
+from palpate.simworld import tissue_description
 from palpate.verdicts import Tally, by_sample, summary_lines, tally
 
 CAMPAIGNS = {"robot": ("robot",), "bench": ("bench",), "paper": ("bench", "robot")}
@@ -64,6 +65,12 @@ def register(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="the paper's estimate vs the joint fit on the same trials, contact errors 0, "
         "+-0.1, +-0.3 mm (palpate/compare.py)",
+    )
+    parser.add_argument(
+        "--compare-paper",
+        action="store_true",
+        help="the paper's method beside the paper's Table I (bench) or II (robot): per-sample "
+        "rows and the error structure (palpate/papertables.py)",
     )
 
 
@@ -115,6 +122,8 @@ def run(args: argparse.Namespace) -> int:
     bar.close()
     if args.compare_methods:
         return _compare(campaigns, args)
+    if args.compare_paper:
+        return _compare_paper(campaigns, args)
     payloads = [_report(c, args) for c in campaigns]
     sim_all = sum(o.sim_time for c in campaigns for o in c.outcomes)
     if args.json:
@@ -163,6 +172,23 @@ def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
     return 0
 
 
+def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
+    from palpate.papertables import comparison, print_comparison
+
+    payloads = []
+    for c in campaigns:
+        data = comparison(
+            c.outcomes, c.scene.campaign.kind, c.scene.campaign.outlier_above_kpa * 1e3
+        )
+        payloads.append({"scene": c.scene.name, "seed": args.seed, **data})
+        if not args.json:
+            print_comparison(data, c.scene.name, args.seed)
+            print()
+    if args.json:
+        print(json.dumps(payloads[0] if len(payloads) == 1 else {"campaigns": payloads}, indent=2))
+    return 0
+
+
 def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     """Print one campaign's table (unless ``--json``) and return its JSON payload."""
     scene, outcomes, wall = c.scene, c.outcomes, c.wall
@@ -188,7 +214,9 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         "seed": args.seed,
         "trials": [o.as_dict() for o in outcomes],
         "samples": [
-            {"sample": r.sample, "trials": r.trials, **_kpa(r.summary.__dict__)} for r in rows
+            {"sample": r.sample, "trials": r.trials, **_kpa(r.summary.__dict__)}
+            | {"tissue_model": tissue_description(scene, c.stack, r.sample)}
+            for r in rows
         ],
         "median_abs_relative_error": mare,
         "method": "joint fit (contact-point-free); paper estimate per trial as estimated_kpa",
@@ -209,6 +237,10 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     if args.json:
         return payload
     _print_table(scene.name, rows, by_sample(outcomes))
+    samples = scene.campaign_samples()
+    levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
+    note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
+    print(f"world tissue: {', '.join(levels)}{note}")
     print()
     for line in summary_lines(outcomes):
         print(line)

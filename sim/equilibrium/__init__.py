@@ -38,6 +38,7 @@ from sim.equilibrium.law import (
     BeamLike,
     ContactEffects,
     ForceLaw,
+    TissueLaw,
     axial_law,
 )
 from sim.equilibrium.solve import solve_contact
@@ -51,6 +52,7 @@ __all__ = [
     "ContactEffects",
     "ContactState",
     "ForceLaw",
+    "TissueLaw",
     "axial_law",
     "solve_contact",
 ]

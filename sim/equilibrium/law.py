@@ -1,8 +1,11 @@
-"""What the equilibrium solver is given: the beam's axial law and the contact world's effects.
+"""What the equilibrium solver is given: the beam's axial law, the tissue's law and the contact
+world's effects.
 
 The beam law is an ``estimation.beam.Beam`` (anything shaped like :class:`BeamLike`), wrapped by
-:func:`axial_law`, or an :class:`AxialLaw` built around any ``force(e)`` callable;
-:class:`ContactEffects` switches on the tube tip's compliance and the beam's imperfection.
+:func:`axial_law`, or an :class:`AxialLaw` built around any ``force(e)`` callable; the tissue is
+anything shaped like :class:`TissueLaw` (the closed forms of ``sim.tissue``, the finite-element
+tables of ``sim.fem``, a rigid block); :class:`ContactEffects` switches on the tube tip's
+compliance and the beam's imperfection.
 """
 
 from __future__ import annotations
@@ -21,6 +24,23 @@ ForceLaw = Callable[[FloatArray], ArrayLike]
 
 DEFAULT_MAX_E_OVER_L = 0.2
 """Largest e/L the solver searches when the beam law does not say (trials visit <= 1e-2)."""
+
+
+class TissueLaw(Protocol):
+    """The tissue's force against indentation depth, as the solver calls it: ``F(delta)`` and
+    ``dF/ddelta`` and the inverse ``delta(F)`` on arrays (any shape, SI), and their plain-float
+    twins (the per-position path). F(0) = 0 and F increases. Hashable: it is part of the keys of
+    the per-process equilibrium cache (``sim.contact_table``)."""
+
+    def force_and_stiffness(self, delta: ArrayLike, /) -> tuple[FloatArray, FloatArray]: ...
+
+    def inverse(self, force: ArrayLike, /) -> FloatArray: ...
+
+    def force_and_stiffness_at(self, delta: float, /) -> tuple[float, float]: ...
+
+    def inverse_at(self, force: float, /) -> float: ...
+
+    def __hash__(self) -> int: ...
 
 
 class BeamLike(Protocol):

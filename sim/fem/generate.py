@@ -1,8 +1,10 @@
 """Regenerate the force tables shipped with the package: ``python -m sim.fem.generate``.
 
 The shipped problems are the scenes' samples: the paper's phantoms (tip R = 3.5 mm, 10 mm layers
-in a 40 mm radius dish, nu = 0.45, bonded, frictionless; linear and neo-Hookean) and the
-soft-tissue designs (R = 6 mm, 20 mm layers). Each table is solved afresh, written to
+in a 40 mm radius dish, nu = 0.45, bonded, frictionless; linear and neo-Hookean), the
+soft-tissue designs (R = 6 mm, 20 mm layers) and the half-space stand-in (a block 200 R deep and
+wide, nu = 0.45, for any tip: ``sim.sample_law``). tests/sim/test_sample_law.py checks that every
+sample of the shipped scenes finds its table here. Each table is solved afresh, written to
 ``sim/fem/tables/<key>.npz``, and its key, build time and status printed; tables that no shipped
 problem names any more are removed. Options: ``--only NAME`` (repeatable), ``--list``.
 """
@@ -23,6 +25,7 @@ SHIPPED: dict[str, LayerProblem] = {
     "paper-neo-hookean": LayerProblem.from_dimensions(**_PAPER, material="neo-hookean"),
     "soft-linear": LayerProblem.from_dimensions(**_SOFT),
     "soft-neo-hookean": LayerProblem.from_dimensions(**_SOFT, material="neo-hookean"),
+    "half-space-linear": LayerProblem(thickness_ratio=200.0, radius_ratio=200.0, poisson=0.45),
 }
 """The problems whose tables ship in ``sim/fem/tables``, by name."""
 

@@ -98,7 +98,9 @@ def session_on_ptys(tmp_path: Path, trials: str) -> tuple[list[BenchOutcome], li
 def test_a_session_on_the_emulators_ptys_runs_logs_and_releases(tmp_path: Path) -> None:
     outcomes, torque, ticks = session_on_ptys(tmp_path, ONE)
     assert torque == [False, False, False]  # the bus closed with torque off
-    assert ticks == 0  # back at the retract pose (the power-up pose here)
+    # back at the retract pose (the power-up pose here), within the 5 um position tolerance
+    # (one 4.9 um encoder tick): where in it the stage stops depends on the trial's motion
+    assert abs(ticks) <= 1
     (o,) = outcomes
     assert o.state == "done", o.reason
     assert o.estimate is not None

@@ -3,12 +3,22 @@
 from __future__ import annotations
 
 import ast
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCES = [*sorted((ROOT / "sim" / "fem").glob("*.py")), ROOT / "sim" / "viscoelastic.py"]
+# the world's FE path outside sim/fem: it may use estimation's beam mechanics, never its laws
+WORLD = [
+    ROOT / "sim" / n
+    for n in ("sample_law.py", "contact_history.py", "contact_table.py", "world.py")
+]
+WORLD += sorted((ROOT / "sim" / "equilibrium").glob("*.py"))
+LAWS = ("estimation.hertz", "estimation.corrections", "estimation.jointfit", "sim.tissue")
 
 
 def imported_modules(path: Path) -> set[str]:
@@ -32,6 +42,67 @@ def test_no_estimator_contact_law_in_the_world(path: Path) -> None:
     assert not bad, f"{path.relative_to(ROOT)} imports {sorted(bad)}"
 
 
+@pytest.mark.parametrize("path", WORLD, ids=lambda p: p.name)
+def test_the_worlds_fe_path_imports_no_contact_law_at_module_level(path: Path) -> None:
+    """sim.sample_law imports sim.tissue (the closed forms) only inside the closed-form branch;
+    the rest of the path never names the laws at all."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    top = [n for n in tree.body if isinstance(n, ast.Import | ast.ImportFrom)]
+    names = {a.name for n in top if isinstance(n, ast.Import) for a in n.names}
+    names |= {n.module for n in top if isinstance(n, ast.ImportFrom) and n.module}
+    assert not {n for n in names if n.startswith(LAWS)}, f"{path.name}: {sorted(names)}"
+
+
 def test_the_scan_sees_the_package() -> None:
     assert len(SOURCES) >= 8
     assert "sim.fem.problem" in imported_modules(ROOT / "sim" / "fem" / "table.py")
+
+
+WORLD_PATH = """
+import sys
+import numpy as np
+from config.sample import SampleConfig
+from config.scene import FidelityConfig
+from config import load_stack
+from robot_free_section import section
+from sim.contact_history import ViscoelasticContact
+from sim.contact_table import GridPhysics, equilibrium_on_grid
+from sim.equilibrium import ContactEffects
+from sim.sample_law import relaxation, world_tissue
+stack = load_stack()
+sample = SampleConfig(name="S", modulus_kpa=500.0, material="neo-hookean",
+                      relaxation_time_s=1.0, relaxed_ratio=0.8)
+fidelity = FidelityConfig(tissue_model="fe", viscoelastic=True)
+law = world_tissue(sample, fidelity, stack.sensor.tip_radius)
+s = section(stack.sensor)
+physics = GridPhysics(s.EI, s.EA, s.fiber_offset, stack.sensor.grating_length,
+                      tuple(stack.sensor.grating_centres_from_tip()), law,
+                      ContactEffects(imperfection=0.001))
+equilibrium_on_grid(physics, tuple(np.linspace(0, 1.5e-3, 31).tolist()), 42e-3)
+history = ViscoelasticContact(physics, relaxation(sample, fidelity))
+for k in range(1, 20):
+    history.at(0.01 * k, 5e-5 * k, 42e-3)
+print(" ".join(sorted(m for m in sys.modules if m.startswith("estimation"))))
+"""
+
+SECTION = """
+from estimation.section import composite_section
+def section(sensor):
+    return composite_section(sensor.fiber_radius, sensor.fiber_modulus, sensor.wire_radius,
+                             sensor.wire_modulus, sensor.wire_count)
+"""
+
+
+def test_the_world_on_the_fe_level_never_loads_the_estimators_laws(tmp_path: Path) -> None:
+    """The world's FE path (sample -> law -> tabulated and stepped equilibrium, grating strains)
+    runs in a fresh interpreter without ever importing estimation.hertz or .corrections: what
+    is never loaded is never called. (The beam mechanics of estimation are allowed.)"""
+    (tmp_path / "robot_free_section.py").write_text(SECTION)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
+    out = subprocess.run(
+        [sys.executable, "-c", WORLD_PATH], capture_output=True, text=True, env=env, check=False
+    )
+    assert out.returncode == 0, out.stderr
+    loaded = set(out.stdout.split())
+    assert "estimation.beam" in loaded  # the scan sees the estimation modules that do load
+    assert not loaded & {"estimation.hertz", "estimation.corrections", "estimation.jointfit"}

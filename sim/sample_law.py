@@ -1,0 +1,183 @@
+"""The world's force law for a scene's sample: the tissue fidelity levels and how a sample's
+keys map onto them (the one place that does).
+
+``fidelity.tissue_model`` picks the level:
+
+- ``"fe"`` (the default): the sample's own finite-element table (:mod:`sim.fem`): a rigid
+  sphere on a layer of the sample's thickness and lateral radius on a rigid base, ``bonded`` or
+  sliding, ``material`` linear or neo-Hookean, the tip-surface ``friction`` mapped to the FE's
+  contact condition by :func:`contact_condition`. Independent of the estimator: nothing on this
+  path imports ``estimation.hertz`` or ``estimation.corrections`` (tests/sim/test_fem_imports.py).
+  A half-space (``thickness_mm: null``, or ``finite_thickness: false``) is a block 200 R deep
+  and 200 R wide (within 0.4 % of Sneddon's half-space to delta = R, docs/tissue-fe.md). The
+  FE is always a sphere at finite depth, so ``large_indentation`` does not apply to it.
+- ``"closed-form"``: :class:`sim.tissue.TissueModel`, Sneddon's sphere times the Dimitriadis
+  series: the estimator's own family of laws, cheap; a scene that picks it judges the estimator
+  on its own model. Linear, frictionless only (``material`` and ``friction`` are ignored).
+
+``rigid: true`` on either level: a steel block (:class:`RigidBlock`).
+
+Viscoelasticity (``fidelity.viscoelastic`` and a sample's ``relaxation_time_s``): the elastic
+law above becomes the instantaneous one of a standard linear solid (:func:`relaxation`);
+``modulus_kpa`` is the *relaxed* modulus E_inf, what a quasi-static test measures, so an
+elastic and a viscoelastic sample mean the same by it, and E_0 = E_inf / ``relaxed_ratio``. The
+world steps it on the virtual clock (``sim.contact_history``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from config.sample import SampleConfig
+from config.scene import FidelityConfig
+from sim.equilibrium import TissueLaw
+from sim.equilibrium.law import FloatArray
+from sim.fem import FeTissueLaw, LayerProblem, table_key
+from sim.viscoelastic import StandardLinearSolid
+
+HALF_SPACE_RATIO = 200.0
+"""Depth and lateral radius / R of the block that stands in for a half-space on the FE level."""
+
+STEEL_MODULUS = 200e9  # Pa
+STEEL_POISSON = 0.3
+
+
+def contact_condition(friction: float, poisson: float) -> str:
+    """The FE contact condition for a Coulomb ``friction`` coefficient between tip and surface.
+
+    The FE has the two limits of Coulomb friction: frictionless, and full stick (a surface node
+    that touches stays on the sphere's point it reached). Spence (1975, J. Elasticity 5:297)
+    showed that a Hertzian indentation with friction mu has a central stick zone whose size
+    depends only on beta / mu, with beta = (1 - 2 nu) / (2 (1 - nu)) the mismatch of the rigid
+    sphere and the layer: the stick zone vanishes as mu -> 0 and covers the contact when mu is
+    large against beta. The sample gets the nearer limit: full stick when ``mu >= beta``,
+    frictionless below (always frictionless at mu = 0; any mu > 0 sticks an incompressible
+    layer, where friction changes nothing). The two limits differ by 0.1-0.2 % in force at
+    nu = 0.45 and by 5-6 % at nu = 0 (docs/tissue-fe.md)."""
+    if friction <= 0.0:
+        return "frictionless"
+    beta = (1.0 - 2.0 * poisson) / (2.0 * (1.0 - poisson))
+    return "stick" if friction >= beta else "frictionless"
+
+
+def fe_problem(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> LayerProblem:
+    """The dimensionless FE problem of ``sample`` (ValueError naming the sample if it has none)."""
+    options: dict[str, Any] = {
+        "poisson": sample.poisson,
+        "material": sample.material,
+        "base": "bonded" if sample.bonded else "sliding",
+        "contact": contact_condition(sample.friction, sample.poisson),
+    }
+    thickness = sample.thickness if fidelity.finite_thickness else None
+    if thickness is None:
+        side = HALF_SPACE_RATIO * tip_radius
+        return LayerProblem.from_dimensions(tip_radius, side, side, **options)
+    if sample.lateral_radius <= tip_radius:
+        raise ValueError(
+            f"sample {sample.name}: lateral_radius_mm must exceed the tip radius "
+            f"({tip_radius * 1e3:g} mm) for the finite-element tissue"
+        )
+    return LayerProblem.from_dimensions(tip_radius, thickness, sample.lateral_radius, **options)
+
+
+def relaxation(sample: SampleConfig, fidelity: FidelityConfig) -> StandardLinearSolid | None:
+    """The sample's standard linear solid when the scene switches viscoelasticity on and the
+    sample has a relaxation time; None: elastic."""
+    if not fidelity.viscoelastic or sample.relaxation_time_s is None or sample.rigid:
+        return None
+    return StandardLinearSolid(sample.relaxation_time_s, sample.relaxed_ratio)
+
+
+def world_tissue(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueLaw:
+    """The world's (elastic, instantaneous when viscoelastic) force law of ``sample``."""
+    if sample.rigid:
+        return RigidBlock(tip_radius)
+    sls = relaxation(sample, fidelity)
+    modulus = sample.modulus / (1.0 if sls is None else sls.ratio)
+    if fidelity.tissue_model == "fe":
+        return FeTissueLaw(fe_problem(sample, fidelity, tip_radius), modulus, tip_radius)
+    from sim.tissue import TissueModel  # the estimator's family: only on this level
+
+    return TissueModel(
+        modulus=modulus,
+        poisson=sample.poisson,
+        thickness=(
+            sample.thickness if (sample.thickness and fidelity.finite_thickness) else math.inf
+        ),
+        bonded=sample.bonded,
+        tip_radius=tip_radius,
+        finite_thickness=fidelity.finite_thickness,
+        large_indentation=fidelity.large_indentation,
+    )
+
+
+def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> dict[str, Any]:
+    """What the world's tissue of ``sample`` is, for results (``tissue_model`` in ``--json``)."""
+    sls = relaxation(sample, fidelity)
+    out: dict[str, Any] = {"level": "rigid" if sample.rigid else fidelity.tissue_model}
+    if sample.rigid:
+        out["law"] = "steel block (Hertz, E = 200 GPa)"
+    elif fidelity.tissue_model == "fe":
+        problem = fe_problem(sample, fidelity, tip_radius)
+        out.update(
+            law="finite elements (sim.fem)",
+            material=problem.material,
+            base=problem.base,
+            contact=problem.contact,
+            thickness_over_r=problem.thickness_ratio,
+            lateral_radius_over_r=problem.radius_ratio,
+            poisson=problem.poisson,
+            table=table_key(problem),
+        )
+    else:
+        out["law"] = "Sneddon x Dimitriadis (sim.tissue: the estimator's own family)"
+    out["viscoelastic"] = (
+        None
+        if sls is None
+        else {"relaxation_time_s": sls.tau, "relaxed_ratio": sls.ratio, "modulus": "relaxed"}
+    )
+    return out
+
+
+@dataclass(frozen=True)
+class RigidBlock:
+    """A rigid reference sample: the tip on a steel block (Hertz on a half-space with
+    E = 200 GPa, nu = 0.3; the tip itself rigid). At the sensor's 1.4 N it gives 0.2 um: the
+    stage's and tube's compliance is all that remains, which is what a rigid reference is for.
+    Own closed form (not the estimator's), the physics of a small contact on a thick block."""
+
+    tip_radius: float
+
+    @property
+    def _c(self) -> float:
+        reduced = STEEL_MODULUS / (1.0 - STEEL_POISSON**2)
+        return 4.0 / 3.0 * reduced * math.sqrt(self.tip_radius)
+
+    def force_and_stiffness(self, delta: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        d = np.asarray(delta, dtype=np.float64)
+        if not np.all(np.isfinite(d)) or np.any(d < 0):
+            raise ValueError("indentation depth delta must be finite and >= 0")
+        root = np.sqrt(d)
+        return self._c * d * root, 1.5 * self._c * root
+
+    def inverse(self, force: ArrayLike) -> FloatArray:
+        f = np.asarray(force, dtype=np.float64)
+        if not np.all(np.isfinite(f)) or np.any(f < 0):
+            raise ValueError("force must be finite and >= 0")
+        return np.asarray(np.cbrt(f / self._c) ** 2, dtype=np.float64)
+
+    def force_and_stiffness_at(self, delta: float) -> tuple[float, float]:
+        if not (delta >= 0 and math.isfinite(delta)):
+            raise ValueError("indentation depth delta must be finite and >= 0")
+        root = math.sqrt(delta)
+        return self._c * delta * root, 1.5 * self._c * root
+
+    def inverse_at(self, force: float) -> float:
+        if not (force >= 0 and math.isfinite(force)):
+            raise ValueError("force must be finite and >= 0")
+        return float((force / self._c) ** (2.0 / 3.0))
