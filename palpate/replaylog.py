@@ -91,6 +91,9 @@ def _replay_joint(
     if recorded is None or "joint" not in recorded or inputs is None:
         report["joint"] = None
         return True
+    probe = next(log.of_kind("probe"), None)
+    if probe is not None:  # the estimator was told the misalignment probing measured
+        inputs = {**inputs, "misalignment": probe["misalignment"]}
     rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
     fit = joint_from_rows(rows, EstimatorInputs.from_dict(inputs), stack, section)
     replayed = json.loads(json.dumps(joint_record(fit)))

@@ -35,12 +35,20 @@ from palpate.simworld import (
 from robot.drive import DriveController
 from robot.dynamixel.driver import DynamixelBus
 from robot.indentation import Observation, State, TrialMarks, TrialPlan
+from robot.probing import ProbeResult
 from robot.rig import RigSettings, ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import end_record, estimate_record, header_common
 from robot.trial.run import TrialResult, run_trial
-from robot.trial.setup import detector_for, guards_for, rig_settings, sensor_section, trial_plan
+from robot.trial.setup import (
+    detector_for,
+    guards_for,
+    prober_for,
+    rig_settings,
+    sensor_section,
+    trial_plan,
+)
 from sensor.reader import FrameReader, layout_from_config
 from sensor.strain import StrainChain
 from sim.board import BoardEmulator, BoardFaults
@@ -79,6 +87,10 @@ class TrialOutcome:
     marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
     joint: JointFit | None = None  # the contact-point-free estimate (robot.trial.estimate)
     joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
+    misalignment: float = 0.0  # rad, what the estimator was told (probing's, or the IK's)
+    true_misalignment: float | None = None  # rad, the world's at the indentation (sim truth)
+    probe: ProbeResult | None = None
+    probing_time: float = 0.0  # simulated s in the probing step
 
     def modulus(self, method: str = "joint") -> float | None:
         """E (Pa) by ``"joint"`` (the whole-record fit) or ``"paper"`` (Eqs. 13-14)."""
@@ -113,9 +125,32 @@ class TrialOutcome:
             "state": self.state,
             "reason": self.reason,
             "ik_residual_deg": math.degrees(self.ik_residual),
+            "misalignment_deg": math.degrees(self.misalignment),
+            "true_misalignment_deg": _deg(self.true_misalignment),
+            "probe": None if self.probe is None else _probe_summary(self.probe),
+            "probing_s": self.probing_time,
             "sim_time_s": self.sim_time,
             "log": self.log_path,
         }
+
+
+def _deg(x: float | None) -> float | None:
+    return None if x is None else math.degrees(x)
+
+
+def _probe_summary(p: ProbeResult) -> dict[str, Any]:
+    """The trial JSON's view of probing: what was measured and decided (the log has it all)."""
+    return {
+        "reachable": p.reachable,
+        "reason": p.reason,
+        "normal": p.normal,
+        "normal_sigma_deg": math.degrees(p.normal_sigma),
+        "model": p.model,
+        "radius_mm": None if p.radius is None else p.radius * 1e3,
+        "miss_mm": p.miss * 1e3,
+        "roll_deg": math.degrees(p.roll),
+        "touches": len(p.touches),
+    }
 
 
 class EmulatorHook(Protocol):
@@ -193,10 +228,11 @@ def run_sim_trial(
 ) -> TrialOutcome:
     """Run one simulated trial end to end and estimate the modulus from it."""
     c = scene.campaign
-    geo = trial_geometry(stack, spec)
+    geo = trial_geometry(stack, spec, trial_sample(scene, spec))
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
     stack = trial_stack(scene, stack, geo, retract)
     plan = trial_plan(c, stack, roll=geo.plan_roll, contact=geo.contact_translation, home=retract)
+    prober = prober_for(c, stack, stack.tube(geo.tube)) if spec.kind == "robot" else None
     clock = VirtualClock()
     servos = ServoJoints(stack)
     world = trial_world(spec, scene, stack, geo, servos)
@@ -216,13 +252,21 @@ def run_sim_trial(
             with _trial_log(log_dir, spec, scene, stack, plan, geo, hook) as log:
                 guards = guards_for(c, stack, rig.tick)
                 detector = detector_for(c, chain)
-                result = run_trial(rig, clock, plan, guards, detector, log, on_tick=on_tick)
+                prober = (
+                    prober_for(c, stack, stack.tube(geo.tube)) if spec.kind == "robot" else None
+                )
+                result = run_trial(
+                    rig, clock, plan, guards, detector, log, on_tick=on_tick, prober=prober
+                )
                 estimate = _estimate(result, spec, scene, stack, geo)
                 if log is not None:
                     log.write(estimate_record(estimate))
                     log.write(end_record(result))
     log_path = None if log is None else str(log.path)
-    return _outcome(spec, geo, result, estimate, log_path, series)
+    outcome = _outcome(spec, geo, result, estimate, log_path, series)
+    indentation = world.indentation
+    outcome.true_misalignment = None if indentation is None else indentation.misalignment
+    return outcome
 
 
 def _rig_settings(
@@ -291,8 +335,13 @@ def _estimate(
         stack=stack,
         section=sensor_section(stack),
         poisson=trial_sample(scene, spec).poisson,
-        inputs=_estimator_inputs(spec, scene, stack, geo),
+        inputs=_estimator_inputs(spec, scene, stack, geo, _misalignment(result, geo)),
     )
+
+
+def _misalignment(result: TrialResult, geo: TrialGeometry) -> float:
+    """What the controller knows of the misalignment: probing's measure, else the plan's IK."""
+    return geo.residual if result.probe is None else result.probe.misalignment
 
 
 def _outcome(
@@ -317,6 +366,9 @@ def _outcome(
         marks=result.marks,
         joint=estimate.joint,
         joint_seconds=estimate.joint_seconds,
+        misalignment=_misalignment(result, geo),
+        probe=result.probe,
+        probing_time=result.probing_time,
     )
 
 
@@ -339,7 +391,11 @@ def _header(
 
 
 def _estimator_inputs(
-    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
+    spec: TrialSpec,
+    scene: SceneConfig,
+    stack: StackConfig,
+    geo: TrialGeometry,
+    misalignment: float | None = None,
 ) -> EstimatorInputs:
     """What the joint fit is told: the sample as the user knows it (not the sim's switches)."""
     sample = trial_sample(scene, spec)
@@ -352,5 +408,5 @@ def _estimator_inputs(
         thickness=sample.thickness,
         bonded=sample.bonded,
         encoder_resolution=stack.drive.lead / TICKS_PER_REV,
-        misalignment=geo.residual,
+        misalignment=geo.residual if misalignment is None else misalignment,
     )

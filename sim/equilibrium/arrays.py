@@ -14,10 +14,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from sim.equilibrium.law import AxialLaw, BoolArray, ContactEffects, FloatArray
+from sim.equilibrium.law import AxialLaw, BoolArray, ContactEffects, FloatArray, TissueLaw
 from sim.equilibrium.sides import BeamSide, TissueSide
 from sim.equilibrium.state import ContactState, status_message
-from sim.tissue import TissueModel
 
 
 class _Onset(NamedTuple):
@@ -32,7 +31,7 @@ class _Onset(NamedTuple):
 def solve_array(
     u: FloatArray,
     law: AxialLaw,
-    tissue: TissueModel,
+    tissue: TissueLaw,
     fx: ContactEffects,
     atol: float,
     maxiter: int,

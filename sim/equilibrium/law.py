@@ -23,6 +23,23 @@ DEFAULT_MAX_E_OVER_L = 0.2
 """Largest e/L the solver searches when the beam law does not say (trials visit <= 1e-2)."""
 
 
+class TissueLaw(Protocol):
+    """What the solver needs from a tissue's force law (``sim.tissue.TissueModel``, a
+    finite-element law, ``sim.oblique.ObliqueContact``): force and stiffness at depths, the
+    depth at forces, on arrays of any shape and in plain floats. Hashable, so a contact table
+    solved with it can be cached."""
+
+    def force_and_stiffness(self, delta: ArrayLike, /) -> tuple[FloatArray, FloatArray]: ...
+
+    def inverse(self, force: ArrayLike, /) -> FloatArray: ...
+
+    def force_and_stiffness_at(self, delta: float, /) -> tuple[float, float]: ...
+
+    def inverse_at(self, force: float, /) -> float: ...
+
+    def __hash__(self) -> int: ...
+
+
 class BeamLike(Protocol):
     """What the solver needs from ``estimation.beam.Beam``."""
 

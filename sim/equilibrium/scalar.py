@@ -21,9 +21,14 @@ from collections.abc import Callable
 import numpy as np
 
 from estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
-from sim.equilibrium.law import DEFAULT_MAX_E_OVER_L, AxialLaw, ContactEffects, FloatArray
+from sim.equilibrium.law import (
+    DEFAULT_MAX_E_OVER_L,
+    AxialLaw,
+    ContactEffects,
+    FloatArray,
+    TissueLaw,
+)
 from sim.equilibrium.state import ContactState, status_message
-from sim.tissue import TissueModel
 
 
 def _as_float(x: object) -> float:
@@ -101,7 +106,7 @@ class ScalarBeam:
 def solve_scalar(
     u_in: FloatArray,
     law: AxialLaw,
-    tissue: TissueModel,
+    tissue: TissueLaw,
     fx: ContactEffects,
     atol: float,
     maxiter: int,
@@ -143,7 +148,7 @@ _Stage = tuple[float, float, float, int, int]  # delta, e, P, status, iterations
 
 
 def _pre_onset(
-    u: float, d_a: float, beam: ScalarBeam, tissue: TissueModel, atol: float, maxiter: int
+    u: float, d_a: float, beam: ScalarBeam, tissue: TissueLaw, atol: float, maxiter: int
 ) -> _Stage:
     """Newton in delta from the right on a convex increasing function."""
     d, lo = min(u, d_a), 0.0
@@ -165,7 +170,7 @@ def _post_onset(
     u: float,
     onset: tuple[float, float, float],
     beam: ScalarBeam,
-    tissue: TissueModel,
+    tissue: TissueLaw,
     atol: float,
     maxiter: int,
 ) -> _Stage:

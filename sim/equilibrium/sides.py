@@ -36,8 +36,13 @@ from typing import Generic, TypeVar
 import numpy as np
 
 from estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
-from sim.equilibrium.law import DEFAULT_MAX_E_OVER_L, AxialLaw, ContactEffects, FloatArray
-from sim.tissue import TissueModel
+from sim.equilibrium.law import (
+    DEFAULT_MAX_E_OVER_L,
+    AxialLaw,
+    ContactEffects,
+    FloatArray,
+    TissueLaw,
+)
 
 T = TypeVar("T")
 
@@ -71,7 +76,7 @@ class Recall(Generic[T]):
 class TissueSide:
     """The tissue law for one solve, each evaluation recalled (:class:`Recall`)."""
 
-    def __init__(self, tissue: TissueModel) -> None:
+    def __init__(self, tissue: TissueLaw) -> None:
         self.force_and_stiffness = Recall(tissue.force_and_stiffness)
         self.inverse = Recall(tissue.inverse)
 

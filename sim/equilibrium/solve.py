@@ -6,16 +6,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from sim.equilibrium.arrays import solve_array
-from sim.equilibrium.law import AxialLaw, BeamLike, ContactEffects, axial_law
+from sim.equilibrium.law import AxialLaw, BeamLike, ContactEffects, TissueLaw, axial_law
 from sim.equilibrium.scalar import solve_scalar
 from sim.equilibrium.state import ContactState
-from sim.tissue import TissueModel
 
 
 def solve_contact(
     u: ArrayLike,
     beam: BeamLike | AxialLaw,
-    tissue: TissueModel,
+    tissue: TissueLaw,
     effects: ContactEffects | None = None,
     *,
     atol: float = 1e-13,
