@@ -305,10 +305,10 @@ def fit_surface(
 
 def load_crossing(
     advance: ArrayLike, load: ArrayLike, threshold: float, *, grid: int = 200
-) -> float | None:
-    """Where a light touch's load reached ``threshold``: the advance (m) at which the sphere's
-    contact law ``load = b + c (x - x0)^1.5`` (Hertz, on a baseline b), fitted to the whole
-    approach (N,) by least squares, crosses ``b + threshold``; None when it does not rise.
+) -> tuple[float, float] | None:
+    """Where a light touch began and where its load reached ``threshold``: ``(x0, x)`` (m) of
+    the sphere's contact law ``load = b + c (x - x0)^1.5`` (Hertz, on a baseline b), fitted to
+    the whole approach (N,) by least squares; None when it does not rise.
 
     Why not the first tick above the threshold: with the sensor's few-microstrain noise on a
     soft sample that tick is tens of micrometres early or late, and so is a baseline taken on a
@@ -341,4 +341,4 @@ def load_crossing(
     x0, c, _ = best(np.linspace(x0 - cell, x0 + cell, grid))
     if not c > 0:
         return None
-    return float(x0 + (threshold / c) ** (2.0 / 3.0))
+    return x0, float(x0 + (threshold / c) ** (2.0 / 3.0))

@@ -36,7 +36,14 @@ from robot.trial.estimate import estimate_trial
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import end_record, estimate_record, header_common
 from robot.trial.run import run_trial
-from robot.trial.setup import detector_for, guards_for, rig_settings, sensor_section, trial_plan
+from robot.trial.setup import (
+    detector_for,
+    guards_for,
+    prober_for,
+    rig_settings,
+    sensor_section,
+    trial_plan,
+)
 from sensor.strain import StrainChain
 
 SKIPPED = "skipped"
@@ -293,7 +300,11 @@ def _run_one(
     path = log_dir / f"{trial.trial_id}.jsonl"
     with TrialLogWriter(path, _header(trial, loaded, section)) as log:
         guards = guards_for(c, stack, rig.tick)
-        result = run_trial(rig, hw.clock, trial.plan, guards, detector_for(c, chain), log)
+        # the robot probes the surface first when the campaign says so (null: it does)
+        prober = prober_for(c, stack, trial.tube) if trial.kind == "robot" else None
+        result = run_trial(
+            rig, hw.clock, trial.plan, guards, detector_for(c, chain), log, prober=prober
+        )
         estimate = estimate_trial(
             result,
             kind=trial.kind,

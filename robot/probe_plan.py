@@ -12,7 +12,8 @@ the roll by the bow.
 
 Where the next touch can be (:meth:`ProbeGeometry.predict`): with one touch, anywhere within
 ``max_tilt`` of facing the tube; with two, the plane through them least tilted from facing the
-tube, give or take ``max_tilt`` about their line; with three or more, the fitted plane.
+tube, give or take ``max_tilt`` about their line; with three or more, the fitted plane give or
+take three times its normal's uncertainty about the touches' centroid.
 :meth:`ProbeGeometry.sweep_needs` turns that into the advance behind the surface on every ray a
 roll sweeps. :meth:`ProbeGeometry.replan` fits the plane (or, with five touches or more that a
 plane cannot explain, the sphere: ``estimation.surface``) and asks the inverse kinematics of
@@ -33,11 +34,12 @@ from numpy.typing import NDArray
 
 from config.schema import TubeConfig
 from estimation.beamstate import axial_strain
-from estimation.surface import SurfaceGeometry, fit_surface
+from estimation.surface import SurfaceGeometry, fit_plane, fit_surface
 from robot import kinematics
 from robot.indentation import TrialPlan
 
 Vector = NDArray[np.float64]
+FloatArray = NDArray[np.float64]
 SWEEP_STEPS = 8  # rays checked along a roll for the retract before it
 ROLL_MARGIN = math.radians(1.0)  # probe rolls stay this far inside the roll limits
 MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is read with
@@ -77,13 +79,15 @@ class Touch:
     """One light touch: the roll and stage advance (rad, m) and the tip centre and the sensor
     axis there (3-tuples, base frame); ``slipped`` when the FBG saw the beam bow without the
     load rising (the tip slid on a surface too steep for its friction): kept for the moves,
-    left out of the fit."""
+    left out of the fit; ``depth``: how far past the surface the touch is (its load's onset
+    to its threshold), which a move must keep clear of besides the surface's own doubt."""
 
     roll: float
     advance: float
     centre: tuple[float, float, float]
     tangent: tuple[float, float, float]
     slipped: bool = False  # the tip slid instead of loading: not a point of the surface
+    depth: float = 0.0  # m of advance from where the load began to the touch
 
 
 @dataclass(frozen=True)
@@ -127,15 +131,20 @@ class ProbeGeometry:
         translation_limits: tuple[float, float],
         roll_limits: tuple[float, float],
         bending_mode: Callable[[float], Sequence[float]],
+        loads: Callable[[FloatArray, FloatArray], FloatArray] | None = None,
     ) -> None:
         """``bending_mode``: the gratings' onset bending shape at an exposed length (m)
-        (``estimation.beamstate.onset_mode``), to take the beam's bow out of its load."""
+        (``estimation.beamstate.onset_mode``), to take the beam's bow out of its load tick by
+        tick; ``loads``: the axial strain P/EA of a record (advances (N,) m, strains (N, G))
+        by the full non-linear beam state (``estimation.beamstate.infer_states``), for the fit
+        of a touch (the onset shape is a few microstrain off once the bow has grown)."""
         self.tube = tube
         self.tip_radius = tip_radius
         self.translation_limits = translation_limits
         self.roll_limits = roll_limits
         self._mode = bending_mode
         self._modes: dict[int, Sequence[float]] = {}
+        self.loads = loads
 
     def axial(self, strains: Sequence[float], advance: float) -> float:
         """The axial strain P/EA (compression positive) at a stage ``advance`` (m): the uniform
@@ -192,25 +201,26 @@ class ProbeGeometry:
     ) -> tuple[float, float]:
         """(advance, slack) m: where the next touch at ``roll`` is expected, and how far either
         side of it the surface can be (see the module docstring)."""
-        model, line = _model(touches, settings.sigma)
+        model, line, tilt = _model(touches, settings.sigma)
         x = self.advance_to(model, roll)
         if not math.isfinite(x):
             x = touches[-1].advance
-        if line is None:
-            return x, 3.0 * settings.sigma + settings.clearance
         c = np.asarray(self.touch(roll, x).centre)
-        return x, _distance_to_line(c, line) * math.tan(settings.max_tilt)
+        slack = _distance_to_line(c, line) * math.tan(min(tilt, settings.max_tilt))
+        return x, slack + 3.0 * settings.sigma
 
     def sweep_needs(
         self, touches: list[Touch], start: float, end: float, settings: ProbeSettings
     ) -> tuple[list[float], list[float]]:
         """(rolls, advances): rays from roll ``start`` to ``end`` and, on each, the advance (m)
-        behind where the surface can be, by ``clearance``."""
+        behind where the surface can be, by ``clearance`` (the touches, and so the prediction,
+        are their depth past the surface)."""
         rolls = np.linspace(start, end, SWEEP_STEPS + 1).tolist()
+        depth = max(t.depth for t in touches)  # the touches are this far past the surface
         safe = []
         for roll in rolls:
             x, slack = self.predict(touches, roll, settings)
-            safe.append(max(x - slack - settings.clearance, self.translation_limits[0]))
+            safe.append(max(x - depth - slack - settings.clearance, self.translation_limits[0]))
         return rolls, safe
 
     def sweep_retract(
@@ -247,7 +257,8 @@ class ProbeGeometry:
         )  # fmt: skip
         move = ik.reachable and settings.replan
         roll = ik.roll if move else plan.roll
-        advance = ik.advance if move else plan.contact_advance
+        depth = float(np.mean([t.depth for t in held]))  # the fit is this far past the surface
+        advance = ik.advance - depth if move else plan.contact_advance
         if not settings.replan:  # measure only: the misalignment of the plan's own pose
             ik = _plan_pose(self, target, n0, surface.radius, plan)
         retract = self.sweep_retract(touches, touches[-1].roll, roll, settings)
@@ -306,20 +317,23 @@ def _reason(ik: kinematics.IKSolution, settings: ProbeSettings) -> str:
 
 def _model(
     touches: list[Touch], sigma: float
-) -> tuple[SurfaceGeometry, tuple[Vector, Vector] | None]:
-    """The centres' surface the touches so far support, and the line about which it may still
-    turn (None once three touches fix a plane)."""
+) -> tuple[SurfaceGeometry, tuple[Vector, Vector], float]:
+    """The centres' plane the touches so far support, the line about which it may still turn
+    and by how much (rad; ``inf``: by any angle, the search's bound applies). Three touches or
+    more fix a plane up to three times its normal's 1-sigma angle about their centroid (three
+    on one side of the roll leave it loose across)."""
     c = np.array([t.centre for t in touches])
-    facing = -np.array([t.tangent for t in touches]).mean(axis=0)
+    rays = np.array([t.tangent for t in touches])
+    facing = -rays.mean(axis=0)
     if len(touches) >= 3:
-        fit = fit_surface(c, sigma=sigma, hint=facing)
+        fit = fit_plane(c, sigma=sigma, hint=facing, directions=rays)
         if fit.success and fit.centres is not None:
-            return SurfaceGeometry(fit.centres.point, fit.centres.normal), None
+            return fit.centres, (fit.centres.point, np.zeros(3)), 3.0 * fit.normal_sigma
     if len(touches) == 1:
-        return SurfaceGeometry.make(c[0], facing), (c[0], np.zeros(3))
+        return SurfaceGeometry.make(c[0], facing), (c[0], np.zeros(3)), math.inf
     along = (c[1] - c[0]) / np.linalg.norm(c[1] - c[0])
     normal = facing - float(facing @ along) * along
-    return SurfaceGeometry.make(c[0], normal), (c[0], along)
+    return SurfaceGeometry.make(c[0], normal), (c[0], along), math.inf
 
 
 def _distance_to_line(p: Vector, line: tuple[Vector, Vector]) -> float:

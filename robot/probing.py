@@ -81,6 +81,7 @@ class ProbeRoutine:
         self._loaded_ticks = 0
         self._zero_roll = plan.roll  # the roll the strains were last zeroed at
         self._ramp: list[tuple[float, float]] = []  # (advance, axial strain) of this seek
+        self._ramp_strains: list[tuple[float, ...]] = []  # the strains of those ticks
 
     @property
     def roll(self) -> float:
@@ -102,16 +103,16 @@ class ProbeRoutine:
         axial = self.geometry.axial(obs.strains, obs.advance)
         if math.isfinite(axial):
             self._ramp.append((obs.advance, axial))
+            self._ramp_strains.append(obs.strains)
         load = axial - self._baseline()
         bowed = max((abs(e) for e in obs.strains), default=0.0) >= TOUCH_BOW * s.touch_strain
         if math.isfinite(load) and (load >= TOUCH_TOP * s.touch_strain or bowed):
             # a bow without the load is a slipping tip (the surface too steep for its friction)
             slipped = bowed and load < s.touch_strain
-            x = obs.advance if slipped else self._crossing()
-            self.touches.append(
-                dataclasses.replace(self.geometry.touch(obs.roll, x), slipped=slipped)
-            )
-            self._ramp = []
+            start, x = (obs.advance, obs.advance) if slipped else self._crossing()
+            touch = self.geometry.touch(obs.roll, x)
+            self.touches.append(dataclasses.replace(touch, slipped=slipped, depth=x - start))
+            self._ramp, self._ramp_strains = [], []
             self.phase = _Phase.LIFT
             return self._lift(obs)
         if obs.advance >= self.limit - self.plan.position_tolerance:
@@ -128,13 +129,18 @@ class ProbeRoutine:
             return 0.0
         return float(np.mean([a for _, a in self._ramp[:BASELINE_TICKS]]))
 
-    def _crossing(self) -> float:
-        """The advance where the seek's load reached the threshold: the Hertz power fitted to
-        the whole seek (``estimation.surface.load_crossing``); the last tick's when that fails."""
+    def _crossing(self) -> tuple[float, float]:
+        """Where the seek's load began and where it reached the threshold: the Hertz power
+        fitted to the whole seek (``estimation.surface.load_crossing``), on the loads of the
+        full beam state when the geometry has them; the last tick's advance (twice) when the
+        fit fails."""
         xs = [x for x, _ in self._ramp]
         ys = [a for _, a in self._ramp]
+        if self.geometry.loads is not None and len(xs) >= 4:
+            ys = self.geometry.loads(np.array(xs), np.array(self._ramp_strains)).tolist()
         found = load_crossing(xs, ys, self.settings.touch_strain) if len(xs) >= 4 else None
-        return self._ramp[-1][0] if found is None else found
+        last = self._ramp[-1][0]
+        return (last, last) if found is None else found
 
     def _lift(self, obs: Observation) -> Command | ProbeResult:
         """Plan what follows a touch (the next move, or the re-plan and the way out) and start

@@ -12,10 +12,11 @@ import math
 from collections.abc import Callable
 
 import numpy as np
+from numpy.typing import NDArray
 
 from config.scene import CampaignConfig
 from config.schema import MM, StackConfig, TubeConfig
-from estimation.beamstate import onset_mode
+from estimation.beamstate import infer_states, onset_mode
 from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
 from estimation.section import Section, composite_section
 from robot.indentation import Guards, Prober, TrialPlan
@@ -23,6 +24,8 @@ from robot.probing import ProbeGeometry, ProbeRoutine, ProbeSettings
 from robot.rig import RigSettings
 from sensor.strain import StrainChain, grating_intervals
 from wire.dynamixel import TICKS_PER_REV
+
+FloatArray = NDArray[np.float64]
 
 
 def sensor_section(stack: StackConfig) -> Section:
@@ -67,11 +70,18 @@ def prober_for(
     probing = campaign.probing()
     if probing is False:
         return None
-    fiber_offset = sensor_section(stack).fiber_offset
+    section = sensor_section(stack)
+    fiber_offset = section.fiber_offset
 
     def bending(length: float) -> tuple[float, ...]:
         intervals = grating_intervals(stack.sensor, length)
         return tuple(onset_mode(intervals, length, fiber_offset).tolist())
+
+    def loads(advance: FloatArray, strains: FloatArray) -> FloatArray:
+        lengths = advance - tube.flush_translation
+        intervals = grating_intervals(stack.sensor, 0.0)[None, :, :] + lengths[:, None, None]
+        states = infer_states(strains, intervals, lengths, section.EA, fiber_offset, 1e-6)
+        return np.asarray(states.P / section.EA)
 
     geometry = ProbeGeometry(
         tube,
@@ -79,6 +89,7 @@ def prober_for(
         translation_limits=stack.drive.translation_limits,
         roll_limits=stack.drive.roll_limits,
         bending_mode=bending,
+        loads=loads,
     )
 
     def build(plan: TrialPlan) -> Prober:
