@@ -127,7 +127,7 @@ class TrialOutcome:
             "ik_residual_deg": math.degrees(self.ik_residual),
             "misalignment_deg": math.degrees(self.misalignment),
             "true_misalignment_deg": _deg(self.true_misalignment),
-            "probe": None if self.probe is None else _probe_summary(self.probe),
+            "probe": None if self.probe is None else self.probe.summary(),
             "probing_s": self.probing_time,
             "sim_time_s": self.sim_time,
             "log": self.log_path,
@@ -136,21 +136,6 @@ class TrialOutcome:
 
 def _deg(x: float | None) -> float | None:
     return None if x is None else math.degrees(x)
-
-
-def _probe_summary(p: ProbeResult) -> dict[str, Any]:
-    """The trial JSON's view of probing: what was measured and decided (the log has it all)."""
-    return {
-        "reachable": p.reachable,
-        "reason": p.reason,
-        "normal": p.normal,
-        "normal_sigma_deg": math.degrees(p.normal_sigma),
-        "model": p.model,
-        "radius_mm": None if p.radius is None else p.radius * 1e3,
-        "miss_mm": p.miss * 1e3,
-        "roll_deg": math.degrees(p.roll),
-        "touches": len(p.touches),
-    }
 
 
 class EmulatorHook(Protocol):

@@ -52,7 +52,9 @@ class ProbeSettings:
     Attributes:
         offsets: the rolls of the touches after the first, relative to the plan's roll.
         touch_strain: axial strain (compression) that is a touch.
-        speed: approach speed of a touch; fast_speed for the moves between touches.
+        speed: approach speed of the first touch; fast_speed for the moves between touches.
+        decel: the stage's deceleration: once a touch has shown how deep the sample yields,
+            later ones approach as fast as the stage stops within half that depth.
         clearance: kept between the tip and where the surface can be, when moving.
         max_tilt: the largest tilt of the surface from facing the tube the search allows for.
         sigma: a touch's uncertainty along its ray (m), for the normal's uncertainty.
@@ -65,6 +67,7 @@ class ProbeSettings:
     touch_strain: float
     speed: float
     fast_speed: float
+    decel: float = math.inf  # m/s^2, the stage's; a seek may go as fast as it can stop in
     clearance: float = 0.2e-3
     max_tilt: float = math.radians(30.0)
     sigma: float = 10e-6
@@ -114,10 +117,25 @@ class ProbeResult:
     retract_to: float
 
     def as_dict(self) -> dict[str, Any]:
+        """Everything, for the trial log's ``probe`` record."""
         d = dataclasses.asdict(self)
         d["misalignment_deg"] = math.degrees(self.misalignment)
         d["normal_sigma_deg"] = math.degrees(self.normal_sigma)
         return d
+
+    def summary(self) -> dict[str, Any]:
+        """What was measured and decided, for a campaign's JSON (the log has the touches)."""
+        return {
+            "reachable": self.reachable,
+            "reason": self.reason,
+            "normal": self.normal,
+            "normal_sigma_deg": math.degrees(self.normal_sigma),
+            "model": self.model,
+            "radius_mm": None if self.radius is None else self.radius * 1e3,
+            "miss_mm": self.miss * 1e3,
+            "roll_deg": math.degrees(self.roll),
+            "touches": len(self.touches),
+        }
 
 
 class ProbeGeometry:

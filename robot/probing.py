@@ -120,7 +120,17 @@ class ProbeRoutine:
                 f"probing: no surface within {self.limit * 1e3:.2f} mm of stage travel at roll "
                 f"{math.degrees(self.roll):.1f} deg"
             )
-        return Command(self.limit, self.roll, s.speed)
+        return Command(self.limit, self.roll, self._seek_speed())
+
+    def _seek_speed(self) -> float:
+        """The first touch's speed, then as fast as the stage stops (v^2 / 2a) within half the
+        depth the touches went to (a soft sample yields more, so it can be met faster)."""
+        s = self.settings
+        depths = [t.depth for t in self.touches if not t.slipped and t.depth > 0]
+        if not depths or not math.isfinite(s.decel):
+            return s.speed
+        reach = TOUCH_TOP ** (2.0 / 3.0) * min(depths)  # a touch's depth at its top load
+        return min(max(math.sqrt(s.decel * reach), s.speed), s.fast_speed)
 
     def _baseline(self) -> float:
         """The axial strain of the free beam on this seek: the mean of its first ticks (the

@@ -99,6 +99,7 @@ def prober_for(
             touch_strain=campaign.probe_touch_ue * 1e-6,
             speed=min(PROBE_SPEED, stack.drive.max_speed),
             fast_speed=stack.drive.max_speed,
+            decel=stack.drive.max_accel,
             max_residual=math.radians(campaign.misalignment_tolerance_deg),
             max_miss=campaign.miss_tolerance_mm * MM,
             standoff=plan.standoff,
