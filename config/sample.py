@@ -67,15 +67,19 @@ class SampleConfig:
     ``lateral_radius_mm`` (the sample's finite lateral size), a standard-linear-solid relaxation
     (``relaxation_time_s``, null = elastic, and ``relaxed_ratio`` = E_inf / E_0, used where the
     scene's fidelity switches viscoelasticity on; ``modulus_kpa`` is then the relaxed modulus
-    E_inf), the Coulomb ``friction`` between tip and surface (the normal force law takes the
-    nearer of the FE's frictionless and full-stick limits: ``sim.sample_law.contact_condition``),
-    and ``rigid`` (a rigid reference for calibrating the tube's and stage's compliance: the
-    modulus is then not used). How each key reaches the world: docs/world.md.
+    E_inf), the Coulomb ``friction`` between tip and surface (0.5 by default, silicone or gel on
+    a printed sphere: an oblique contact slips where tan(misalignment) exceeds it; the normal
+    force law takes the nearer of the FE's frictionless and full-stick limits:
+    ``sim.sample_law.contact_condition``), and ``rigid`` (a rigid reference for calibrating the
+    tube's and stage's compliance: the modulus is then not used). How each key reaches the
+    world: docs/world.md.
 
     Surface pose, relative to where the campaign plans the sample (the surface normal against
     the nominal approach): ``tilt_deg`` (angle between the surface normal and the nominal
-    approach direction), ``tilt_azimuth_deg`` (about the approach axis),
-    ``curvature_radius_mm`` (a convex sphere of that radius; null = flat) and ``offset_mm``
+    approach direction), ``tilt_azimuth_deg`` (about the approach axis, from the direction in
+    which the tube's bend angle grows; null: the azimuth at which a roll of the trial's own tube
+    meets the tilted surface orthogonally, the placement chooses it and the controller is not
+    told), ``curvature_radius_mm`` (a convex sphere of that radius; null = flat) and ``offset_mm``
     (x, y, z in the robot's base frame).
 
     ``assumed``: what the operator believes (:class:`AssumedConfig`); null = the truth above.
@@ -90,10 +94,10 @@ class SampleConfig:
     lateral_radius_mm: float = field(default=40.0, metadata=limits(gt=0, le=1000))
     relaxation_time_s: float | None = field(default=None, metadata=limits(gt=0, le=1e4))
     relaxed_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1))
-    friction: float = field(default=0.0, metadata=limits(ge=0, le=5))
+    friction: float = field(default=0.5, metadata=limits(ge=0, le=5))
     rigid: bool = False
     tilt_deg: float = field(default=0.0, metadata=limits(ge=0, le=80))
-    tilt_azimuth_deg: float = field(default=0.0, metadata=limits(ge=-360, le=360))
+    tilt_azimuth_deg: float | None = field(default=0.0, metadata=limits(ge=-360, le=360))
     curvature_radius_mm: float | None = field(default=None, metadata=limits(gt=0, le=1e4))
     offset_mm: tuple[float, float, float] = field(
         default=(0.0, 0.0, 0.0), metadata=limits(ge=-1000, le=1000)
@@ -117,8 +121,8 @@ class SampleConfig:
         return math.radians(self.tilt_deg)
 
     @property
-    def tilt_azimuth(self) -> float:
-        return math.radians(self.tilt_azimuth_deg)
+    def tilt_azimuth(self) -> float | None:
+        return None if self.tilt_azimuth_deg is None else math.radians(self.tilt_azimuth_deg)
 
     @property
     def curvature_radius(self) -> float | None:

@@ -80,10 +80,22 @@ class CampaignConfig:
     detector: Literal["paper", "cusum"] = "paper"
     detector_threshold_ue: float = field(default=300.0, metadata=limits(gt=0, le=10000))
     outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))
-    # Find the surface normal by light touches before indenting; null: on for robot campaigns,
-    # off on the vertical bench stage.
-    probe: bool | None = None
+    # Find the surface normal by light touches before indenting (robot.probing), then re-plan
+    # the roll and advance orthogonal to it; null: on for robot campaigns, off on the vertical
+    # bench stage. "measure": touch, fit and log the misalignment, but indent as planned.
+    probe: bool | Literal["measure"] | None = None
     misalignment_tolerance_deg: float = field(default=2.0, metadata=limits(gt=0, le=45))
+    # The orthogonal contact must lie this close to where the plan aimed (on the sample).
+    miss_tolerance_mm: float = field(default=30.0, metadata=limits(gt=0, le=500))
+    probe_points: int = field(default=4, metadata=limits(ge=3, le=9))  # touches; >= 5: spheres
+    # How far the touches' arc bows across the roll (a roll moves the tip on a circle about the
+    # x axis): what fixes the normal's tilt along the tube's bend, so the roll span per tube.
+    probe_sagitta_mm: float = field(default=3.0, metadata=limits(gt=0, le=50))
+    probe_touch_ue: float = field(default=25.0, metadata=limits(gt=0, le=1000))  # light touch
+
+    def probing(self) -> bool | Literal["measure"]:
+        """Whether trials probe: ``probe`` itself, or for null, robot campaigns only."""
+        return self.kind == "robot" if self.probe is None else self.probe
 
     @property
     def orientation_rolls_deg(self) -> tuple[float, ...]:

@@ -40,6 +40,10 @@ class SensorConfig:
     grating_length_mm: float = field(default=3.0, metadata=limits(gt=0, le=50))
     first_grating_from_tip_mm: float = field(default=10.0, metadata=limits(ge=0, le=500))
     used_gratings: tuple[int, ...] = (1, 2, 3)
+    # Weight (for scenes that model gravity): the printed tip sphere (3.5 mm, ~1.18 g/cm^3
+    # MJP resin) and the beam (four NiTi wires, 6.45 g/cm^3, and the fiber).
+    tip_mass_g: float = field(default=0.21, metadata=limits(ge=0, le=100))
+    linear_mass_g_per_m: float = field(default=0.9, metadata=limits(ge=0, le=1000))
 
     def validate(self) -> None:
         if not self.used_gratings:
@@ -73,6 +77,14 @@ class SensorConfig:
     @property
     def exposed_length(self) -> float:
         return self.exposed_length_mm * MM
+
+    @property
+    def tip_mass(self) -> float:
+        return self.tip_mass_g * 1e-3
+
+    @property
+    def linear_mass(self) -> float:
+        return self.linear_mass_g_per_m * 1e-3
 
     @property
     def grating_length(self) -> float:
@@ -200,6 +212,9 @@ class DriveConfig:
     max_roll_accel_deg_per_s2: float = field(default=360.0, metadata=limits(gt=0, le=1000000))
     home_translation_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
     home_roll_deg: float = field(default=0.0, metadata=limits(ge=-3600, le=3600))
+    # The inner roller gear is slaved to the outer one; a twist between them beyond this (a
+    # slipping gear, a stalled servo) stops the trial and retracts.
+    max_twist_deg: float = field(default=3.0, metadata=limits(gt=0, le=360))
 
     def validate(self) -> None:
         if self.translation_min_mm >= self.translation_max_mm:
@@ -232,6 +247,10 @@ class DriveConfig:
     @property
     def max_speed(self) -> float:
         return self.max_speed_mm_per_s * MM
+
+    @property
+    def max_twist(self) -> float:
+        return math.radians(self.max_twist_deg)
 
     @property
     def max_roll_speed(self) -> float:

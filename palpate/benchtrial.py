@@ -41,6 +41,7 @@ from robot.trial.setup import (
     detector_for,
     guards_for,
     position_tolerance,
+    prober_for,
     rig_settings,
     sensor_section,
 )
@@ -214,7 +215,11 @@ def _run_one(
     path = log_dir / f"{trial.trial_id}.jsonl"
     with TrialLogWriter(path, _header(trial, loaded, section, inputs)) as log:
         guards = guards_for(c, stack, rig.tick)
-        result = run_trial(rig, hw.clock, trial.plan, guards, detector_for(c, chain), log)
+        # the robot probes the surface first when the campaign says so (null: it does)
+        prober = prober_for(c, stack, trial.tube) if trial.kind == "robot" else None
+        result = run_trial(
+            rig, hw.clock, trial.plan, guards, detector_for(c, chain), log, prober=prober
+        )
         estimate = estimate_trial(
             result,
             kind=trial.kind,

@@ -101,6 +101,9 @@ def _replay_joint(
         report["joint"] = None
         report["note"] = "the log has no joint-fit inputs (written before the joint fit)"
         return True
+    probe = next(log.of_kind("probe"), None)
+    if probe is not None:  # the estimator was told the misalignment probing measured
+        raw = {**raw, "misalignment": probe["misalignment"]}
     inputs = EstimatorInputs.from_dict(raw)
     rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
     fitted = fit_rows(rows, inputs, stack, section)

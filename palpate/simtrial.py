@@ -15,19 +15,13 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
 from config.scene import FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
-from estimation.compliance import ComplianceFit
-from estimation.jointfit import JointFit
-from estimation.southwell import SouthwellFit
-from estimation.stiffness import StiffnessEstimate
-from estimation.verdict import Verdict
+from palpate.simresult import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
 from palpate.simworld import (
     ServoJoints,
     TrialGeometry,
@@ -40,14 +34,19 @@ from palpate.simworld import (
 )
 from robot.drive import DriveController
 from robot.dynamixel.driver import DynamixelBus
-from robot.indentation import Observation, State, TrialMarks, TrialPlan
+from robot.indentation import Observation, State, TrialPlan
 from robot.rig import RigSettings, ServoFbgRig
-from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
-from robot.trial.inputs import belief_fields
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import end_record, estimate_record, header_common
-from robot.trial.run import TrialResult, run_trial
-from robot.trial.setup import detector_for, guards_for, rig_settings, sensor_section, trial_plan
+from robot.trial.run import run_trial
+from robot.trial.setup import (
+    detector_for,
+    guards_for,
+    prober_for,
+    rig_settings,
+    sensor_section,
+    trial_plan,
+)
 from sensor.reader import FrameReader, layout_from_config
 from sensor.strain import StrainChain
 from sim.board import BoardEmulator, BoardFaults
@@ -57,7 +56,6 @@ from sim.dynamixel.direct import direct_transport
 from sim.dynamixel.timing import BusTiming
 from sim.inprocess import FramePipe, InProcessPort, MemorySerial
 from sim.world import World
-from wire.dynamixel import TICKS_PER_REV
 
 # The simulated trial's public names; the spec, the geometry and the tissue are simworld's.
 __all__ = [
@@ -71,80 +69,6 @@ __all__ = [
 ]
 
 Transport = Literal["fast", "wire"]
-
-
-@dataclass
-class TrialOutcome:
-    spec: TrialSpec
-    state: str
-    reason: str
-    estimate: StiffnessEstimate | None
-    exposed_length_at_buckling: float | None
-    ik_residual: float
-    ticks: int
-    sim_time: float
-    log_path: str | None
-    series: dict[str, list[float]] = field(default_factory=dict)
-    marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
-    joint: JointFit | None = None  # the contact-point-free estimate (robot.trial.estimate)
-    joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
-    verdict: Verdict | None = None  # ok, suspect (reasons) or none (why)
-    southwell: SouthwellFit | None = None  # the beam's bow, fitted from the record
-    calibration: ComplianceFit | None = None  # on a rigid reference: the rig's compliance
-
-    @property
-    def status(self) -> str:
-        """The verdict's status ("none" without one)."""
-        return "none" if self.verdict is None else self.verdict.status
-
-    def modulus(self, method: str = "joint") -> float | None:
-        """E (Pa) by ``"joint"`` (the whole-record fit; None when its verdict is ``none``) or
-        ``"paper"`` (Eqs. 13-14)."""
-        if method == "joint":
-            if self.joint is None or self.status == "none":
-                return None
-            return self.joint.modulus
-        if method == "paper":
-            return None if self.estimate is None else self.estimate.modulus
-        raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
-
-    def as_dict(self) -> dict[str, Any]:
-        est = self.estimate
-        jf = self.joint
-
-        def kpa(v: float | None) -> float | None:
-            return None if v is None else v / 1e3
-
-        shown = jf if self.status != "none" else None
-        bow = self.southwell
-        return {
-            "trial": self.spec.trial_id,
-            "sample": self.spec.sample,
-            "tube": self.spec.tube,
-            "orientation": self.spec.orientation,
-            "exposed_length_mm": self.spec.exposed_length * 1e3,
-            "actual_kpa": self.spec.modulus / 1e3,
-            "reference_kpa": kpa(self.spec.reference),
-            "estimated_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
-            "delta_mm": None if est is None else est.delta * 1e3,
-            "force_n": None if est is None else est.force,
-            "joint_kpa": kpa(None if shown is None else shown.modulus),
-            "joint_ci_kpa": None if shown is None else [kpa(shown.ci_low), kpa(shown.ci_high)],
-            "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,
-            "joint_message": "no loading record" if jf is None else jf.message,
-            "verdict": self.status,
-            "verdict_reasons": [] if self.verdict is None else list(self.verdict.reasons),
-            "model_form": None if jf is None else jf.model_form,
-            "best_fit": None if jf is None else jf.best,
-            "w0_over_l": None if bow is None else bow.w0_over_l,
-            "calibration": None if self.calibration is None else self.calibration.as_dict(),
-            "warnings": [] if jf is None else list(jf.warnings),
-            "state": self.state,
-            "reason": self.reason,
-            "ik_residual_deg": math.degrees(self.ik_residual),
-            "sim_time_s": self.sim_time,
-            "log": self.log_path,
-        }
 
 
 class EmulatorHook(Protocol):
@@ -232,10 +156,11 @@ def run_sim_trial(
 ) -> TrialOutcome:
     """Run one simulated trial end to end and estimate the modulus from it."""
     c = scene.campaign
-    geo = trial_geometry(stack, spec)
+    geo = trial_geometry(stack, spec, trial_sample(scene, spec))
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
     stack = trial_stack(scene, stack, geo, retract)
     plan = trial_plan(c, stack, roll=geo.plan_roll, contact=geo.contact_translation, home=retract)
+    prober = prober_for(c, stack, stack.tube(geo.tube)) if spec.kind == "robot" else None
     clock = VirtualClock()
     servos = ServoJoints(stack)
     world = trial_world(spec, scene, stack, geo, servos)
@@ -257,13 +182,21 @@ def run_sim_trial(
             with _trial_log(log_dir, spec, scene, stack, plan, geo, hook) as log:
                 guards = guards_for(c, stack, rig.tick)
                 detector = detector_for(c, chain)
-                result = run_trial(rig, clock, plan, guards, detector, log, on_tick=on_tick)
-                estimate = _estimate(result, spec, scene, stack, geo)
+                prober = (
+                    prober_for(c, stack, stack.tube(geo.tube)) if spec.kind == "robot" else None
+                )
+                result = run_trial(
+                    rig, clock, plan, guards, detector, log, on_tick=on_tick, prober=prober
+                )
+                estimate = estimate_sim_trial(result, spec, scene, stack, geo)
                 if log is not None:
                     log.write(estimate_record(estimate))
                     log.write(end_record(result))
     log_path = None if log is None else str(log.path)
-    return _outcome(spec, geo, result, estimate, log_path, series)
+    outcome = outcome_of(spec, geo, result, estimate, log_path, series)
+    indentation = world.indentation
+    outcome.true_misalignment = None if indentation is None else indentation.misalignment
+    return outcome
 
 
 def bus_timing(fidelity: FidelityConfig, servos: ServoBusConfig) -> BusTiming | None:
@@ -328,51 +261,6 @@ def _trial_log(
         yield log
 
 
-def _estimate(
-    result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
-) -> TrialEstimate:
-    flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
-    inputs = _estimator_inputs(spec, scene, stack, geo)
-    return estimate_trial(
-        result,
-        kind=spec.kind,
-        exposed_length=spec.exposed_length,
-        flush_translation=flush,
-        stack=stack,
-        section=sensor_section(stack),
-        poisson=inputs.poisson,
-        inputs=inputs,
-    )
-
-
-def _outcome(
-    spec: TrialSpec,
-    geo: TrialGeometry,
-    result: TrialResult,
-    estimate: TrialEstimate,
-    log_path: str | None,
-    series: dict[str, list[float]],
-) -> TrialOutcome:
-    return TrialOutcome(
-        spec=spec,
-        state=result.state.value,
-        reason=result.reason,
-        estimate=estimate.paper,
-        exposed_length_at_buckling=estimate.exposed_length_at_buckling,
-        ik_residual=geo.residual,
-        ticks=result.ticks,
-        sim_time=result.duration,
-        log_path=log_path,
-        series=series,
-        marks=result.marks,
-        joint=estimate.joint,
-        joint_seconds=estimate.joint_seconds,
-        verdict=estimate.verdict,
-        southwell=estimate.southwell,
-        calibration=estimate.calibration,
-    )
-
-
 def _header(
     spec: TrialSpec,
     scene: SceneConfig,
@@ -381,7 +269,7 @@ def _header(
     geo: TrialGeometry,
 ) -> dict[str, Any]:
     tube = stack.tube(geo.tube) if spec.kind == "robot" else None
-    inputs = _estimator_inputs(spec, scene, stack, geo)
+    inputs = estimator_inputs(spec, scene, stack, geo)
     return {
         "trial": spec.trial_id,
         "source": "simulation",
@@ -389,32 +277,3 @@ def _header(
         "scene": scene.name,
         **header_common(plan, sensor_section(stack), stack.sensor, tube, inputs.poisson, inputs),
     }
-
-
-def _estimator_inputs(
-    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
-) -> EstimatorInputs:
-    """What the joint fit is told: the sample as the operator believes it (the scene's
-    ``assumed:``, else the sample's own values), the rig's calibrated compliance, the
-    campaign's limits; never the simulator's switches."""
-    sample = trial_sample(scene, spec)
-    c = scene.campaign
-    robot = spec.kind == "robot"
-    compliance, calibrated = stack.compliance(geo.tube if robot else None)
-    belief = belief_fields(
-        sample.assumed, thickness=sample.thickness, bonded=sample.bonded, poisson=sample.poisson
-    )
-    return EstimatorInputs(
-        kind=spec.kind,
-        exposed_length=spec.exposed_length,
-        flush_translation=stack.tube(geo.tube).flush_translation if robot else 0.0,
-        tip_radius=stack.sensor.tip_radius,
-        encoder_resolution=stack.drive.lead / TICKS_PER_REV,
-        misalignment=geo.residual,
-        compliance=compliance,
-        compliance_calibrated=calibrated,
-        misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
-        travel_window=c.max_travel_past_contact_mm * 1e-3,
-        rigid=sample.rigid,
-        **belief,
-    )

@@ -19,7 +19,8 @@ import numpy as np
 
 from config.sample import SampleConfig
 from config.scene import FidelityConfig, SceneConfig
-from config.schema import StackConfig
+from config.schema import StackConfig, TubeConfig
+from palpate.placement import place_sample
 from robot import kinematics
 from robot.drive import TRANSLATION, RollerGearDrive
 from robot.dynamixel.units import rad_from_ticks
@@ -27,6 +28,7 @@ from robot.trial.estimate import exposed_length_at
 from robot.trial.setup import sensor_section
 from sim.dynamixel.bus import EmulatedBus
 from sim.equilibrium import TissueLaw
+from sim.gravity import BeamWeight
 from sim.sample_law import describe, relaxation, world_tissue
 from sim.world import Surface, World
 from wire.dynamixel import TICKS_PER_REV
@@ -83,8 +85,12 @@ class TrialGeometry:
     tube: str
 
 
-def _robot_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
-    """Place the sample where the campaign wants it, then let the IK find the way back to it."""
+def _robot_geometry(
+    stack: StackConfig, spec: TrialSpec, sample: SampleConfig | None
+) -> TrialGeometry:
+    """Plan the trial where the campaign aims it (the IK on the surface the plan believes in:
+    facing the tube at the target), and place the sample there as the scene says
+    (:func:`palpate.placement.place_sample`: tilted, moved, curved)."""
     tube = stack.tube(spec.tube)
     nominal = kinematics.forward(tube, spec.roll, tube.flush_translation + spec.exposed_length)
     r_tip = stack.sensor.tip_radius
@@ -100,19 +106,35 @@ def _robot_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
     )
     if not ik.reachable:
         raise ValueError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
-    surface = Surface(point=target, normal=normal)
+    if sample is None:
+        surface = Surface(point=target, normal=normal)
+    else:
+        surface = place_sample(tube, spec.roll, (target, nominal.tangent), sample, spec.seed)
     return TrialGeometry(ik.roll, ik.advance, surface, ik.residual, ik.tube)
 
 
-def _bench_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
+def _bench_geometry(
+    stack: StackConfig, spec: TrialSpec, sample: SampleConfig | None
+) -> TrialGeometry:
+    """The vertical stage: the sample under it, tilted as the scene says (the stage cannot turn
+    to meet it: the tilt is the trial's misalignment)."""
     depth = BENCH_CONTACT_TRANSLATION + spec.exposed_length + stack.sensor.tip_radius
     surface = Surface(point=depth * VERTICAL, normal=-VERTICAL)
+    if sample is not None and (sample.tilt != 0.0 or sample.curvature_radius is not None):
+        stage = TubeConfig(name="bench-stage")  # a straight "tube": azimuth from -y
+        nominal = (surface.point, VERTICAL)
+        surface = place_sample(stage, -math.pi / 2, nominal, sample, spec.seed)
     return TrialGeometry(0.0, BENCH_CONTACT_TRANSLATION, surface, 0.0, "bench-stage")
 
 
-def trial_geometry(stack: StackConfig, spec: TrialSpec) -> TrialGeometry:
-    """Where the sample is and how the robot reaches it; ValueError if it cannot."""
-    return _bench_geometry(stack, spec) if spec.kind == "bench" else _robot_geometry(stack, spec)
+def trial_geometry(
+    stack: StackConfig, spec: TrialSpec, sample: SampleConfig | None = None
+) -> TrialGeometry:
+    """Where the sample is and how the robot reaches it; ValueError if it cannot. ``sample``:
+    the scene's, for its pose (None: the plan's surface, facing the tube at the target)."""
+    if spec.kind == "bench":
+        return _bench_geometry(stack, spec, sample)
+    return _robot_geometry(stack, spec, sample)
 
 
 def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
@@ -188,6 +210,8 @@ def trial_world(
 ) -> World:
     """The simulated world of one trial: the scene's sample at the trial's surface, seeded."""
     sample = trial_sample(scene, spec)
+    sensor = stack.sensor
+    weight = BeamWeight.of(sensor.tip_mass, sensor.linear_mass) if scene.fidelity.gravity else None
     return World(
         section=sensor_section(stack),
         sensor=stack.sensor,
@@ -202,4 +226,7 @@ def trial_world(
         length_grows=spec.kind == "robot",
         encoder_step=stack.drive.lead / TICKS_PER_REV,
         relaxation=relaxation(sample, scene.fidelity),
+        friction=sample.friction,
+        poisson=sample.poisson,
+        weight=weight,
     )

@@ -10,6 +10,12 @@ States and the normal path::
     IDLE -> HOMING -> POSITIONING -> APPROACH -> CONTACT -> INDENTING -> BUCKLED
          -> RETRACTING -> DONE
 
+With a ``prober`` (``robot.probing``) the first arrival at the stand-off goes to PROBING
+instead: light touches around the plan, a fitted surface, and the pose orthogonal to it, which
+replaces the plan's roll and contact advance (POSITIONING again, the strain zero taken again at
+the new roll, then APPROACH). Where no pose is within the tolerances the machine retracts and
+ends in UNREACHABLE before it indents: the trial's verdict, not a fault of the hardware.
+
 FAULT (a guard tripped: retract, then stop) and ABORTED (operator stop) are reachable from every
 state. A fault always ends with the stage retracted to the home advance when the drive still
 answers; the trial record is closed with the reason.
@@ -17,18 +23,24 @@ answers; the trial record is closed with the reason.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Protocol
 
 from estimation.detect_buckling import BucklingDetector
+
+if TYPE_CHECKING:  # types only: robot.probing imports this module
+    from robot.probing import ProbeResult
 
 
 class State(enum.Enum):
     IDLE = "idle"
     HOMING = "homing"
     POSITIONING = "positioning"
+    PROBING = "probing"
     APPROACH = "approach"
     CONTACT = "contact"
     INDENTING = "indenting"
@@ -37,9 +49,12 @@ class State(enum.Enum):
     DONE = "done"
     FAULT = "fault"
     ABORTED = "aborted"
+    UNREACHABLE = "unreachable"
 
 
-TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED})
+TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})
+PLANNED_ENDS = frozenset({State.DONE, State.UNREACHABLE})  # torque stays on: nothing went wrong
+REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 
 
 @dataclass(frozen=True)
@@ -69,6 +84,7 @@ class Guards:
     state_timeout: float = 60.0  # s in any one state
     early_contact_margin: float = 0.5e-3  # contact this much before the plan is "unexpected"
     bus_grace: float = 0.5  # s of lost servo replies tolerated while retracting (goals still go)
+    max_twist: float | None = None  # rad, inner vs outer roller gear; None: not watched
 
 
 @dataclass(frozen=True)
@@ -82,6 +98,7 @@ class Observation:
     servo_fault: str | None = None  # a fault the servo bus reported, if any
     bus_lost: bool = False  # servo_fault is a transport failure (no or garbled replies)
     abort: bool = False  # the operator pressed stop
+    twist: float = 0.0  # rad, inner roller gear's roll minus the outer's (the sensor's twist)
 
 
 @dataclass(frozen=True)
@@ -90,6 +107,14 @@ class Command:
     roll: float  # goal, rad
     speed: float  # m/s for the advance
     torque: bool = True
+    rezero: bool = False  # take the strain zero again on the frames of the last ticks at rest
+
+
+class Prober(Protocol):
+    """The probing step (``robot.probing.ProbeRoutine``): each tick a command, then its result
+    (or a ``str``: why it failed)."""
+
+    def step(self, obs: Observation) -> Command | ProbeResult | str: ...
 
 
 @dataclass(frozen=True)
@@ -112,6 +137,11 @@ def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -
     peak = max((abs(s) for s in obs.strains), default=0.0)
     if peak > guards.strain_limit:
         return f"fiber strain {peak * 1e6:.0f} ue over the limit {guards.strain_limit * 1e6:.0f} ue"
+    if guards.max_twist is not None and abs(obs.twist) > guards.max_twist:
+        return (
+            f"sensor twist {math.degrees(obs.twist):.2f} deg (inner vs outer roller gear) over "
+            f"the {math.degrees(guards.max_twist):.2f} deg bound"
+        )
     if x_contact is not None:
         past = obs.advance - x_contact
         if past > guards.max_travel_past_contact:
@@ -139,8 +169,12 @@ class IndentationMachine:
     guards: Guards
     detector: BucklingDetector
     on_transition: Callable[[Transition], None] = lambda tr: None
+    prober: Callable[[TrialPlan], Prober] | None = None  # builds the probing step from the plan
     state: State = State.IDLE
     marks: TrialMarks = field(default_factory=TrialMarks)
+    probe: ProbeResult | None = None  # what probing found, once it has
+    _probing: Prober | None = None
+    _settle: int = -1  # ticks at rest so far before the re-zero; -1: none pending
     _entered: float = 0.0
     _last_command: Command | None = None
     _first_touch: float | None = None  # advance at the first contact event, planned or not
@@ -203,6 +237,7 @@ class IndentationMachine:
             self._fault(obs, f"timeout in {self.state.value} after {self.guards.state_timeout:g} s")
             return
         in_contact_phase = self.state in (
+            State.PROBING,
             State.APPROACH,
             State.CONTACT,
             State.INDENTING,
@@ -258,6 +293,15 @@ class IndentationMachine:
         target = p.contact_advance - p.standoff
         at_roll = abs(obs.roll - p.roll) <= p.roll_tolerance
         if at_roll and abs(obs.advance - target) <= p.position_tolerance:
+            if self.prober is not None and self.probe is None:
+                self._probing = self.prober(p)
+                self._go(State.PROBING, obs.t, "at stand-off: probing", obs.advance, obs.strains)
+                return self._probe_step(obs)
+            if self._settle >= 0:  # re-zero the strains at the new roll, at rest
+                self._settle += 1
+                rezero = self._settle > REZERO_SETTLE_TICKS
+                self._settle = -1 if rezero else self._settle
+                return Command(target, p.roll, 0.0, rezero=rezero)
             self._go(State.APPROACH, obs.t, "at stand-off", obs.advance, obs.strains)
             return Command(target, p.roll, p.approach_speed)
         # Roll first with the sensor back, then advance: never sweep the tip sideways near tissue.
@@ -281,6 +325,26 @@ class IndentationMachine:
             )
             return self._hold(obs)
         return Command(limit, p.roll, p.approach_speed)
+
+    def _probe_step(self, obs: Observation) -> Command:
+        assert self._probing is not None  # set on entering PROBING
+        out = self._probing.step(obs)
+        if isinstance(out, Command):
+            return out
+        if isinstance(out, str):
+            self._fault(obs, out)
+            return self._hold(obs)
+        self.probe = out
+        self.plan = dataclasses.replace(
+            self.plan, roll=out.roll, contact_advance=out.contact_advance
+        )
+        if not out.reachable:
+            self.marks.reason = f"unreachable: {out.reason}"
+            self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
+            return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
+        self._settle = 0
+        self._go(State.POSITIONING, obs.t, f"probed: {out.reason}", obs.advance, obs.strains)
+        return self._positioning(obs)
 
     def _contact(self, obs: Observation) -> Command:
         self.detector.reset()
@@ -325,6 +389,8 @@ class IndentationMachine:
         if abs(obs.advance - goal) <= p.position_tolerance:
             if self.marks.reason.startswith("aborted"):
                 target = State.ABORTED
+            elif self.marks.reason.startswith("unreachable"):
+                target = State.UNREACHABLE
             elif self.marks.reason == "completed":
                 target = State.DONE
             else:
@@ -334,12 +400,13 @@ class IndentationMachine:
         return Command(goal, obs.roll, p.fast_speed)
 
     def _terminal(self, obs: Observation) -> Command:
-        return Command(obs.advance, obs.roll, 0.0, torque=self.state is State.DONE)
+        return Command(obs.advance, obs.roll, 0.0, torque=self.state in PLANNED_ENDS)
 
 
 _HANDLERS: dict[State, Callable[[IndentationMachine, Observation], Command]] = {
     State.HOMING: IndentationMachine._homing,
     State.POSITIONING: IndentationMachine._positioning,
+    State.PROBING: IndentationMachine._probe_step,
     State.APPROACH: IndentationMachine._approach,
     State.CONTACT: IndentationMachine._contact,
     State.INDENTING: IndentationMachine._indenting,
@@ -348,4 +415,5 @@ _HANDLERS: dict[State, Callable[[IndentationMachine, Observation], Command]] = {
     State.DONE: IndentationMachine._terminal,
     State.FAULT: IndentationMachine._terminal,
     State.ABORTED: IndentationMachine._terminal,
+    State.UNREACHABLE: IndentationMachine._terminal,
 }

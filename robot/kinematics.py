@@ -24,6 +24,7 @@ tangent to the surface plane through the target: n . (tip + L t - p) = R.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ import transforms3d
 from numpy.typing import NDArray
 
 from config.schema import TubeConfig
+from estimation.surface import SurfaceGeometry
 
 Vector = NDArray[np.float64]
 
@@ -43,6 +45,8 @@ REASONS: Final[dict[int, str]] = {
     2: "the surface is closer to the tube tip than the tip sphere allows (exposed length < 0)",
     3: "the advance needed is outside the translation limits",
     4: "no roll within the roll limits gives the best alignment",
+    5: "no roll of this tube meets the surface within the angle tolerance",
+    6: "the orthogonal contact misses the target by more than the position tolerance",
 }
 
 
@@ -142,6 +146,15 @@ def best_roll(tube: TubeConfig, normal: Vector) -> tuple[float, float]:
     return roll, math.acos(max(-1.0, min(1.0, cos_res)))
 
 
+def apex(tube: TubeConfig) -> Vector | None:
+    """The point (3,) of the x axis every tip tangent line of a bent tube passes through, at any
+    roll (None for a straight tube, whose only line is the x axis itself)."""
+    if tube.tip_angle == 0.0:
+        return None
+    p0, t0 = tube_tip_in_bend_plane(tube)
+    return np.asarray(p0 - (p0[2] / t0[2]) * t0)
+
+
 def solve_for_tube(
     tube: TubeConfig,
     target: Vector,
@@ -150,20 +163,48 @@ def solve_for_tube(
     tip_radius: float,
     translation_limits: tuple[float, float],
     roll_limits: tuple[float, float] = (-math.pi, math.pi),
+    radius: float | None = None,
+    max_residual: float | None = None,
+    max_miss: float | None = None,
 ) -> IKSolution:
     """IK with a given tube: best roll, then the advance where the tip sphere touches the plane
-    through ``target`` (3,) with outward unit ``normal`` (3,)."""
+    through ``target`` (3,) with outward unit ``normal`` (3,) there, or the convex sphere of
+    ``radius`` (m) through it. ``max_residual`` (rad) and ``max_miss`` (m), when given, are
+    part of reachability (statuses 5 and 6)."""
     if not tip_radius >= 0:
         raise ValueError(f"tip_radius must be >= 0, got {tip_radius}")
     p = np.asarray(target, dtype=float)
     n = _unit(normal)
-    roll, residual = best_roll(tube, n)
-    status = 0
-    fitted = _fit_roll(roll, roll_limits)
-    if fitted is None:
-        status = 4
+    if radius is None:
+        sol = _on_plane(tube, p, n, tip_radius, roll_limits)
     else:
-        roll = fitted
+        sol = _on_sphere(tube, SurfaceGeometry.make(p, n, radius), tip_radius, roll_limits)
+    status = sol.status
+    if status == 0 and sol.exposed_length < 0:
+        status = 2
+    lo, hi = translation_limits
+    if status == 0 and not lo <= sol.advance <= hi:
+        status = 3
+    if status == 0 and max_residual is not None and sol.residual > max_residual:
+        status = 5
+    if status == 0 and max_miss is not None and sol.miss > max_miss:
+        status = 6
+    return dataclasses.replace(sol, status=status)
+
+
+def _roll_for(
+    tube: TubeConfig, n: Vector, roll_limits: tuple[float, float]
+) -> tuple[float, float, int]:
+    """(roll, residual, status 0 or 4) of the best roll for the outward normal ``n``."""
+    roll, residual = best_roll(tube, n)
+    fitted = _fit_roll(roll, roll_limits)
+    return (roll, residual, 4) if fitted is None else (fitted, residual, 0)
+
+
+def _on_plane(
+    tube: TubeConfig, p: Vector, n: Vector, tip_radius: float, roll_limits: tuple[float, float]
+) -> IKSolution:
+    roll, residual, status = _roll_for(tube, n, roll_limits)
     pose = forward(tube, roll, tube.flush_translation)
     approach = float(n @ pose.tangent)  # = -cos(residual)
     if approach > -1e-12:
@@ -172,12 +213,31 @@ def solve_for_tube(
     advance = tube.flush_translation + exposed
     centre = pose.tube_tip + exposed * pose.tangent
     contact = centre - tip_radius * n
-    if status == 0 and exposed < 0:
-        status = 2
-    lo, hi = translation_limits
-    if status == 0 and not lo <= advance <= hi:
-        status = 3
     miss = float(np.linalg.norm(contact - p))
+    return IKSolution(tube.name, roll, advance, exposed, residual, status, contact, miss)
+
+
+def _on_sphere(
+    tube: TubeConfig, surface: SurfaceGeometry, tip_radius: float, roll_limits: tuple[float, float]
+) -> IKSolution:
+    """The roll whose line passes nearest the sphere's centre (through the cone's apex), then
+    where the tip sphere meets it and the angle to the normal there."""
+    centre_of_sphere = surface.centre
+    x = apex(tube)
+    towards = surface.normal if x is None else _unit(x - centre_of_sphere)
+    roll, _, status = _roll_for(tube, towards, roll_limits)
+    pose = forward(tube, roll, tube.flush_translation)
+    exposed = surface.offset(tip_radius).ray_hit(pose.tube_tip, pose.tangent)
+    if not math.isfinite(exposed):
+        return IKSolution(
+            tube.name, roll, math.nan, math.nan, math.pi / 2, 1, surface.point, math.inf
+        )
+    centre = pose.tube_tip + exposed * pose.tangent
+    n_local = surface.normal_at(centre)
+    residual = math.acos(max(-1.0, min(1.0, -float(n_local @ pose.tangent))))
+    contact = centre - tip_radius * n_local
+    miss = float(np.linalg.norm(contact - surface.point))
+    advance = tube.flush_translation + exposed
     return IKSolution(tube.name, roll, advance, exposed, residual, status, contact, miss)
 
 
@@ -189,11 +249,15 @@ def inverse(
     tip_radius: float,
     translation_limits: tuple[float, float],
     roll_limits: tuple[float, float] = (-math.pi, math.pi),
+    radius: float | None = None,
+    max_residual: float | None = None,
+    max_miss: float | None = None,
 ) -> IKSolution:
     """Choose the tube and roll whose tangent is best anti-parallel to ``normal``.
 
     The smallest residual among reachable solutions wins (ties: the tube listed first); when
-    none is reachable, the smallest-residual solution is returned with its status.
+    none is reachable, the smallest-residual solution is returned with its status. ``radius``,
+    ``max_residual`` and ``max_miss`` as in :func:`solve_for_tube`.
     """
     if not tubes:
         raise ValueError("inverse kinematics needs at least one tube")
@@ -205,6 +269,9 @@ def inverse(
             tip_radius=tip_radius,
             translation_limits=translation_limits,
             roll_limits=roll_limits,
+            radius=radius,
+            max_residual=max_residual,
+            max_miss=max_miss,
         )
         for t in tubes
     ]

@@ -32,6 +32,7 @@ from sensor.strain import StrainChain
 from wire.frame import Frame, Status
 
 ContactMode = Literal["event", "fbg"]
+REZERO_FRAMES = 8  # frames a zero taken again during a trial averages
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,7 @@ class ServoFbgRig:
         self._joints: JointState | None = None
         self._frame: Frame | None = None
         self._frame_t = -math.inf
+        self._twist = 0.0
         self.frames: list[Frame] = []  # every frame received, for the trial log and plots
 
     @property
@@ -87,6 +89,10 @@ class ServoFbgRig:
             frames += self._receive()
             if len(frames) >= samples:
                 break
+        return self._zero_on(frames)
+
+    def _zero_on(self, frames: list[Frame]) -> StrainChain:
+        """The chain zeroed on ``frames`` (taken at rest, the sensor free)."""
         if not frames:
             raise SensorPortError(f"board port {self.reader.port_name!r}: no frames to zero on")
         wl = np.stack([f.wavelengths for f in frames])
@@ -101,8 +107,9 @@ class ServoFbgRig:
         fault: str | None = None
         lost = False
         try:
-            joints, _ = self.drive.read()
+            joints, motors = self.drive.read()
             self._joints = joints
+            self._twist = self.drive.drive.twist({n: m.position for n, m in motors.items()})
         except ServoFaultError as exc:
             fault = str(exc)
         except ServoTransportError as exc:
@@ -137,9 +144,13 @@ class ServoFbgRig:
             stream_age=t - self._frame_t,
             servo_fault=fault,
             bus_lost=lost,
+            twist=self._twist,
         )
 
     def command(self, cmd: Command) -> None:
+        if cmd.rezero and self.frames:
+            # the machine held still for these ticks: the newest frames are all at rest
+            self.chain = self._zero_on(self.frames[-REZERO_FRAMES:])
         if self._joints is None:
             return
         if not cmd.torque:

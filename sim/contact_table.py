@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from estimation.beam import Beam
 from estimation.elastica import post_buckling
 from sim.equilibrium import ContactEffects, TissueLaw, solve_contact
+from sim.oblique import ObliqueContact, slip_law, slip_strains
 
 Vector = NDArray[np.float64]
 
@@ -61,6 +62,7 @@ class GridPhysics(NamedTuple):
     centres_from_tip: tuple[float, ...]
     tissue: TissueLaw
     effects: ContactEffects
+    bending_sign: float = 1.0  # -1: the beam buckles toward the other side (a pre-bend's)
 
 
 @functools.lru_cache(maxsize=256, typed=True)
@@ -74,13 +76,27 @@ def equilibrium_on_grid(
     again whenever a trial repeats a sample, tube length and contact geometry (the robot
     campaign's straight and bent tubes meet the tissue at the same exposed length to the last
     bit), which saves its ~5 ms per call. Raises RuntimeError naming the failure if the contact
-    solver does not converge."""
+    solver does not converge.
+
+    A slipping oblique contact (:mod:`sim.oblique`) replaces the pinned beam by the clamped-free
+    beam-column its lateral load makes of it, strains included."""
     beam = Beam(physics.EI, physics.EA, physics.fiber_offset, length)
-    sol = solve_contact(np.asarray(u, dtype=np.float64), beam, physics.tissue, physics.effects)
+    tissue = physics.tissue
+    oblique = tissue if isinstance(tissue, ObliqueContact) else None
+    slip = None if oblique is None else slip_law(oblique, beam.EI, beam.EA, length)
+    uu = np.asarray(u, dtype=np.float64)
+    sol = solve_contact(uu, beam if slip is None else slip, tissue, physics.effects)
     if not sol.success:
         raise RuntimeError(f"contact equilibrium failed at L = {length:.6g} m: {sol.message}")
     R = np.abs(sol.R)
-    out = (sol.delta, sol.e, sol.P, R, grating_strains(physics, beam, sol.P, R))
+    if slip is not None and oblique is not None:
+        half = 0.5 * physics.grating_length
+        from_tip = np.asarray(physics.centres_from_tip)[:, None] + np.array([-half, half])
+        bend = slip_strains(oblique, sol.P, beam.EI, physics.fiber_offset, length, from_tip)
+        eps = bend - (sol.P / physics.EA)[:, None]
+    else:
+        eps = grating_strains(physics, beam, sol.P, R)
+    out = (sol.delta, sol.e, sol.P, R, eps)
     for a in out:
         a.flags.writeable = False  # shared by every caller of the cache
     return out
@@ -96,7 +112,10 @@ def grating_strains(
     half = 0.5 * physics.grating_length
     centres = beam.length - np.asarray(physics.centres_from_tip)
     intervals = np.stack([centres - half, np.minimum(centres + half, beam.length)], axis=-1)
-    return beam.bending_strains(g, intervals) - (P / physics.EA)[:, None]
+    bend = beam.bending_strains(g, intervals)
+    if physics.bending_sign < 0:  # the beam buckles toward the other side (a pre-bend's)
+        bend = -bend
+    return bend - (P / physics.EA)[:, None]
 
 
 def _lerp(a: list[float], b: list[float], w: float) -> list[float]:

@@ -3,15 +3,22 @@
 Each board sample asks the world for its state at time ``t``. The world reads the servos' present
 positions (through injected callables, so ``sim/`` never imports the control code), places the
 sensor with the injected forward kinematics, and solves the quasi-static contact along the sensor
-axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.sample_law`: the
-sample's finite-element table, or the closed forms where a scene picks them), tabulated along
-the trial's path (:mod:`sim.contact_table`, which also turns the beam state into grating
-strains); a viscoelastic sample is instead stepped on the clock (:mod:`sim.contact_history`).
-From the beam state it makes what the hardware would send: peak wavelengths (Eq. 1 with Eq. 3
-and Eq. 12, plus noise and temperature drift), the force scale reading and the contact event.
-Gratings still inside the tube read 0.
+axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.tissue`), which is not the
+estimator's Hertz model, tabulated along the trial's path (:mod:`sim.contact_table`, which
+also turns the beam state into grating strains). From the beam state it makes what the hardware
+would send: peak wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and temperature drift),
+the force scale reading and the contact event. Gratings still inside the tube read 0.
 
-Only what the scene switches on is computed (:class:`config.scene.FidelityConfig`).
+Only what the scene switches on is computed (:class:`config.scene.FidelityConfig`). The tissue's
+force law is the sample's own (:mod:`sim.sample_law`: its finite-element table, or the closed
+forms where a scene picks them); a viscoelastic sample's contact is stepped on the clock
+(:mod:`sim.contact_history`) instead of tabulated.
+
+The surface is a plane or a convex sphere (:class:`Surface`). Each roll the sensor touches the
+tissue at has its own contact (a probing robot touches at several): its own table, solved with
+the tissue law as the sensor axis sees it at that contact (:mod:`sim.oblique`: the angle to the
+local normal, the sample's friction, the surface's curvature) and, with ``gravity``, the beam's
+pre-bend from its own weight (:mod:`sim.gravity`). :attr:`World.contacts` keeps what each was.
 """
 
 from __future__ import annotations
@@ -26,10 +33,13 @@ import numpy as np
 from config.scene import FidelityConfig
 from config.schema import FbgConfig, SensorConfig
 from estimation.section import Section
+from estimation.surface import SurfaceGeometry
 from sim.board import BoardSample
 from sim.contact_history import ViscoelasticContact
 from sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
 from sim.equilibrium import ContactEffects, TissueLaw
+from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
+from sim.oblique import ObliqueContact
 from sim.viscoelastic import StandardLinearSolid
 from wire.frame import Status
 
@@ -42,12 +52,39 @@ _CONTACT_FLAG = int(Status.CONTACT_EVENT)  # int() of an IntFlag costs ~0.3 us p
 _FORCE_FLAG = int(Status.FORCE_VALID)
 
 
+ALIGNED = 1e-6  # rad: a misalignment below this is the aligned contact, bit for bit
+
+
 @dataclass(frozen=True)
 class Surface:
-    """The tissue's surface plane: a point on it and its outward unit normal (base frame, m)."""
+    """The tissue's surface: a point on it and its outward unit normal there (base frame, m);
+    ``radius`` (m) makes it a convex sphere through the point, None a plane."""
 
     point: Vector
     normal: Vector
+    radius: float | None = None
+
+
+@dataclass(frozen=True)
+class Contact:
+    """One contact of a trial: the roll it was made at, the angle between the sensor axis and
+    the inward normal where the tip first touched (rad), whether the friction held the tip, and
+    the pre-bend imperfection the beam carried (w0, m, signed: negative buckles the other way)."""
+
+    roll: float
+    misalignment: float
+    sticks: bool
+    imperfection: float
+
+
+class _ContactGrid(NamedTuple):
+    """The grid solver of one contact's physics (a :class:`sim.contact_table.GridSolver`)."""
+
+    physics: GridPhysics
+
+    def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
+        grid = tuple(np.asarray(u, dtype=np.float64).tolist())
+        return equilibrium_on_grid(self.physics, grid, length)
 
 
 class WorldState(NamedTuple):
@@ -97,13 +134,18 @@ class World:
         has_force: bool = True,
         length_grows: bool = True,
         encoder_step: float | None = None,
+        friction: float = 0.5,
+        poisson: float = 0.45,
+        weight: BeamWeight | None = None,
         relaxation: StandardLinearSolid | None = None,
     ) -> None:
         """``encoder_step``: the stage advance per encoder count (m). The stage stops only on
         whole counts, so every sample in contact lies on that lattice; the contact table is
         then solved on it and needs no interpolation in the advance (None: a 5 um grid).
-        ``relaxation``: the tissue is viscoelastic (``tissue`` is its instantaneous law), so
-        the contact is stepped at every sample instead of tabulated."""
+        ``friction`` and ``poisson``: the sample's, for oblique contacts; ``weight``: the
+        sensor's weight when the scene models gravity (None: it does not). ``relaxation``: the
+        tissue is viscoelastic (``tissue`` is its instantaneous law), so each contact is stepped
+        at every sample instead of tabulated."""
         self.section = section
         self.sensor = sensor
         self.fbg = fbg
@@ -133,11 +175,19 @@ class World:
         self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
         self.encoder_step = encoder_step
-        self._table: ContactTable | None = None
-        self._history = (
-            None if relaxation is None else ViscoelasticContact(self._grid(), relaxation)
-        )
+        self.friction = friction
+        self.poisson = poisson
+        self.weight = weight
+        half = 0.5 * sensor.grating_length
+        self._from_tip = np.asarray(self._centres)[:, None] + np.array([-half, half])
+        self._tables: dict[float, ContactTable] = {}
+        self.relaxation = relaxation
+        self._histories: dict[float, ViscoelasticContact] = {}
         self._now = 0.0  # the time of the sample being computed
+        self._contact_at: dict[float, Contact] = {}
+        self.contacts: list[Contact] = []
+        self.indentation: Contact | None = None  # the contact that went deepest
+        self._deepest = 0.0
         self._surface = surface
         self._joints: tuple[float, float, int] | None = None  # the reading _physics belongs to
         self._physics: _Physics = (0.0, -math.inf, 0.0, 0.0, 0.0, 0.0, self._free)
@@ -155,7 +205,7 @@ class World:
     # -- physics ------------------------------------------------------------------------------
     def state(self, t: float) -> WorldState:
         joints = self.joints()
-        if joints != self._joints or self._history is not None:  # a history moves with time
+        if joints != self._joints or self.relaxation is not None:  # a history moves with time
             self._now = t
             self._physics = self._physics_at(joints[0], joints[1])
             self._joints = joints
@@ -168,23 +218,120 @@ class World:
 
     def _physics_at(self, roll: float, translation: float) -> _Physics:
         tip, tangent, length = self.pose(roll, translation)
-        n = self._surface.normal
-        cos_a = -float(tangent @ n)  # 1 when the sensor points straight into the surface
-        centre_height = float((tip - self._surface.point) @ n) - length * cos_a
-        past = (self._tip_radius - centre_height) / cos_a if cos_a > 0.05 else -math.inf
-        strains = self._free
+        past, normal = self._past(tip, tangent, length)
+        strains = self._free if self.weight is None else self._sag(roll, tangent, length)
         delta = e = P = R = 0.0
-        if past > 0.0 and length > 0.0 and self._history is not None:
-            delta, e, P, R, strains = self._history.at(self._now, past, length)
-        elif past > 0.0 and length > 0.0:
-            if self._table is None:
-                self._table = ContactTable(
-                    self, length - past, self.length_grows, lattice=self._lattice(past)
-                )
-            delta, e, P, R, strains = self._table.at(past)
-        elif self._history is not None:
-            self._history.release(self._now)
+        if past > 0.0 and length > 0.0:
+            table = self._tables.get(roll)
+            if table is None:
+                table = self._new_table(roll, tangent, length, past, normal)
+            if self.relaxation is None:
+                delta, e, P, R, bent = table.at(past)
+            else:
+                delta, e, P, R, bent = self._histories[roll].at(self._now, past, length)
+            if past > self._deepest:
+                self._deepest = past
+                self.indentation = self._contact_at[roll]
+            strains = (
+                bent
+                if self.weight is None
+                else tuple(a + b for a, b in zip(strains, bent, strict=True))
+            )
+        else:
+            for history in self._histories.values():  # the surface recovers while the tip is away
+                history.release(self._now)
         return length, past, delta, e, P, R, strains
+
+    def _past(self, tip: Vector, tangent: Vector, length: float) -> tuple[float, Vector]:
+        """How far (m) the tip sphere's centre is past first touch along the axis (-inf when
+        the axis does not meet the surface within 87 deg), and the outward normal where the
+        tip first touches."""
+        n = self._surface.normal
+        if self._surface.radius is None:
+            cos_a = -float(tangent @ n)  # 1 when the sensor points straight into the surface
+            centre_height = float((tip - self._surface.point) @ n) - length * cos_a
+            past = (self._tip_radius - centre_height) / cos_a if cos_a > 0.05 else -math.inf
+            return past, n
+        s = self._surface
+        offset = SurfaceGeometry(s.point, n, s.radius).offset(self._tip_radius)
+        centre = tip + length * tangent
+        ahead = offset.ray_hit(centre, tangent)
+        if not math.isfinite(ahead):
+            return -math.inf, n
+        local = offset.normal_at(centre + ahead * tangent)
+        return (-ahead if -float(tangent @ local) > 0.05 else -math.inf), local
+
+    def _sag(self, roll: float, tangent: Vector, length: float) -> tuple[float, ...]:
+        """The free beam's strains under its own weight (gravity on)."""
+        assert self.weight is not None
+        across = self.weight.across(sensing_axis(tangent, roll))
+        sec = self.section
+        return across.sag_strains(sec.EI, sec.fiber_offset, length, self._from_tip)
+
+    def _new_table(
+        self, roll: float, tangent: Vector, length: float, past: float, normal: Vector
+    ) -> ContactTable:
+        """The contact table of a first touch at ``roll``: the tissue as this axis sees it."""
+        cos_a = min(1.0, -float(tangent @ normal))
+        psi = math.acos(cos_a)
+        curvature = 1.0
+        if self._surface.radius is not None:
+            curvature = math.sqrt(self._surface.radius / (self._surface.radius + self._tip_radius))
+        contact_length = length - past
+        tissue: TissueLaw = self.tissue
+        if psi > ALIGNED or curvature != 1.0:
+            tissue = ObliqueContact(
+                self.tissue,
+                psi,
+                self.friction,
+                self.poisson,
+                curvature,
+                self._slip_share(roll, tangent, normal, psi),
+            )
+        effects, sign, w0 = self._pre_bend(roll, tangent, contact_length)
+        sec = self.section
+        physics = GridPhysics(
+            sec.EI,
+            sec.EA,
+            sec.fiber_offset,
+            self.sensor.grating_length,
+            self._centres,
+            tissue,
+            effects,
+            sign,
+        )
+        table = ContactTable(
+            _ContactGrid(physics), contact_length, self.length_grows, lattice=self._lattice(past)
+        )
+        self._tables[roll] = table
+        if self.relaxation is not None:
+            self._histories[roll] = ViscoelasticContact(physics, self.relaxation)
+        sticks = not isinstance(tissue, ObliqueContact) or tissue.sticks
+        self.contacts.append(Contact(roll, psi, sticks, w0))
+        self._contact_at[roll] = self.contacts[-1]
+        return table
+
+    def _slip_share(self, roll: float, tangent: Vector, normal: Vector, psi: float) -> float:
+        """cos of the angle between a slip's lateral load (b = sin psi n + cos psi m) and the
+        fiber's bending plane."""
+        if psi <= ALIGNED:
+            return 0.0
+        along = (tangent + math.cos(psi) * normal) / math.sin(psi)  # m, the way t leans
+        lateral = math.sin(psi) * normal + math.cos(psi) * along
+        return float(lateral @ sensing_axis(tangent, roll))
+
+    def _pre_bend(
+        self, roll: float, tangent: Vector, length: float
+    ) -> tuple[ContactEffects, float, float]:
+        """(effects, bending sign, signed imperfection w0 m) of a contact: the scene's
+        imperfection, plus the first-mode equivalent of the weight's pin offset (gravity on)."""
+        w0 = self.fidelity.imperfection_w0_over_l * length
+        if self.weight is None:
+            return self.effects, 1.0, w0
+        across = self.weight.across(sensing_axis(tangent, roll))
+        w0 += offset_to_mode() * across.pin_offset(self.section.EI, length)
+        effects = ContactEffects(self.effects.tube_stiffness, abs(w0) / length)
+        return effects, (1.0 if w0 >= 0 else -1.0), w0
 
     def _lattice(self, past: float) -> tuple[float, float] | None:
         """(step, origin) of the encoder lattice in the advance past contact, from the first
@@ -196,11 +343,7 @@ class World:
     def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
         """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R|, strains
         (M, G) (see :func:`equilibrium_on_grid`, which caches it)."""
-        grid = tuple(np.asarray(u, dtype=np.float64).tolist())
-        return equilibrium_on_grid(self._grid(), grid, length)
-
-    def _grid(self) -> GridPhysics:
-        return GridPhysics(
+        physics = GridPhysics(
             self.section.EI,
             self.section.EA,
             self.section.fiber_offset,
@@ -209,6 +352,7 @@ class World:
             self.tissue,
             self.effects,
         )
+        return equilibrium_on_grid(physics, tuple(np.asarray(u, dtype=np.float64).tolist()), length)
 
     # -- what the board sends ----------------------------------------------------------------
     def sample(self, t: float) -> BoardSample:

@@ -15,15 +15,18 @@ from typing import Any, Protocol
 
 from estimation.detect_buckling import BucklingDetector
 from robot.indentation import (
+    PLANNED_ENDS,
     Command,
     Guards,
     IndentationMachine,
     Observation,
+    Prober,
     State,
     Transition,
     TrialMarks,
     TrialPlan,
 )
+from robot.probing import ProbeResult
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import end_record
 from sensor.clock import Clock
@@ -66,10 +69,18 @@ class TrialResult:
     # (state after the tick, advance m, strains) per tick, as in the log's sample records: the
     # whole-record estimators (``robot.trial.estimate``) read it without a log
     record: list[tuple[str, float, tuple[float, ...]]] = field(default_factory=list)
+    probe: ProbeResult | None = None  # what probing found, when the trial probed
 
     @property
     def ok(self) -> bool:
         return self.state is State.DONE
+
+    @property
+    def probing_time(self) -> float:
+        """Seconds spent probing (0 without), from the transitions."""
+        start = next((t.t for t in self.transitions if t.target is State.PROBING), None)
+        end = next((t.t for t in self.transitions if t.source is State.PROBING), None)
+        return 0.0 if start is None or end is None else end - start
 
 
 def run_trial(
@@ -82,11 +93,14 @@ def run_trial(
     *,
     max_ticks: int = 200_000,
     on_tick: Callable[[Observation, State], None] | None = None,
+    prober: Callable[[TrialPlan], Prober] | None = None,
 ) -> TrialResult:
-    """Run one trial to DONE, FAULT or ABORTED; the rig is left retracted or torque-free.
+    """Run one trial to DONE, UNREACHABLE, FAULT or ABORTED; the rig is left retracted or
+    torque-free. ``prober`` builds the probing step (``robot.probing``) when the trial probes.
 
     One tick every ``rig.tick`` seconds of ``clock``; after ``max_ticks`` the trial is aborted
-    (and retracts). Every transition and every tick is written to ``log`` as it happens."""
+    (and retracts). Every transition and every tick is written to ``log`` as it happens, and
+    what probing found as a ``probe`` record when it is found."""
     transitions: list[Transition] = []
     record: list[tuple[str, float, tuple[float, ...]]] = []
 
@@ -95,7 +109,10 @@ def run_trial(
         if log is not None:
             log.write(_transition_record(tr))
 
-    machine = IndentationMachine(plan, guards, detector, on_transition=record_transition)
+    machine = IndentationMachine(
+        plan, guards, detector, on_transition=record_transition, prober=prober
+    )
+    probe_logged = False
     t0 = clock.now()
     ticks = 0
     recovered = False
@@ -111,13 +128,16 @@ def run_trial(
                 log.write(_sample_record(obs, machine.state, cmd))
             if on_tick is not None:
                 on_tick(obs, machine.state)
+            if machine.probe is not None and not probe_logged and log is not None:
+                log.write({"kind": "probe", **machine.probe.as_dict()})
+                probe_logged = True
             ticks += 1
             if not machine.finished:
                 clock.sleep(rig.tick)
     except BaseException as exc:
         _crashed(exc, rig, machine.marks, log, ticks, clock, t0)
         raise
-    if machine.state is not State.DONE:
+    if machine.state not in PLANNED_ENDS:
         rig.release()  # torque policy: a trial that did not complete leaves the servos limp
     return TrialResult(
         state=machine.state,
@@ -127,6 +147,7 @@ def run_trial(
         duration=clock.now() - t0,
         transitions=transitions,
         record=record,
+        probe=machine.probe,
     )
 
 

@@ -8,17 +8,24 @@ everywhere.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+
 import numpy as np
+from numpy.typing import NDArray
 
 from config.scene import CampaignConfig
-from config.schema import MM, StackConfig
-from estimation.beamstate import onset_mode
+from config.schema import MM, StackConfig, TubeConfig
+from estimation.beamstate import infer_states, onset_mode
 from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
 from estimation.section import Section, composite_section
-from robot.indentation import Guards, TrialPlan
+from robot.indentation import Guards, Prober, TrialPlan
+from robot.probing import ProbeGeometry, ProbeRoutine, ProbeSettings
 from robot.rig import RigSettings
 from sensor.strain import StrainChain, grating_intervals
 from wire.dynamixel import TICKS_PER_REV
+
+FloatArray = NDArray[np.float64]
 
 
 def sensor_section(stack: StackConfig) -> Section:
@@ -36,7 +43,71 @@ def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Gua
         max_travel_past_contact=campaign.max_travel_past_contact_mm * MM,
         strain_limit=stack.fbg.strain_limit,
         stream_timeout=max(stack.board.stale_timeout_s, 5 * tick),
+        max_twist=stack.drive.max_twist,
     )
+
+
+PROBE_SPEED = 2.5e-3  # m/s, a touch's approach
+
+
+def probe_offsets(points: int, step: float) -> tuple[float, ...]:
+    """The rolls of the touches after the first, relative to the plan's (rad): a small step to
+    one side first (the surface's slope, before a wide move: until then the surface may be
+    anywhere within the search's tilt), then the full ``step`` on that side (predicted from
+    the slope), then on the other (predicted from a plane), then between. Three touches span
+    one side and a quarter: four are needed for a normal to a fraction of a degree."""
+    pattern = (0.25, 1.0, -1.0, -0.5, 0.5, -0.75, 0.75, -0.25)
+    return tuple(step * k for k in pattern[: points - 1])
+
+
+def prober_for(
+    campaign: CampaignConfig, stack: StackConfig, tube: TubeConfig
+) -> Callable[[TrialPlan], Prober] | None:
+    """The probing step of a campaign's trials with ``tube`` (``robot.probing``), None when
+    the campaign does not probe. Touches are approached at ``PROBE_SPEED``: the stage stops
+    v^2 / 2a past the touch (0.06 mm at 2.5 mm/s and 50 mm/s^2, 0.25 mm at 5 mm/s, which on
+    a 1 MPa sample is the whole way to buckling); the moves between them at the top speed."""
+    probing = campaign.probing()
+    if probing is False:
+        return None
+    section = sensor_section(stack)
+    fiber_offset = section.fiber_offset
+
+    def bending(length: float) -> tuple[float, ...]:
+        intervals = grating_intervals(stack.sensor, length)
+        return tuple(onset_mode(intervals, length, fiber_offset).tolist())
+
+    def loads(advance: FloatArray, strains: FloatArray) -> FloatArray:
+        lengths = advance - tube.flush_translation
+        intervals = grating_intervals(stack.sensor, 0.0)[None, :, :] + lengths[:, None, None]
+        states = infer_states(strains, intervals, lengths, section.EA, fiber_offset, 1e-6)
+        return np.asarray(states.P / section.EA)
+
+    geometry = ProbeGeometry(
+        tube,
+        tip_radius=stack.sensor.tip_radius,
+        translation_limits=stack.drive.translation_limits,
+        roll_limits=stack.drive.roll_limits,
+        bending_mode=bending,
+        loads=loads,
+    )
+
+    def build(plan: TrialPlan) -> Prober:
+        step = geometry.roll_step(campaign.probe_sagitta_mm * MM, plan.roll, plan.contact_advance)
+        settings = ProbeSettings(
+            offsets=probe_offsets(campaign.probe_points, step),
+            touch_strain=campaign.probe_touch_ue * 1e-6,
+            speed=min(PROBE_SPEED, stack.drive.max_speed),
+            fast_speed=stack.drive.max_speed,
+            decel=stack.drive.max_accel,
+            max_residual=math.radians(campaign.misalignment_tolerance_deg),
+            max_miss=campaign.miss_tolerance_mm * MM,
+            standoff=plan.standoff,
+            replan=probing is True,
+        )
+        return ProbeRoutine(geometry, settings, plan)
+
+    return build
 
 
 def rig_settings(

@@ -29,8 +29,10 @@ DEFAULT_MAX_E_OVER_L = 0.2
 class TissueLaw(Protocol):
     """The tissue's force against indentation depth, as the solver calls it: ``F(delta)`` and
     ``dF/ddelta`` and the inverse ``delta(F)`` on arrays (any shape, SI), and their plain-float
-    twins (the per-position path). F(0) = 0 and F increases. Hashable: it is part of the keys of
-    the per-process equilibrium cache (``sim.contact_table``)."""
+    twins (the per-position path). F(0) = 0 and F increases. Implemented by the closed forms
+    (``sim.tissue.TissueModel``), the finite-element law (``sim.fem``) and the oblique contact
+    that wraps either (``sim.oblique.ObliqueContact``). Hashable: it is part of the keys of the
+    per-process equilibrium cache (``sim.contact_table``)."""
 
     def force_and_stiffness(self, delta: ArrayLike, /) -> tuple[FloatArray, FloatArray]: ...
 

@@ -1,7 +1,7 @@
 """Regenerate the force tables shipped with the package: ``python -m sim.fem.generate``.
 
 The shipped problems are the scenes' samples: the paper's phantoms (tip R = 3.5 mm, 10 mm layers
-in a 40 mm radius dish, nu = 0.45, bonded, frictionless; linear and neo-Hookean), the
+in a 40 mm radius dish, nu = 0.45, bonded, frictionless and full stick; linear and neo-Hookean), the
 soft-tissue designs (R = 6 mm, 20 mm layers) and the half-space stand-in (a block 200 R deep and
 wide, nu = 0.45, for any tip: ``sim.sample_law``). tests/sim/test_sample_law.py checks that every
 sample of the shipped scenes finds its table here. Each table is solved afresh, written to
@@ -23,9 +23,17 @@ _SOFT = {"tip_radius": 6e-3, "thickness": 20e-3, "radius": 40e-3, "poisson": 0.4
 SHIPPED: dict[str, LayerProblem] = {
     "paper-linear": LayerProblem.from_dimensions(**_PAPER),
     "paper-neo-hookean": LayerProblem.from_dimensions(**_PAPER, material="neo-hookean"),
+    # a sample's default friction (0.5) sticks on these layers (sim.sample_law.contact_condition)
+    "paper-linear-stick": LayerProblem.from_dimensions(**_PAPER, contact="stick"),
+    "paper-neo-hookean-stick": LayerProblem.from_dimensions(
+        **_PAPER, material="neo-hookean", contact="stick"
+    ),
     "soft-linear": LayerProblem.from_dimensions(**_SOFT),
     "soft-neo-hookean": LayerProblem.from_dimensions(**_SOFT, material="neo-hookean"),
     "half-space-linear": LayerProblem(thickness_ratio=200.0, radius_ratio=200.0, poisson=0.45),
+    "half-space-linear-stick": LayerProblem(
+        thickness_ratio=200.0, radius_ratio=200.0, poisson=0.45, contact="stick"
+    ),
 }
 """The problems whose tables ship in ``sim/fem/tables``, by name."""
 

@@ -40,9 +40,12 @@ def test_friction_maps_to_the_nearer_limit() -> None:
 
 
 def test_the_default_sample_is_the_shipped_paper_phantom() -> None:
-    assert fe_problem(SAMPLE, FE, R) == SHIPPED["paper-linear"]
+    # the default friction (0.5) sticks; a frictionless sample is the other shipped table
+    assert fe_problem(SAMPLE, FE, R) == SHIPPED["paper-linear-stick"]
     neo = dataclasses.replace(SAMPLE, material="neo-hookean")
-    assert fe_problem(neo, FE, R) == SHIPPED["paper-neo-hookean"]
+    assert fe_problem(neo, FE, R) == SHIPPED["paper-neo-hookean-stick"]
+    slick = dataclasses.replace(SAMPLE, friction=0.0)
+    assert fe_problem(slick, FE, R) == SHIPPED["paper-linear"]
 
 
 def test_half_space_and_layer_switch_give_the_deep_block() -> None:
@@ -50,7 +53,7 @@ def test_half_space_and_layer_switch_give_the_deep_block() -> None:
     off = fe_problem(SAMPLE, dataclasses.replace(FE, finite_thickness=False), R)
     assert half == off
     assert half.thickness_ratio == half.radius_ratio == HALF_SPACE_RATIO
-    assert half == SHIPPED["half-space-linear"]
+    assert half == SHIPPED["half-space-linear-stick"]  # the default friction sticks
     wide_tip = fe_problem(dataclasses.replace(SAMPLE, thickness_mm=None), FE, 6e-3)
     assert wide_tip == half  # one stand-in for every tip radius
 
@@ -63,7 +66,7 @@ def test_half_space_and_layer_switch_give_the_deep_block() -> None:
         {"lateral_radius_mm": 30.0},
         {"material": "neo-hookean"},
         {"bonded": False},
-        {"friction": 1.0},
+        {"friction": 0.0},  # the default 0.5 sticks; 0 slides
     ],
     ids=lambda c: next(iter(c)),
 )
@@ -130,7 +133,7 @@ def test_rigid_block_is_a_stiff_consistent_law() -> None:
 def test_description_names_the_table() -> None:
     d = describe(SAMPLE, FE, R)
     assert d["level"] == "fe"
-    assert d["table"] == table_key(SHIPPED["paper-linear"])
+    assert d["table"] == table_key(SHIPPED["paper-linear-stick"])
     assert d["viscoelastic"] is None
     assert describe(SAMPLE, FidelityConfig(tissue_model="closed-form"), R)["level"] == "closed-form"
 

@@ -1,0 +1,202 @@
+"""What a simulated trial ends with: its outcome, and the estimate from what the estimator is told.
+
+The estimator is told the sample as the operator believes it (the scene's ``assumed:``, else
+the sample's own values), the rig's calibrated compliance, the campaign's limits and the
+misalignment the controller knows (probing's measure, else the plan's IK residual); never the
+simulator's switches or the world's truth (``robot.trial.estimate`` runs the estimators).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from config.scene import SceneConfig
+from config.schema import StackConfig
+from estimation.compliance import ComplianceFit
+from estimation.jointfit import JointFit
+from estimation.southwell import SouthwellFit
+from estimation.stiffness import StiffnessEstimate
+from estimation.verdict import Verdict
+from palpate.simworld import TrialGeometry, TrialSpec, trial_sample
+from robot.indentation import TrialMarks
+from robot.probing import ProbeResult
+from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from robot.trial.inputs import belief_fields
+from robot.trial.run import TrialResult
+from robot.trial.setup import sensor_section
+from wire.dynamixel import TICKS_PER_REV
+
+
+@dataclass
+class TrialOutcome:
+    spec: TrialSpec
+    state: str
+    reason: str
+    estimate: StiffnessEstimate | None
+    exposed_length_at_buckling: float | None
+    ik_residual: float
+    ticks: int
+    sim_time: float
+    log_path: str | None
+    series: dict[str, list[float]] = field(default_factory=dict)
+    marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
+    joint: JointFit | None = None  # the contact-point-free estimate (robot.trial.estimate)
+    joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
+    verdict: Verdict | None = None  # ok, suspect (reasons) or none (why)
+    southwell: SouthwellFit | None = None  # the beam's bow, fitted from the record
+    calibration: ComplianceFit | None = None  # on a rigid reference: the rig's compliance
+
+    misalignment: float = 0.0  # rad, what the estimator was told (probing's, or the IK's)
+    true_misalignment: float | None = None  # rad, the world's at the indentation (sim truth)
+    probe: ProbeResult | None = None
+    probing_time: float = 0.0  # simulated s in the probing step
+
+    @property
+    def status(self) -> str:
+        """The verdict's status ("none" without one)."""
+        return "none" if self.verdict is None else self.verdict.status
+
+    def modulus(self, method: str = "joint") -> float | None:
+        """E (Pa) by ``"joint"`` (the whole-record fit; None when its verdict is ``none``) or
+        ``"paper"`` (Eqs. 13-14)."""
+        if method == "joint":
+            if self.joint is None or self.status == "none":
+                return None
+            return self.joint.modulus
+        if method == "paper":
+            return None if self.estimate is None else self.estimate.modulus
+        raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
+
+    def as_dict(self) -> dict[str, Any]:
+        est = self.estimate
+        jf = self.joint
+
+        def kpa(v: float | None) -> float | None:
+            return None if v is None else v / 1e3
+
+        shown = jf if self.status != "none" else None
+        bow = self.southwell
+        return {
+            "trial": self.spec.trial_id,
+            "sample": self.spec.sample,
+            "tube": self.spec.tube,
+            "orientation": self.spec.orientation,
+            "exposed_length_mm": self.spec.exposed_length * 1e3,
+            "actual_kpa": self.spec.modulus / 1e3,
+            "reference_kpa": kpa(self.spec.reference),
+            "estimated_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
+            "delta_mm": None if est is None else est.delta * 1e3,
+            "force_n": None if est is None else est.force,
+            "joint_kpa": kpa(None if shown is None else shown.modulus),
+            "joint_ci_kpa": None if shown is None else [kpa(shown.ci_low), kpa(shown.ci_high)],
+            "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,
+            "joint_message": "no loading record" if jf is None else jf.message,
+            "verdict": self.status,
+            "verdict_reasons": [] if self.verdict is None else list(self.verdict.reasons),
+            "model_form": None if jf is None else jf.model_form,
+            "best_fit": None if jf is None else jf.best,
+            "w0_over_l": None if bow is None else bow.w0_over_l,
+            "calibration": None if self.calibration is None else self.calibration.as_dict(),
+            "warnings": [] if jf is None else list(jf.warnings),
+            "state": self.state,
+            "reason": self.reason,
+            "ik_residual_deg": math.degrees(self.ik_residual),
+            "misalignment_deg": math.degrees(self.misalignment),
+            "true_misalignment_deg": _deg(self.true_misalignment),
+            "probe": None if self.probe is None else self.probe.summary(),
+            "probing_s": self.probing_time,
+            "sim_time_s": self.sim_time,
+            "log": self.log_path,
+        }
+
+
+def _deg(x: float | None) -> float | None:
+    return None if x is None else math.degrees(x)
+
+
+def estimate_sim_trial(
+    result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
+) -> TrialEstimate:
+    flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
+    inputs = estimator_inputs(spec, scene, stack, geo, misalignment_of(result, geo))
+    return estimate_trial(
+        result,
+        kind=spec.kind,
+        exposed_length=spec.exposed_length,
+        flush_translation=flush,
+        stack=stack,
+        section=sensor_section(stack),
+        poisson=inputs.poisson,
+        inputs=inputs,
+    )
+
+
+def misalignment_of(result: TrialResult, geo: TrialGeometry) -> float:
+    """What the controller knows of the misalignment: probing's measure, else the plan's IK."""
+    return geo.residual if result.probe is None else result.probe.misalignment
+
+
+def outcome_of(
+    spec: TrialSpec,
+    geo: TrialGeometry,
+    result: TrialResult,
+    estimate: TrialEstimate,
+    log_path: str | None,
+    series: dict[str, list[float]],
+) -> TrialOutcome:
+    return TrialOutcome(
+        spec=spec,
+        state=result.state.value,
+        reason=result.reason,
+        estimate=estimate.paper,
+        exposed_length_at_buckling=estimate.exposed_length_at_buckling,
+        ik_residual=geo.residual,
+        ticks=result.ticks,
+        sim_time=result.duration,
+        log_path=log_path,
+        series=series,
+        marks=result.marks,
+        joint=estimate.joint,
+        joint_seconds=estimate.joint_seconds,
+        verdict=estimate.verdict,
+        southwell=estimate.southwell,
+        calibration=estimate.calibration,
+        misalignment=misalignment_of(result, geo),
+        probe=result.probe,
+        probing_time=result.probing_time,
+    )
+
+
+def estimator_inputs(
+    spec: TrialSpec,
+    scene: SceneConfig,
+    stack: StackConfig,
+    geo: TrialGeometry,
+    misalignment: float | None = None,
+) -> EstimatorInputs:
+    """What the joint fit is told: the sample as the operator believes it (the scene's
+    ``assumed:``, else the sample's own values), the rig's calibrated compliance, the
+    campaign's limits; never the simulator's switches."""
+    sample = trial_sample(scene, spec)
+    c = scene.campaign
+    robot = spec.kind == "robot"
+    compliance, calibrated = stack.compliance(geo.tube if robot else None)
+    belief = belief_fields(
+        sample.assumed, thickness=sample.thickness, bonded=sample.bonded, poisson=sample.poisson
+    )
+    return EstimatorInputs(
+        kind=spec.kind,
+        exposed_length=spec.exposed_length,
+        flush_translation=stack.tube(geo.tube).flush_translation if robot else 0.0,
+        tip_radius=stack.sensor.tip_radius,
+        encoder_resolution=stack.drive.lead / TICKS_PER_REV,
+        misalignment=geo.residual if misalignment is None else misalignment,
+        compliance=compliance,
+        compliance_calibrated=calibrated,
+        misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
+        travel_window=c.max_travel_past_contact_mm * 1e-3,
+        rigid=sample.rigid,
+        **belief,
+    )

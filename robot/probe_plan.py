@@ -1,0 +1,361 @@
+"""The geometry and the decisions of probing: the touches' rolls, where the next touch can be,
+the fitted surface and the orthogonal pose (``robot.probing`` runs them tick by tick).
+
+A touch is the tip sphere's centre when the FBG's load reached the light-touch threshold, from
+the kinematics and the stage encoder. The centres lie on the surface offset by the tip radius
+plus the light touch's small depth, the same at every touch: that moves each centre along its
+ray, and every ray of a bent tube comes from the cone's apex (``robot.kinematics.apex``), so a
+plane through them keeps its normal. Rolling moves the tip on a circle about the base x axis:
+the plane's tilt across the roll is known only through that circle's bow (the sagitta the
+touches span), the tilt along it through their spread; :meth:`ProbeGeometry.roll_step` sizes
+the roll by the bow.
+
+Where the next touch can be (:meth:`ProbeGeometry.predict`): with one touch, anywhere within
+``max_tilt`` of facing the tube; with two, the plane through them least tilted from facing the
+tube, give or take ``max_tilt`` about their line; with three or more, the fitted plane give or
+take three times its normal's uncertainty about the touches' centroid.
+:meth:`ProbeGeometry.sweep_needs` turns that into the advance behind the surface on every ray a
+roll sweeps. :meth:`ProbeGeometry.replan` fits the plane (or, with five touches or more that a
+plane cannot explain, the sphere: ``estimation.surface``) and asks the inverse kinematics of
+the trial's tube for the roll and advance that meet it orthogonally, near where the plan aimed
+(the first touch); reachable only within the angle and position tolerances.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from config.schema import TubeConfig
+from estimation.beamstate import axial_strain
+from estimation.surface import SurfaceGeometry, fit_plane, fit_surface
+from robot import kinematics
+from robot.indentation import TrialPlan
+
+Vector = NDArray[np.float64]
+FloatArray = NDArray[np.float64]
+SWEEP_STEPS = 8  # rays checked along a roll for the retract before it
+ROLL_MARGIN = math.radians(1.0)  # probe rolls stay this far inside the roll limits
+MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is read with
+
+
+@dataclass(frozen=True)
+class ProbeSettings:
+    """How a trial probes (SI: rad, m, m/s).
+
+    Attributes:
+        offsets: the rolls of the touches after the first, relative to the plan's roll.
+        touch_strain: axial strain (compression) that is a touch.
+        speed: approach speed of the first touch; fast_speed for the moves between touches.
+        decel: the stage's deceleration: once a touch has shown how deep the sample yields,
+            later ones approach as fast as the stage stops within half that depth.
+        clearance: kept between the tip and where the surface can be, when moving.
+        max_tilt: the largest tilt of the surface from facing the tube the search allows for.
+        sigma: a touch's uncertainty along its ray (m), for the normal's uncertainty.
+        max_residual, max_miss: the tolerances of the orthogonal pose.
+        standoff: where the trial's approach starts before the expected contact.
+        replan: False measures and logs the misalignment but keeps the plan's pose.
+    """
+
+    offsets: tuple[float, ...]
+    touch_strain: float
+    speed: float
+    fast_speed: float
+    decel: float = math.inf  # m/s^2, the stage's; a seek may go as fast as it can stop in
+    clearance: float = 0.2e-3
+    max_tilt: float = math.radians(30.0)
+    sigma: float = 10e-6
+    max_residual: float = math.radians(2.0)
+    max_miss: float = 30e-3
+    standoff: float = 1e-3
+    replan: bool = True
+
+
+@dataclass(frozen=True)
+class Touch:
+    """One light touch: the roll and stage advance (rad, m) and the tip centre and the sensor
+    axis there (3-tuples, base frame); ``slipped`` when the FBG saw the beam bow without the
+    load rising (the tip slid on a surface too steep for its friction): kept for the moves,
+    left out of the fit; ``depth``: how far past the surface the touch is (its load's onset
+    to its threshold), which a move must keep clear of besides the surface's own doubt."""
+
+    roll: float
+    advance: float
+    centre: tuple[float, float, float]
+    tangent: tuple[float, float, float]
+    slipped: bool = False  # the tip slid instead of loading: not a point of the surface
+    depth: float = 0.0  # m of advance from where the load began to the touch
+
+
+@dataclass(frozen=True)
+class ProbeResult:
+    """What probing found and the pose it chose.
+
+    ``reachable`` False means no pose of the trial's tube meets the surface within the
+    tolerances (``reason`` says which); ``roll`` and ``contact_advance`` are then the plan's.
+    ``misalignment`` (rad) is the residual angle of the chosen pose to the measured normal,
+    ``normal_sigma`` (rad) the normal's 1-sigma angle (nan when it was not measured), ``miss``
+    (m) the distance from the first touch's surface point to the chosen contact."""
+
+    reachable: bool
+    reason: str
+    roll: float
+    contact_advance: float
+    misalignment: float
+    normal_sigma: float
+    miss: float
+    normal: tuple[float, float, float] | None
+    model: str
+    radius: float | None
+    touches: tuple[Touch, ...]
+    retract_to: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """Everything, for the trial log's ``probe`` record."""
+        d = dataclasses.asdict(self)
+        d["misalignment_deg"] = math.degrees(self.misalignment)
+        d["normal_sigma_deg"] = math.degrees(self.normal_sigma)
+        return d
+
+    def summary(self) -> dict[str, Any]:
+        """What was measured and decided, for a campaign's JSON (the log has the touches)."""
+        return {
+            "reachable": self.reachable,
+            "reason": self.reason,
+            "normal": self.normal,
+            "normal_sigma_deg": math.degrees(self.normal_sigma),
+            "model": self.model,
+            "radius_mm": None if self.radius is None else self.radius * 1e3,
+            "miss_mm": self.miss * 1e3,
+            "roll_deg": math.degrees(self.roll),
+            "touches": len(self.touches),
+        }
+
+
+class ProbeGeometry:
+    """The trial tube's kinematics for probing: tip centres, predictions and the re-plan."""
+
+    def __init__(
+        self,
+        tube: TubeConfig,
+        *,
+        tip_radius: float,
+        translation_limits: tuple[float, float],
+        roll_limits: tuple[float, float],
+        bending_mode: Callable[[float], Sequence[float]],
+        loads: Callable[[FloatArray, FloatArray], FloatArray] | None = None,
+    ) -> None:
+        """``bending_mode``: the gratings' onset bending shape at an exposed length (m)
+        (``estimation.beamstate.onset_mode``), to take the beam's bow out of its load tick by
+        tick; ``loads``: the axial strain P/EA of a record (advances (N,) m, strains (N, G))
+        by the full non-linear beam state (``estimation.beamstate.infer_states``), for the fit
+        of a touch (the onset shape is a few microstrain off once the bow has grown)."""
+        self.tube = tube
+        self.tip_radius = tip_radius
+        self.translation_limits = translation_limits
+        self.roll_limits = roll_limits
+        self._mode = bending_mode
+        self._modes: dict[int, Sequence[float]] = {}
+        self.loads = loads
+
+    def axial(self, strains: Sequence[float], advance: float) -> float:
+        """The axial strain P/EA (compression positive) at a stage ``advance`` (m): the uniform
+        part of ``strains`` once the bow along the onset shape at this exposed length is out
+        (the shape moves along the gratings as the sensor comes out: a millimetre of length
+        turns a 300 kPa sample's touch by ~60 um if the shape is not the one at hand)."""
+        if not strains:
+            return math.nan
+        key = round((advance - self.tube.flush_translation) / MODE_STEP)
+        if key not in self._modes:
+            self._modes[key] = self._mode(key * MODE_STEP)
+        return axial_strain(strains, self._modes[key])
+
+    @property
+    def can_probe(self) -> bool:
+        """A bent tube: its rolls give different lines."""
+        return self.tube.tip_angle > 0.0
+
+    def roll_step(self, sagitta: float, plan_roll: float, plan_advance: float) -> float:
+        """The roll (rad) either side of the plan that bows the tip's arc by ``sagitta`` (m) at
+        the planned contact: the tip moves on a circle about the x axis, and the plane's tilt
+        along the tube's bend is known only through that bow (at most 60 deg)."""
+        c = kinematics.forward(self.tube, plan_roll, plan_advance).sensor_tip
+        radial = math.hypot(float(c[1]), float(c[2]))
+        if not radial > sagitta / 2:
+            return math.radians(60.0) if radial > 0 else 0.0
+        return min(math.acos(1.0 - sagitta / radial), math.radians(60.0))
+
+    def probe_rolls(self, plan_roll: float, offsets: Sequence[float]) -> list[float]:
+        """The touches' rolls: the plan's, then ``offsets`` from it, mirrored when that keeps
+        them within the roll limits, else held a degree inside them (one roll for a straight
+        tube)."""
+        if not self.can_probe:
+            return [plan_roll]
+        lo, hi = self.roll_limits[0] + ROLL_MARGIN, self.roll_limits[1] - ROLL_MARGIN
+        for sign in (1.0, -1.0):
+            rolls = [plan_roll + sign * o for o in offsets]
+            if all(lo <= r <= hi for r in rolls):
+                return [plan_roll, *rolls]
+        return [plan_roll] + [min(max(plan_roll + o, lo), hi) for o in offsets]
+
+    def touch(self, roll: float, advance: float) -> Touch:
+        pose = kinematics.forward(self.tube, roll, advance)
+        c, t = pose.sensor_tip, pose.tangent
+        return Touch(roll, advance, (c[0], c[1], c[2]), (t[0], t[1], t[2]))
+
+    def advance_to(self, centres: SurfaceGeometry, roll: float) -> float:
+        """The advance (m) at which the tip centre reaches the centres' surface at ``roll``."""
+        pose = kinematics.forward(self.tube, roll, self.tube.flush_translation)
+        return self.tube.flush_translation + centres.ray_hit(pose.tube_tip, pose.tangent)
+
+    def predict(
+        self, touches: list[Touch], roll: float, settings: ProbeSettings
+    ) -> tuple[float, float]:
+        """(advance, slack) m: where the next touch at ``roll`` is expected, and how far either
+        side of it the surface can be (see the module docstring)."""
+        model, line, tilt = _model(touches, settings.sigma)
+        x = self.advance_to(model, roll)
+        if not math.isfinite(x):
+            x = touches[-1].advance
+        c = np.asarray(self.touch(roll, x).centre)
+        slack = _distance_to_line(c, line) * math.tan(min(tilt, settings.max_tilt))
+        return x, slack + 3.0 * settings.sigma
+
+    def sweep_needs(
+        self, touches: list[Touch], start: float, end: float, settings: ProbeSettings
+    ) -> tuple[list[float], list[float]]:
+        """(rolls, advances): rays from roll ``start`` to ``end`` and, on each, the advance (m)
+        behind where the surface can be, by ``clearance`` (the touches, and so the prediction,
+        are their depth past the surface)."""
+        rolls = np.linspace(start, end, SWEEP_STEPS + 1).tolist()
+        depth = max(t.depth for t in touches)  # the touches are this far past the surface
+        safe = []
+        for roll in rolls:
+            x, slack = self.predict(touches, roll, settings)
+            safe.append(max(x - depth - slack - settings.clearance, self.translation_limits[0]))
+        return rolls, safe
+
+    def sweep_retract(
+        self, touches: list[Touch], start: float, end: float, settings: ProbeSettings
+    ) -> float:
+        """The advance (m) behind the surface on every ray from roll ``start`` to ``end``."""
+        lowest = touches[-1].advance - settings.clearance
+        return min(lowest, *self.sweep_needs(touches, start, end, settings)[1])
+
+    def replan(self, touches: list[Touch], plan: TrialPlan, settings: ProbeSettings) -> ProbeResult:
+        """Fit the surface, find the orthogonal pose of this tube, decide reachability."""
+        if not self.can_probe:
+            why = "a straight tube meets the surface along one line at every roll"
+            return self._unmeasured(touches, plan, settings, why)
+        held = [t for t in touches if not t.slipped]
+        if len(held) < 3:
+            why = f"{len(touches) - len(held)} of {len(touches)} touches slipped"
+            return self._unmeasured(touches, plan, settings, why)
+        centres = np.array([t.centre for t in held])
+        rays = np.array([t.tangent for t in held])
+        fit = fit_surface(
+            centres, sigma=settings.sigma, hint=-rays.mean(axis=0), directions=rays,
+            reference=centres[0],
+        )  # fmt: skip
+        if not fit.success:
+            return self._unmeasured(touches, plan, settings, fit.message)
+        surface = fit.surface(self.tip_radius)
+        n0 = surface.normal_at(centres[0])
+        target = centres[0] - self.tip_radius * n0
+        ik = kinematics.solve_for_tube(
+            self.tube, target, n0, tip_radius=self.tip_radius,
+            translation_limits=self.translation_limits, roll_limits=self.roll_limits,
+            radius=surface.radius, max_residual=settings.max_residual, max_miss=settings.max_miss,
+        )  # fmt: skip
+        move = ik.reachable and settings.replan
+        roll = ik.roll if move else plan.roll
+        depth = float(np.mean([t.depth for t in held]))  # the fit is this far past the surface
+        advance = ik.advance - depth if move else plan.contact_advance
+        if not settings.replan:  # measure only: the misalignment of the plan's own pose
+            ik = _plan_pose(self, target, n0, surface.radius, plan)
+        retract = self.sweep_retract(touches, touches[-1].roll, roll, settings)
+        retract = min(retract, advance - settings.standoff - settings.clearance)
+        n = surface.normal
+        return ProbeResult(
+            ik.reachable or not settings.replan,
+            _reason(ik, settings),
+            roll,
+            advance,
+            ik.residual,
+            fit.normal_sigma,
+            ik.miss,
+            (float(n[0]), float(n[1]), float(n[2])),
+            fit.model,
+            surface.radius,
+            tuple(touches),
+            retract,
+        )
+
+    def _unmeasured(
+        self, touches: list[Touch], plan: TrialPlan, settings: ProbeSettings, why: str
+    ) -> ProbeResult:
+        retract = min(touches[-1].advance, plan.contact_advance) - settings.standoff
+        return ProbeResult(
+            True, f"normal not measured: {why}", plan.roll, plan.contact_advance, 0.0,
+            math.nan, 0.0, None, "none", None, tuple(touches), retract - settings.clearance,
+        )  # fmt: skip
+
+
+def _plan_pose(
+    geo: ProbeGeometry, target: Vector, normal: Vector, radius: float | None, plan: TrialPlan
+) -> kinematics.IKSolution:
+    """The misalignment and miss of the plan's own roll on the measured surface."""
+    pose = kinematics.forward(geo.tube, plan.roll, geo.tube.flush_translation)
+    surface = SurfaceGeometry.make(target, normal, radius)
+    hit = surface.offset(geo.tip_radius).ray_hit(pose.tube_tip, pose.tangent)
+    centre = pose.tube_tip + hit * pose.tangent
+    local = surface.normal_at(centre)
+    residual = math.acos(max(-1.0, min(1.0, -float(local @ pose.tangent))))
+    miss = float(np.linalg.norm(centre - geo.tip_radius * local - target))
+    advance = geo.tube.flush_translation + hit
+    return kinematics.IKSolution(geo.tube.name, plan.roll, advance, hit, residual, 0, centre, miss)
+
+
+def _reason(ik: kinematics.IKSolution, settings: ProbeSettings) -> str:
+    found = f"residual {math.degrees(ik.residual):.2f} deg, miss {ik.miss * 1e3:.1f} mm"
+    if ik.reachable:
+        return f"orthogonal pose found: {found}"
+    limits = (
+        f"tolerances {math.degrees(settings.max_residual):.1f} deg, "
+        f"{settings.max_miss * 1e3:.0f} mm"
+    )
+    return f"no orthogonal pose of tube {ik.tube}: {ik.reason} ({found}; {limits})"
+
+
+def _model(
+    touches: list[Touch], sigma: float
+) -> tuple[SurfaceGeometry, tuple[Vector, Vector], float]:
+    """The centres' plane the touches so far support, the line about which it may still turn
+    and by how much (rad; ``inf``: by any angle, the search's bound applies). Three touches or
+    more fix a plane up to three times its normal's 1-sigma angle about their centroid (three
+    on one side of the roll leave it loose across)."""
+    c = np.array([t.centre for t in touches])
+    rays = np.array([t.tangent for t in touches])
+    facing = -rays.mean(axis=0)
+    if len(touches) >= 3:
+        fit = fit_plane(c, sigma=sigma, hint=facing, directions=rays)
+        if fit.success and fit.centres is not None:
+            return fit.centres, (fit.centres.point, np.zeros(3)), 3.0 * fit.normal_sigma
+    if len(touches) == 1:
+        return SurfaceGeometry.make(c[0], facing), (c[0], np.zeros(3)), math.inf
+    along = (c[1] - c[0]) / np.linalg.norm(c[1] - c[0])
+    normal = facing - float(facing @ along) * along
+    return SurfaceGeometry.make(c[0], normal), (c[0], along), math.inf
+
+
+def _distance_to_line(p: Vector, line: tuple[Vector, Vector]) -> float:
+    """Distance from ``p`` to the line (point, unit direction); a zero direction: the point."""
+    q, d = line
+    v = p - q
+    return float(np.linalg.norm(v - float(v @ d) * d))

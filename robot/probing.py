@@ -1,0 +1,236 @@
+"""Finding the surface normal by light touches, then the orthogonal pose (issue 18).
+
+On a real sample the normal is not known in advance (DESIGN, "Orthogonal indentation"). The
+robot can only turn its sensor by rolling its tube, and a roll of a bent tube also moves the
+tip sideways: touching the surface at a few rolls around the plan gives points on it. This
+module runs the touches tick by tick (:class:`ProbeRoutine`, a small state machine the
+indentation machine steps in its PROBING state); :mod:`robot.probe_plan` holds the geometry and
+the decisions (where the next touch can be, the fit, the orthogonal pose, reachability).
+
+The touches, in order: the plan's roll (the first touch is the plan's approach), a small roll
+to one side, the full roll on that side, the full roll on the other (``offsets``). Moving
+between touches is the dangerous part (a roll sweeps the tip sideways, toward where a tilted
+surface may be higher): the stage keeps behind where the surface can be on the rays the roll
+is about to sweep, and an FBG interlock holds the roll whenever the beam shows a load or a bow,
+whatever the surface model says. A touch that never comes within the window where the surface
+must be is a fault; a straight tube (one line at every roll) touches once and cannot tell the
+normal. The result (:class:`ProbeResult`) carries the measured normal, its 1-sigma angle, the
+residual angle (the trial's misalignment) and the miss.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+
+import numpy as np
+
+from estimation.surface import load_crossing
+from robot.indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPlan
+from robot.probe_plan import ProbeGeometry, ProbeResult, ProbeSettings, Touch
+
+MOVE_LOOKAHEAD = math.radians(12.0)  # roll ahead of the present the stage keeps clear of
+ON_RAY = math.radians(2.0)  # within this roll of a touch the tip still faces its dimple
+TOUCH_TOP = 2.0  # a seek goes on to this many thresholds, for the fit of its ramp
+TOUCH_FREE = 0.5  # the tip is free again below this share of the threshold
+FREE_TICKS = 3  # ticks running the FBG must show a free tip
+BASELINE_TICKS = 16  # free ticks at the start of a seek that give its axial strain's zero
+TOUCH_BOW = 10.0  # a bow this many thresholds deep ends a touch early (an imperfect beam)
+
+__all__ = ["ProbeGeometry", "ProbeResult", "ProbeRoutine", "ProbeSettings", "Touch"]
+
+
+class _Phase(enum.Enum):
+    SEEK = "seek"
+    LIFT = "lift"
+    MOVE = "move"
+    SETTLE = "settle"
+    LEAVE = "leave"
+
+
+class ProbeRoutine:
+    """The probing step of one trial, a small state machine of its own: hand it each tick's
+    :class:`Observation`; it returns the :class:`Command` to send, or, once done, the
+    :class:`ProbeResult` (a ``str`` instead when it failed: no surface where one must be).
+
+    A touch: SEEK at the probe speed until the FBG's axial strain (the bow along the onset
+    shape at the present exposed length taken out, zeroed on the seek's first ticks) reaches
+    twice the threshold; the touch is where the Hertz power fitted to the seek's ramp crosses
+    the threshold (with 3 gratings the axial strain has ~5 ue of noise, ~45 um of stage travel
+    on a 300 kPa sample for one tick; the fit brings it to ~10 um); LIFT: plan the next touch
+    and MOVE to its roll while retracting behind the surface on every ray the roll sweeps (the
+    roll waits until the tip is free and wherever the retract has not caught up); SETTLE at
+    rest and take the strain zero again (the beam's own weight bends it differently at
+    another roll); SEEK again."""
+
+    def __init__(self, geometry: ProbeGeometry, settings: ProbeSettings, plan: TrialPlan) -> None:
+        self.geometry = geometry
+        self.settings = settings
+        self.plan = plan
+        self.rolls = geometry.probe_rolls(plan.roll, settings.offsets)
+        self.touches: list[Touch] = []
+        self.phase = _Phase.SEEK
+        self.limit = plan.contact_advance + plan.approach_window
+        self.goal = math.nan
+        self.result: ProbeResult | None = None
+        self._sweep: tuple[list[float], list[float]] = ([], [])  # rolls, safe advance on each
+        self._ticks = 0
+        self._free = True  # the tip is off the surface
+        self._free_ticks = FREE_TICKS
+        self._loaded_ticks = 0
+        self._zero_roll = plan.roll  # the roll the strains were last zeroed at
+        self._ramp: list[tuple[float, float]] = []  # (advance, axial strain) of this seek
+        self._ramp_strains: list[tuple[float, ...]] = []  # the strains of those ticks
+
+    @property
+    def roll(self) -> float:
+        """The roll of the touch under way (the last one once all are made)."""
+        return self.rolls[min(len(self.touches), len(self.rolls) - 1)]
+
+    def step(self, obs: Observation) -> Command | ProbeResult | str:
+        handler = {
+            _Phase.SEEK: self._seek,
+            _Phase.LIFT: self._lift,
+            _Phase.MOVE: self._move,
+            _Phase.SETTLE: self._settle,
+            _Phase.LEAVE: self._leave,
+        }[self.phase]
+        return handler(obs)
+
+    def _seek(self, obs: Observation) -> Command | ProbeResult | str:
+        s = self.settings
+        axial = self.geometry.axial(obs.strains, obs.advance)
+        if math.isfinite(axial):
+            self._ramp.append((obs.advance, axial))
+            self._ramp_strains.append(obs.strains)
+        load = axial - self._baseline()
+        bowed = max((abs(e) for e in obs.strains), default=0.0) >= TOUCH_BOW * s.touch_strain
+        if math.isfinite(load) and (load >= TOUCH_TOP * s.touch_strain or bowed):
+            # a bow without the load is a slipping tip (the surface too steep for its friction)
+            slipped = bowed and load < s.touch_strain
+            start, x = (obs.advance, obs.advance) if slipped else self._crossing()
+            touch = self.geometry.touch(obs.roll, x)
+            self.touches.append(dataclasses.replace(touch, slipped=slipped, depth=x - start))
+            self._ramp, self._ramp_strains = [], []
+            self.phase = _Phase.LIFT
+            return self._lift(obs)
+        if obs.advance >= self.limit - self.plan.position_tolerance:
+            return (
+                f"probing: no surface within {self.limit * 1e3:.2f} mm of stage travel at roll "
+                f"{math.degrees(self.roll):.1f} deg"
+            )
+        return Command(self.limit, self.roll, self._seek_speed())
+
+    def _seek_speed(self) -> float:
+        """The first touch's speed, then as fast as the stage stops (v^2 / 2a) within half the
+        depth the touches went to (a soft sample yields more, so it can be met faster)."""
+        s = self.settings
+        depths = [t.depth for t in self.touches if not t.slipped and t.depth > 0]
+        if not depths or not math.isfinite(s.decel):
+            return s.speed
+        reach = TOUCH_TOP ** (2.0 / 3.0) * min(depths)  # a touch's depth at its top load
+        return min(max(math.sqrt(s.decel * reach), s.speed), s.fast_speed)
+
+    def _baseline(self) -> float:
+        """The axial strain of the free beam on this seek: the mean of its first ticks (the
+        seek starts ``clearance`` or more before the surface), 0 until there are enough."""
+        if len(self._ramp) < BASELINE_TICKS // 2:
+            return 0.0
+        return float(np.mean([a for _, a in self._ramp[:BASELINE_TICKS]]))
+
+    def _crossing(self) -> tuple[float, float]:
+        """Where the seek's load began and where it reached the threshold: the Hertz power
+        fitted to the whole seek (``estimation.surface.load_crossing``), on the loads of the
+        full beam state when the geometry has them; the last tick's advance (twice) when the
+        fit fails."""
+        xs = [x for x, _ in self._ramp]
+        ys = [a for _, a in self._ramp]
+        if self.geometry.loads is not None and len(xs) >= 4:
+            ys = self.geometry.loads(np.array(xs), np.array(self._ramp_strains)).tolist()
+        found = load_crossing(xs, ys, self.settings.touch_strain) if len(xs) >= 4 else None
+        last = self._ramp[-1][0]
+        return (last, last) if found is None else found
+
+    def _lift(self, obs: Observation) -> Command | ProbeResult:
+        """Plan what follows a touch (the next move, or the re-plan and the way out) and start
+        backing off; nothing rolls until the tip is free (``_freed``)."""
+        s, geo = self.settings, self.geometry
+        self._free, self._free_ticks, self._loaded_ticks = False, 0, 0
+        self.goal = self.touches[-1].advance - s.clearance
+        if len(self.touches) == len(self.rolls):
+            self.result = geo.replan(self.touches, self.plan, s)
+            self.goal = min(self.goal, self.result.retract_to)
+            self.phase = _Phase.LEAVE
+            return self._leave(obs)
+        roll = self.rolls[len(self.touches)]
+        x, slack = geo.predict(self.touches, roll, s)
+        rolls, safe = geo.sweep_needs(self.touches, obs.roll, roll, s)
+        self._sweep = (rolls, safe) if rolls[0] <= rolls[-1] else (rolls[::-1], safe[::-1])
+        self.limit = x + slack + s.clearance + self.plan.approach_window
+        self.phase = _Phase.MOVE
+        return self._move(obs)
+
+    def _freed(self, obs: Observation) -> bool:
+        """Whether the tip is off the surface, by the FBG: ``FREE_TICKS`` ticks running with
+        neither load (half the touch's) nor a bow make it free, two with either make it touch
+        again (the noise of one tick does neither). Whenever it comes free the stage keeps
+        ``clearance`` behind; while it is not, nothing rolls, whatever the surface model says.
+        The load counts only near the roll the strains were zeroed at: the beam's own weight
+        bends it differently at another roll (tens of microstrain), the bow counts always."""
+        th = self.settings.touch_strain
+        bow = max((abs(e) for e in obs.strains), default=0.0)
+        loaded = bow >= TOUCH_BOW * th
+        if abs(obs.roll - self._zero_roll) < ON_RAY:  # rolled away, the weight moves the zero
+            loaded = loaded or self.geometry.axial(obs.strains, obs.advance) > TOUCH_FREE * th
+        self._free_ticks = 0 if loaded else self._free_ticks + 1
+        self._loaded_ticks = self._loaded_ticks + 1 if loaded else 0
+        if self._free and self._loaded_ticks >= 2:
+            self._free = False
+        elif not self._free and self._free_ticks >= FREE_TICKS:
+            self._free = True
+            self.goal = min(self.goal, obs.advance - self.settings.clearance)
+        return self._free
+
+    def _safe(self, start: float, end: float) -> float:
+        """The advance behind the surface on every ray from roll ``start`` to ``end``."""
+        rolls, safe = self._sweep
+        lo, hi = min(start, end), max(start, end)
+        inside = [a for r, a in zip(rolls, safe, strict=True) if lo < r < hi]
+        ends = np.interp([lo, hi], rolls, safe)
+        return float(min(*ends, *inside)) if inside else float(min(ends))
+
+    def _move(self, obs: Observation) -> Command:
+        """Roll to the next touch, the stage following the surface on the rays the roll is
+        about to sweep (``MOVE_LOOKAHEAD`` ahead); the roll holds while the tip is on the
+        surface or the stage is not yet behind it on the next few degrees."""
+        s = self.settings
+        if not self._freed(obs):  # back off along the ray until the FBG says the tip is free
+            self.goal = min(self.goal, obs.advance - s.clearance)
+            return Command(self.goal, obs.roll, s.fast_speed)
+        togo = self.roll - obs.roll
+        near = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), 0.03), togo))
+        ahead = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), MOVE_LOOKAHEAD), togo))
+        on_last_ray = abs(obs.roll - self.touches[-1].roll) < ON_RAY
+        goal = min(self.goal, ahead) if on_last_ray else ahead
+        at_roll = abs(togo) <= self.plan.roll_tolerance
+        if at_roll and abs(obs.advance - goal) <= self.plan.position_tolerance:
+            self.goal = goal
+            self.phase, self._ticks = _Phase.SETTLE, 0
+            return Command(goal, self.roll, 0.0)
+        safe = obs.advance <= near + self.plan.position_tolerance
+        return Command(goal, self.roll if safe else obs.roll, s.fast_speed)
+
+    def _settle(self, obs: Observation) -> Command:
+        self._ticks += 1
+        if self._ticks <= REZERO_SETTLE_TICKS:
+            return Command(self.goal, self.roll, 0.0)
+        self.phase = _Phase.SEEK
+        self._zero_roll = obs.roll
+        return Command(self.goal, self.roll, 0.0, rezero=True)
+
+    def _leave(self, obs: Observation) -> Command | ProbeResult:
+        assert self.result is not None
+        if self._freed(obs) and obs.advance <= self.goal + self.plan.position_tolerance:
+            return dataclasses.replace(self.result, retract_to=self.goal)
+        return Command(self.goal, obs.roll, self.settings.fast_speed)

@@ -1,0 +1,104 @@
+"""Probing on the simulator: the normal found by touches, the orthogonal re-plan, the trial that
+says it cannot before indenting, and the twist guard (issue 18)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pytest
+
+from config import load, load_stack, resolve
+from config.scene import SceneConfig
+from config.schema import ServoBusConfig
+from palpate.simtrial import TrialSpec, run_sim_trial
+from robot.trial.log import read_log
+from sim.board import BoardEmulator, BoardFaults
+from sim.clock import VirtualClock
+from sim.dynamixel.bus import EmulatedBus
+from sim.world import World
+
+STACK = load_stack()
+TILTED = load(SceneConfig, resolve("scenes/tilted.yaml"))
+
+
+def spec(
+    sample: str, tube: str = "bent15", orientation: str = "downward", seed: int = 2
+) -> TrialSpec:
+    roll = {"downward": 0.0, "sideways": math.pi / 2, "upward": math.pi}[orientation]
+    modulus = next(s.modulus for s in TILTED.samples if s.name == sample)
+    return TrialSpec(
+        f"{sample}-{tube}-{orientation}", "robot", sample, modulus, 0.45, tube, orientation,
+        roll, 42e-3, seed,
+    )  # fmt: skip
+
+
+def test_probing_finds_a_tilted_surface_and_indents_square_to_it(tmp_path: Path) -> None:
+    out = run_sim_trial(spec("S8-t15"), TILTED, STACK, log_dir=tmp_path)
+    assert out.state == "done", out.reason
+    assert out.probe is not None
+    assert out.probe.reachable
+    assert len(out.probe.touches) == 4
+    assert out.true_misalignment is not None
+    assert math.degrees(out.true_misalignment) < 1.0  # the world's angle at the indentation
+    assert math.degrees(out.misalignment) < 1.0  # what probing measured and the fit was told
+    assert out.joint is not None
+    assert out.joint.modulus is not None
+    assert abs(out.joint.modulus / out.spec.modulus - 1) < 0.05
+    log = read_log(Path(str(out.log_path)))
+    states = [r["to"] for r in log.of_kind("transition")]
+    assert states[:4] == ["homing", "positioning", "probing", "positioning"]
+    probe = next(log.of_kind("probe"))
+    assert probe["misalignment_deg"] == pytest.approx(math.degrees(out.misalignment))
+
+
+def test_without_probing_the_trial_indents_at_the_tilt() -> None:
+    scene = dataclasses.replace(TILTED, campaign=dataclasses.replace(TILTED.campaign, probe=False))
+    out = run_sim_trial(spec("S8-t15"), scene, STACK)
+    assert out.state == "done", out.reason
+    assert out.probe is None
+    assert out.misalignment == 0.0
+    assert out.true_misalignment == pytest.approx(math.radians(15.0), abs=1e-6)
+
+
+def test_a_pose_beyond_tolerance_ends_the_trial_before_it_indents() -> None:
+    campaign = dataclasses.replace(TILTED.campaign, miss_tolerance_mm=5.0)
+    scene = dataclasses.replace(TILTED, campaign=campaign)
+    out = run_sim_trial(spec("S8-t15"), scene, STACK)
+    assert out.state == "unreachable"
+    assert out.reason.startswith("unreachable: no orthogonal pose")
+    assert "position" in out.reason
+    assert out.marks is not None
+    assert out.marks.x_buckling is None
+    assert out.estimate is None
+
+
+class StalledInnerGear:
+    """An emulator hook whose inner roller gear does not turn (a slipping gear)."""
+
+    board_faults: BoardFaults | None = None
+
+    def make_bus(self, cfg: ServoBusConfig, clock: VirtualClock) -> EmulatedBus:
+        self.inner = cfg.inner_roll.id
+        return EmulatedBus.from_config(cfg, clock=clock)
+
+    def attach(
+        self, clock: VirtualClock, bus: EmulatedBus, board: BoardEmulator, world: World
+    ) -> None:
+        bus.servo(self.inner).set_stalled(True)
+
+    def log_opened(self, log: object) -> None:
+        pass
+
+    def detach(self) -> None:
+        pass
+
+
+def test_the_twist_guard_stops_and_retracts_when_the_inner_gear_lags() -> None:
+    out = run_sim_trial(spec("S8-t15"), TILTED, STACK, hook=StalledInnerGear())  # type: ignore[arg-type]
+    assert out.state == "fault"
+    assert "twist" in out.reason
+    assert "3.00 deg bound" in out.reason
+    assert out.marks is not None
+    assert out.marks.x_contact is None
