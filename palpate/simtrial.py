@@ -209,6 +209,8 @@ def run_sim_trial(
         settings = _rig_settings(
             spec, scene, stack, fast_faults=hook is not None and transport == "fast"
         )
+        # the rig waits each tick for exactly what the board has sent, never for a frame not sent
+        settings = dataclasses.replace(settings, sent_bytes=lambda: board.stats.bytes_sent)
         with DriveController(driver, stack.drive) as drive, reader:
             board.start()
             rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)

@@ -11,7 +11,10 @@ from the SDK's ``syncReadTx`` / ``readRx`` rather than ``GroupSyncRead``, becaus
 each status packet's error byte, and the Alert bit in it is how a servo reports a hardware fault.
 
 Safety lives here: every transaction is retried a bounded number of times and then raises
-:class:`~robot.motors.ServoTransportError`; a status error or the Alert bit raises
+:class:`~robot.motors.ServoTransportError`; a port that fails under the driver (a USB adapter
+unplugged: pyserial's EIO or "readiness to read but returned no data") is counted
+(``port_errors``) and opened again with a back-off (``reopens``), its transactions failing as
+transport errors meanwhile; a status error or the Alert bit raises
 :class:`~robot.motors.ServoFaultError` with the decoded Hardware Error Status (never retried);
 goals move at most ``max_goal_step`` per call; :meth:`close` (also on leaving the ``with`` block)
 turns torque off on every servo before releasing the port, whatever happened before.
@@ -22,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import math
 import struct
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Self, TypeVar
@@ -36,7 +40,7 @@ from robot.motors import (
     ServoIdentityError,
     ServoTransportError,
 )
-from sensor.ports import open_failure
+from sensor.ports import OPEN_ERRORS, PORT_ERRORS, open_failure
 from wire import dynamixel as tables
 
 R = TypeVar("R")
@@ -57,6 +61,7 @@ def _state_format() -> struct.Struct:
 _STATE = _state_format()  # one unpack per reply instead of slices and int.from_bytes
 # one servo's part of the goals' sync write: its ID, then its Goal_Position (signed)
 _GOAL_PARAM = struct.Struct("<B" + {1: "b", 2: "h", 4: "i"}[_GOAL_LEN])
+REOPEN_BACKOFF_S = (0.02, 1.0)  # first and longest wall-time wait between reopening attempts
 
 
 @dataclass(frozen=True)
@@ -112,6 +117,12 @@ class DynamixelBus:
         self.max_goal_step = max_goal_step
         self._last_goals: dict[str, float] = {}
         self._connected = False
+        self.port_errors = 0  # transactions that failed in the port itself (it was lost)
+        self.reopens = 0  # times a lost port was opened again
+        self.reopen_backoff_s = REOPEN_BACKOFF_S
+        self._lost = ""  # why the port is down ("" while it works)
+        self._reopen_at = 0.0
+        self._backoff = 0.0
 
     @classmethod
     def from_config(cls, cfg: ServoBusConfig, port: str | Any | None = None) -> Self:
@@ -356,14 +367,50 @@ class DynamixelBus:
         attempts = 1 + (self._retries if retries is None else retries)
         result = sdk.COMM_TX_FAIL
         for _ in range(attempts):
-            value, result, error = call()
+            if self._lost and not self._reopen():
+                break
+            try:
+                value, result, error = call()
+            except PORT_ERRORS as exc:  # the port failed (not a reply: the device itself)
+                self._port.is_using = False
+                self._lose_port(exc)
+                continue
             if result == sdk.COMM_SUCCESS:
                 if servo_id is not None:
                     self._raise_for_status(servo_id, error)
                 return value
             self._port.is_using = False  # the SDK leaves it set after some failures
+        if self._lost:
+            name = self._port.getPortName()
+            raise ServoTransportError(f"{what}: port {name} lost ({self._lost}), reopening")
         reason = self._ph.getTxRxResult(result)
         raise ServoTransportError(f"{what}: {reason} ({attempts} attempts)")
+
+    def _lose_port(self, exc: Exception) -> None:
+        """Count a failed port, close it and try to reopen it at the next attempt."""
+        self.port_errors += 1
+        self._lost = str(exc) or type(exc).__name__
+        self._reopen_at = time.monotonic()
+        self._backoff = self.reopen_backoff_s[0]
+        with contextlib.suppress(*PORT_ERRORS):
+            self._port.closePort()
+
+    def _reopen(self) -> bool:
+        """Open a lost port again if the back-off allows an attempt; True when it is open."""
+        now = time.monotonic()
+        if now < self._reopen_at:
+            return False
+        try:
+            opened = bool(self._port.openPort() and self._port.setBaudRate(self._baudrate))
+        except OPEN_ERRORS as exc:
+            self._lost, opened = str(exc) or type(exc).__name__, False
+        if not opened:
+            self._reopen_at = now + self._backoff
+            self._backoff = min(2 * self._backoff, self.reopen_backoff_s[1])
+            return False
+        self._lost = ""
+        self.reopens += 1
+        return True
 
     def _raise_for_status(self, servo_id: int, error: int) -> None:
         if not error:
