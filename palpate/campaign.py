@@ -6,7 +6,7 @@ import math
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -14,7 +14,7 @@ from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from config.schema import StackConfig
 from estimation.elastica import fast
 from estimation.stiffness import SampleSummary, summarize
-from palpate.executors import SerialExecutor
+from palpate.executors import SerialExecutor, process_pool
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
 
@@ -146,7 +146,7 @@ def run_campaigns(
 
     own: Executor | None = None
     if executor is None and workers > 1:
-        own = executor = ProcessPoolExecutor(max_workers=workers)
+        own = executor = process_pool(workers)
     try:
         if executor is None or isinstance(executor, SerialExecutor):
             outcomes = [done(i, _run_job(job)) for i, job in jobs]

@@ -25,9 +25,12 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     strain, shift = load_pairs_csv(args.file)
-    fit = fit_strain_coefficient(
-        strain, shift, confidence=args.confidence, through_origin=args.through_origin
-    )
+    try:
+        fit = fit_strain_coefficient(
+            strain, shift, confidence=args.confidence, through_origin=args.through_origin
+        )
+    except ValueError as exc:
+        raise ValueError(f"{args.file}: {exc}") from None
     if getattr(args, "json", False):
         print(json.dumps({"file": str(args.file), **fit.as_dict()}, indent=2))
         return 0

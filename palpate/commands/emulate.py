@@ -9,6 +9,7 @@ import logging
 import threading
 
 from config import load_stack
+from palpate.argtypes import positive_float
 from sensor.reader import layout_from_config
 from sim.board import BoardEmulator, constant_source
 from sim.dynamixel.bus import EmulatedBus
@@ -19,7 +20,10 @@ log = logging.getLogger(__name__)
 def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", default="robot.yaml", help="robot configuration YAML")
     parser.add_argument(
-        "--seconds", type=float, default=None, help="stop after this long (default: until Ctrl-C)"
+        "--seconds",
+        type=positive_float,
+        default=None,
+        help="stop after this long (default: until Ctrl-C)",
     )
 
 

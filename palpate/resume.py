@@ -1,0 +1,118 @@
+"""A campaign killed mid-way, resumed: the outcome of a finished trial read back from its log.
+
+A complete log (header, samples, estimate, end) holds everything a trial's row in the tables
+needs: the final state and reason, the marks, the paper's estimate and the joint fit (floats
+written at ``repr`` precision, so they read back bit for bit). What the log does not hold is
+recomputed exactly as the trial computed it (the IK residual from the spec's geometry, the
+exposed length at buckling from the marks). A log that is not complete, is damaged or belongs
+to another trial gives None: that trial runs again.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from config.schema import StackConfig
+from estimation.jointfit import JointFit
+from estimation.stiffness import StiffnessEstimate
+from palpate.runs import set_aside
+from palpate.simtrial import TrialOutcome, TrialSpec, trial_geometry
+from robot.indentation import TrialMarks
+from robot.trial.estimate import exposed_length_at
+from robot.trial.log import TrialLogError, read_log
+
+
+def resume_outcomes(
+    log_dir: Path, specs: list[TrialSpec], stack: StackConfig
+) -> dict[str, TrialOutcome]:
+    """The outcomes of ``specs`` whose logs in ``log_dir`` are complete, by trial id; a log
+    that cannot stand for its trial (killed mid-trial, damaged) is moved aside (``runs``)."""
+    done: dict[str, TrialOutcome] = {}
+    for spec in specs:
+        path = log_dir / f"{spec.trial_id}.jsonl"
+        if not path.exists():
+            continue
+        outcome = outcome_from_log(path, spec, stack)
+        if outcome is None:
+            set_aside(path)
+        else:
+            done[spec.trial_id] = outcome
+    return done
+
+
+def outcome_from_log(path: Path, spec: TrialSpec, stack: StackConfig) -> TrialOutcome | None:
+    """``spec``'s outcome as its trial returned it, from its log at ``path`` (``stack``: the
+    campaign's robot); None when the log cannot stand for the trial."""
+    try:
+        log = read_log(path)
+    except TrialLogError:
+        return None
+    end = log.end
+    estimate = next(log.of_kind("estimate"), None)
+    if not log.complete or log.bad_lines or end is None or estimate is None:
+        return None
+    if log.header.get("spec") != json.loads(json.dumps(dataclasses.asdict(spec))):
+        return None
+    try:
+        return _outcome(spec, stack, end, estimate, str(path))
+    except (KeyError, TypeError, ValueError):  # an altered log: run the trial again
+        return None
+
+
+def _outcome(
+    spec: TrialSpec, stack: StackConfig, end: dict[str, Any], estimate: dict[str, Any], path: str
+) -> TrialOutcome:
+    marks = _marks(end["marks"])
+    length = None
+    if marks.x_buckling is not None:
+        flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
+        length = exposed_length_at(spec.kind, marks.x_buckling, spec.exposed_length, flush)
+    duration = end["duration"]
+    return TrialOutcome(
+        spec=spec,
+        state=str(end["state"]),
+        reason=str(end["reason"]),
+        estimate=_paper(estimate),
+        exposed_length_at_buckling=length,
+        ik_residual=trial_geometry(stack, spec).residual,
+        ticks=int(end["ticks"]),
+        sim_time=math.nan if duration is None else float(duration),
+        log_path=path,
+        marks=marks,
+        joint=_joint(estimate["joint"]),
+    )
+
+
+def _marks(d: dict[str, Any]) -> TrialMarks:
+    names = {f.name for f in dataclasses.fields(TrialMarks)}
+    kwargs = {k: v for k, v in d.items() if k in names}
+    kwargs["strains_at_buckling"] = tuple(kwargs.get("strains_at_buckling") or ())
+    return TrialMarks(**kwargs)
+
+
+def _number(value: Any) -> float:
+    """A float written as null (JSON has no NaN) reads back as NaN."""
+    return math.nan if value is None else float(value)
+
+
+def _paper(record: dict[str, Any]) -> StiffnessEstimate | None:
+    if "modulus" not in record:  # "no buckling detected": the trial had no paper estimate
+        return None
+    return StiffnessEstimate(
+        success=bool(record["success"]),
+        modulus=record["modulus"],
+        delta=_number(record["delta"]),
+        force=_number(record["force"]),
+        message=str(record["message"]),
+    )
+
+
+def _joint(record: dict[str, Any]) -> JointFit:
+    names = {f.name for f in dataclasses.fields(JointFit)}
+    kwargs = {k: v for k, v in record.items() if k in names}
+    kwargs["warnings"] = tuple(kwargs.get("warnings") or ())
+    return JointFit(**kwargs)
