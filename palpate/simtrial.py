@@ -204,7 +204,7 @@ def run_sim_trial(
     on_tick = _series_recorder(world, series) if keep_series else None
     with _emulators(transport, stack, clock, world, hook) as (bus, board, servo_port, board_port):
         servos.bus = bus
-        driver = DynamixelBus.from_config(stack.servos, port=servo_port)
+        driver = DynamixelBus.from_config(_reply_timeout(stack, transport, hook), port=servo_port)
         reader = FrameReader.from_config(board_port, stack.sensor, stack.board, clock=clock)
         settings = _rig_settings(
             spec, scene, stack, fast_faults=hook is not None and transport == "fast"
@@ -225,6 +225,24 @@ def run_sim_trial(
                     log.write(end_record(result))
     log_path = None if log is None else str(log.path)
     return _outcome(spec, geo, result, estimate, log_path, series)
+
+
+SIM_REPLY_TIMEOUT_MS = 2000.0
+
+
+def _reply_timeout(
+    stack: StackConfig, transport: Transport, hook: EmulatorHook | None
+) -> ServoBusConfig:
+    """The servo bus as the driver sees it: over ptys the emulator answers from a thread that a
+    busy machine may not run for a while, so a reply may be late but is never lost, and a
+    generous timeout keeps the trial independent of the machine's load. With fault injection
+    (replies really lost) the configured timeout stands."""
+    servos = stack.servos
+    if transport == "wire" and hook is None:
+        servos = dataclasses.replace(
+            servos, timeout_ms=max(servos.timeout_ms, SIM_REPLY_TIMEOUT_MS)
+        )
+    return servos
 
 
 def _rig_settings(
