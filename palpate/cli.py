@@ -2,7 +2,7 @@
 
 Exit codes (a stable interface): 0 success (every trial ended as planned), 1 a fault (a trial
 faulted, hardware failed), 2 bad input (configuration, arguments, input files): see
-:func:`report_failure` and ``docs/exit-codes.md``.
+:func:`report_failure` and ``docs/reliability.md``.
 
 The table below names each subcommand's module and its one-line help, so ``palpate --help``
 imports none of them (nor numpy, scipy, ...): a command's module is imported only when that

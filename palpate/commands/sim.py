@@ -108,7 +108,7 @@ class _Campaign:
 
 def run(args: argparse.Namespace) -> int:
     """Exit 0 when every trial ended as planned (DONE), 1 when any did not (the tables are
-    printed all the same), 2 on bad input (see docs/exit-codes.md)."""
+    printed all the same), 2 on bad input (see docs/reliability.md)."""
     if args.faults:
         from palpate.faults import run_command
 
