@@ -14,7 +14,7 @@ import dataclasses
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from config.schema import StackConfig
 from estimation.jointfit import JointFit
@@ -24,6 +24,8 @@ from palpate.simtrial import TrialOutcome, TrialSpec, trial_geometry
 from robot.indentation import TrialMarks
 from robot.trial.estimate import exposed_length_at
 from robot.trial.log import TrialLogError, read_log
+
+T = TypeVar("T")
 
 
 def resume_outcomes(
@@ -87,11 +89,17 @@ def _outcome(
     )
 
 
-def _marks(d: dict[str, Any]) -> TrialMarks:
-    names = {f.name for f in dataclasses.fields(TrialMarks)}
-    kwargs = {k: v for k, v in d.items() if k in names}
-    kwargs["strains_at_buckling"] = tuple(kwargs.get("strains_at_buckling") or ())
-    return TrialMarks(**kwargs)
+def _from_record(cls: type[T], record: dict[str, Any], sequence: str) -> T:
+    """Dataclass ``cls`` from a record's fields of the same names (others ignored), the list
+    field ``sequence`` as the tuple the dataclass holds."""
+    names = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+    kwargs = {k: v for k, v in record.items() if k in names}
+    kwargs[sequence] = tuple(kwargs.get(sequence) or ())
+    return cls(**kwargs)
+
+
+def _marks(record: dict[str, Any]) -> TrialMarks:
+    return _from_record(TrialMarks, record, "strains_at_buckling")
 
 
 def _number(value: Any) -> float:
@@ -112,7 +120,4 @@ def _paper(record: dict[str, Any]) -> StiffnessEstimate | None:
 
 
 def _joint(record: dict[str, Any]) -> JointFit:
-    names = {f.name for f in dataclasses.fields(JointFit)}
-    kwargs = {k: v for k, v in record.items() if k in names}
-    kwargs["warnings"] = tuple(kwargs.get("warnings") or ())
-    return JointFit(**kwargs)
+    return _from_record(JointFit, record, "warnings")
