@@ -65,25 +65,14 @@ def test_sigkill_mid_trial_keeps_every_record_written(
     assert "truncated log" in capsys.readouterr().out
 
 
-HEADER = {  # the fields a reader relies on (robot.trial.logschema), nothing more
-    "trial": "x",
-    "spec": {"kind": "bench", "exposed_length": 0.042},
-    "section": {"EI": 1e-4, "EA": 1e4, "neutral_axis": 0.0, "fiber_offset": 1e-4,
-                "I_fiber": 1e-15, "I_wires": 1e-15},
-    "sensor": {},
-    "tube": None,
-    "poisson": 0.45,
-}  # fmt: skip
-SAMPLE = {"kind": "sample", "t": 0.0, "state": "idle", "advance": 0.0, "roll": 0.0,
-          "strains": [], "contact": False}  # fmt: skip
-
-
-def test_a_torn_last_line_is_counted_not_fatal(tmp_path: Path) -> None:
+def test_a_torn_last_line_is_counted_not_fatal(
+    tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
+) -> None:
     from robot.trial.log import TrialLogWriter
 
     path = tmp_path / "t.jsonl"
-    with TrialLogWriter(path, HEADER) as w:
-        w.write(SAMPLE)
+    with TrialLogWriter(path, {"trial": "x", **log_header}) as w:
+        w.write(log_sample)
         assert w.records == 2
     with path.open("a", encoding="utf-8") as fh:
         fh.write('{"kind": "sam')
@@ -95,13 +84,15 @@ def test_a_torn_last_line_is_counted_not_fatal(tmp_path: Path) -> None:
     assert not log.complete
 
 
-def test_a_bad_line_inside_is_damage_not_a_crash(tmp_path: Path) -> None:
+def test_a_bad_line_inside_is_damage_not_a_crash(
+    tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
+) -> None:
     from robot.trial.log import TrialLogWriter
 
     path = tmp_path / "t.jsonl"
-    with TrialLogWriter(path, HEADER) as w:
-        w.write({**SAMPLE, "advance": "abc"})
-        w.write(SAMPLE)
+    with TrialLogWriter(path, {"trial": "x", **log_header}) as w:
+        w.write({**log_sample, "advance": "abc"})
+        w.write(log_sample)
     log = read_log(path)
     assert log.damaged == ["line 2: sample.advance: expected a number or null, got 'abc'"]
     assert not log.torn_tail
