@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import operator
+import re
 import types
 import typing
 from collections.abc import Callable, Mapping
@@ -25,6 +26,18 @@ import yaml
 T = TypeVar("T")
 
 CONFIG_DIR = Path(__file__).resolve().parent
+
+
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader, reading ``1e9`` as the number it means: YAML 1.1 (PyYAML) wants a
+    dot in a float (``1.0e9``) and took ``1e9`` for a string; YAML 1.2 and JSON do not."""
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
 
 
 class ConfigError(ValueError):
@@ -205,12 +218,34 @@ def read_yaml(path: str | Path) -> Any:
     except OSError as exc:
         raise ConfigError(str(p), "", f"cannot read: {exc.strerror}") from None
     try:
-        return yaml.safe_load(text)
+        data = yaml.load(text, Loader=_Loader)  # a SafeLoader: no arbitrary objects
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
         problem = getattr(exc, "problem", exc)
         raise ConfigError(str(p), "", f"malformed YAML: {where}{problem}") from None
+    except RecursionError:
+        raise ConfigError(str(p), "", "malformed YAML: nested too deeply") from None
+    _check_size(data, str(p))
+    return data
+
+
+MAX_NODES = 100_000
+
+
+def _check_size(data: Any, source: str) -> None:
+    """Refuse a document whose aliases expand to more than ``MAX_NODES`` values (a "billion
+    laughs" file would make every later walk over it take forever)."""
+    stack, seen = [data], 0
+    while stack:
+        node = stack.pop()
+        seen += 1
+        if seen > MAX_NODES:
+            raise ConfigError(source, "", f"too large: more than {MAX_NODES} values once expanded")
+        if isinstance(node, dict):
+            stack.extend(node.values())
+        elif isinstance(node, list):
+            stack.extend(node)
 
 
 def load(cls: type[T], path: str | Path) -> T:

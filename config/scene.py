@@ -66,7 +66,9 @@ class CampaignConfig:
 
     kind: Literal["bench", "robot"] = "robot"
     samples: tuple[str, ...] = ()  # empty: every sample of the scene
-    exposed_lengths_mm: tuple[float, ...] = (42.0, 44.0, 46.0, 48.0, 50.0)  # bench-top
+    exposed_lengths_mm: tuple[float, ...] = field(  # bench-top; each as exposed_length_mm
+        default=(42.0, 44.0, 46.0, 48.0, 50.0), metadata=limits(gt=0, le=500)
+    )
     exposed_length_mm: float = field(default=42.0, metadata=limits(gt=0, le=500))  # robot
     tubes: tuple[str, ...] = ("straight", "bent15", "bent30", "bent50")
     orientations: tuple[Orientation, ...] = ("downward", "sideways", "upward")

@@ -35,8 +35,8 @@ from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from robot.trial.inputs import belief_fields
 from robot.trial.log import TrialLogWriter
-from robot.trial.record import end_record, estimate_record, header_common
-from robot.trial.run import run_trial
+from robot.trial.record import estimate_record, header_common
+from robot.trial.run import end_record, run_trial
 from robot.trial.setup import (
     detector_for,
     guards_for,

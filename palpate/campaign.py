@@ -8,7 +8,7 @@ import os
 import time
 import zlib
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,7 +19,7 @@ from config.schema import StackConfig
 from estimation.elastica import fast
 from estimation.stiffness import SampleSummary, summarize
 from palpate.calibration import calibrated, is_reference
-from palpate.executors import SerialExecutor
+from palpate.executors import SerialExecutor, process_pool
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
 
@@ -134,6 +134,9 @@ class CampaignRun:
     transport: Transport = "fast"
     log_dir: Path | None = None
     series_for: str | None = None  # the trial whose force/strain series is kept for the plot
+    # trials of this campaign already done (read back by ``--resume``): their reference trials
+    # calibrate the rest as if they had run now
+    prior: Sequence[TrialOutcome] = ()
 
 
 @dataclass(frozen=True)
@@ -167,7 +170,7 @@ def run_campaigns(
 
     own: Executor | None = None
     if executor is None and workers > 1:
-        own = executor = ProcessPoolExecutor(max_workers=workers)
+        own = executor = process_pool(workers)
     results: dict[str, TrialOutcome] = {}
     try:
         first = [(i, r, s) for i, r in enumerate(runs) for s in r.specs if is_reference(r.scene, s)]
@@ -175,7 +178,10 @@ def run_campaigns(
             results[f"{i}/{spec.trial_id}"] = out
         stacks = [
             calibrated(
-                r.scene, r.stack, [results[f"{i}/{s.trial_id}"] for j, _, s in first if j == i]
+                r.scene,
+                r.stack,
+                [results[f"{i}/{s.trial_id}"] for j, _, s in first if j == i]
+                + [o for o in r.prior if is_reference(r.scene, o.spec)],
             )
             for i, r in enumerate(runs)
         ]

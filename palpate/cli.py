@@ -1,6 +1,8 @@
 """``palpate`` console script: a static table of subcommands, each in its own module.
 
-Exit codes (a stable interface): 0 success, 2 bad input (configuration, arguments), 1 a fault.
+Exit codes (a stable interface): 0 success (every trial ended as planned), 1 a fault (a trial
+faulted, hardware failed), 2 bad input (configuration, arguments, input files): see
+:func:`report_failure` and ``docs/reliability.md``.
 
 The table below names each subcommand's module and its one-line help, so ``palpate --help``
 imports none of them (nor numpy, scipy, ...): a command's module is imported only when that
@@ -250,15 +252,39 @@ def main(argv: Sequence[str] | None = None) -> int:
     configure_logging(args.verbose, args.quiet)
     try:
         return int(args._module.run(args) or EXIT_OK)
-    except (ValueError, FileNotFoundError) as exc:
-        from config.loader import ConfigError
-
-        kind = "bad configuration" if isinstance(exc, ConfigError) else "bad input"
-        log.error("palpate: %s: %s", kind, exc)
-        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         log.error("palpate: interrupted")
         return EXIT_FAULT
+    except Exception as exc:  # the one mapping of errors to messages and exit codes
+        return report_failure(exc)
+
+
+def report_failure(exc: Exception) -> int:
+    """One line on stderr and the exit code for an error that ended a command:
+
+    - bad input, exit 2: a configuration error (file and key), any other ``ValueError`` (the
+      commands raise it naming the file and key or line, or the option), and a file that cannot
+      be read or written (an ``OSError`` that names a file: missing, a directory, no permission);
+    - anything else is a fault, exit 1: a hardware error the command did not handle, or a bug
+      (``internal error``; ``-v`` shows the traceback). No input a user can give should get here:
+      the fuzz targets (``palpate bench --only fuzz``) check that."""
+    from config.loader import ConfigError
+
+    if isinstance(exc, ConfigError):
+        log.error("palpate: bad configuration: %s", exc)
+        return EXIT_BAD_INPUT
+    if isinstance(exc, ValueError):
+        log.error("palpate: bad input: %s", exc)
+        return EXIT_BAD_INPUT
+    if isinstance(exc, OSError) and exc.filename is not None:
+        log.error("palpate: bad input: %s: %s", exc.filename, exc.strerror or exc)
+        return EXIT_BAD_INPUT
+    if isinstance(exc, OSError):
+        log.error("palpate: fault: %s", exc)
+        return EXIT_FAULT
+    log.error("palpate: internal error (a bug; -v shows where): %s: %s", type(exc).__name__, exc)
+    log.debug("traceback of the internal error", exc_info=exc)
+    return EXIT_FAULT
 
 
 if __name__ == "__main__":

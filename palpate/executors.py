@@ -9,6 +9,9 @@
   running cluster; without, it starts a local one with ``workers`` worker processes. Dask is an
   optional extra (``pip install 'palpate[dask]'``), imported only when asked for.
 
+Local pool workers die with the process that started them (:func:`process_pool`): a campaign
+killed with SIGKILL leaves no worker behind waiting forever on its pipe.
+
 No scheduling of our own: every backend is an Executor, ``palpate.campaign.run_campaign``
 submits one job per trial and each trial is seeded by its spec, so results do not depend on
 which executor ran them.
@@ -18,12 +21,46 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import ctypes
 import importlib
+import os
+import signal
+import sys
+import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
 from typing import Any, TypeVar
 
 T = TypeVar("T")
+
+_PR_SET_PDEATHSIG = 1  # linux/prctl.h
+_WATCH_PERIOD_S = 0.5
+
+
+def die_with_parent(parent: int) -> None:
+    """Pool worker initializer: end this worker when process ``parent`` (the one that started
+    the pool) dies, however it dies. On Linux the kernel sends SIGKILL (``PR_SET_PDEATHSIG``);
+    elsewhere a thread watches the parent's pid."""
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+            if os.getppid() != parent:  # the parent died before the request took effect
+                os._exit(1)
+            return
+    threading.Thread(target=_watch_parent, args=(parent,), name="parent-watch", daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        threading.Event().wait(_WATCH_PERIOD_S)
+    os._exit(1)
+
+
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A local process pool whose workers die with this process (:func:`die_with_parent`)."""
+    return ProcessPoolExecutor(
+        max_workers=workers, initializer=die_with_parent, initargs=(os.getpid(),)
+    )
 
 
 class ExecutorUnavailableError(ValueError):
@@ -58,7 +95,7 @@ def _processes(workers: int, scheduler: str | None) -> Iterator[Executor]:
     if workers == 1:  # a pool of one process only adds start-up and pickling
         yield SerialExecutor()
         return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with process_pool(workers) as pool:
         yield pool
 
 

@@ -10,10 +10,13 @@ values and shown, the report says so (``note``), and only the paper's estimate i
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from config.loader import from_mapping
 from config.schema import SensorConfig, StackConfig, TubeConfig
@@ -26,12 +29,19 @@ from robot.trial.estimate import (
     verdict_for,
 )
 from robot.trial.inputs import VERSION
-from robot.trial.log import TrialLog, read_log
+from robot.trial.log import TrialLog, TrialLogError, read_log
 from robot.trial.record import estimator_keys
+
+MAX_PROBLEMS = 5  # bad lines named in the message (all are counted)
 
 
 def replay(path: Path) -> dict[str, Any]:
-    """Recompute the estimate from a log; raises TrialLogError (a ValueError) if unreadable."""
+    """Recompute the estimates from a log and compare them with the recorded ones.
+
+    Raises TrialLogError (a ValueError) when the file is not a trial log or its header is
+    wrong. A log with bad lines (beyond a last line cut short by a crash) is reported as
+    ``damaged`` with the lines and what is wrong with them, and not replayed; a log without its
+    end record as truncated."""
     log = read_log(path)
     h = log.header
     report: dict[str, Any] = {
@@ -40,7 +50,17 @@ def replay(path: Path) -> dict[str, Any]:
         "complete": log.complete,
         "bad_lines": log.bad_lines,
         "records": len(log.records),
+        "problems": log.problems[:MAX_PROBLEMS],
     }
+    if log.damaged:
+        report["damaged"] = True
+        more = len(log.damaged) - MAX_PROBLEMS
+        report["message"] = (
+            f"damaged log: {len(log.damaged)} bad line(s): "
+            + "; ".join(log.damaged[:MAX_PROBLEMS])
+            + (f"; and {more} more" if more > 0 else "")
+        )
+        return report
     end = log.end
     if end is None:
         transitions = list(log.of_kind("transition"))
@@ -50,8 +70,18 @@ def replay(path: Path) -> dict[str, Any]:
             "no estimate can be reproduced"
         )
         return report
+    try:
+        _replay_complete(log, end, report)
+    except (ArithmeticError, np.linalg.LinAlgError) as exc:  # well-formed, physically absurd
+        raise TrialLogError(f"{path}: values out of the estimators' range ({exc})") from None
+    return report
+
+
+def _replay_complete(log: TrialLog, end: dict[str, Any], report: dict[str, Any]) -> None:
+    """Both estimates from a complete, well-formed log, compared with the recorded ones."""
+    h, path = log.header, log.path
     sensor = from_mapping(SensorConfig, _tuples(h["sensor"]), str(path), "sensor")
-    section = Section(**h["section"])
+    section = Section(**{f.name: h["section"][f.name] for f in dataclasses.fields(Section)})
     spec = h["spec"]
     marks = end["marks"]
     x_b = marks.get("x_buckling")
@@ -61,6 +91,8 @@ def replay(path: Path) -> dict[str, Any]:
         if spec["kind"] == "robot":
             flush = from_mapping(TubeConfig, h["tube"], str(path), "tube").flush_translation
         length = exposed_length_at(spec["kind"], x_b, spec["exposed_length"], flush)
+        if not length > 0:
+            raise TrialLogError(f"{path}: end.marks.x_buckling: exposed length {length} m <= 0")
     stack = StackConfig(sensor=sensor)
     est = estimate_from_marks(
         marks.get("x_contact"),
@@ -86,7 +118,6 @@ def replay(path: Path) -> dict[str, Any]:
         modulus is not None and rec is not None and math.isclose(modulus, rec, rel_tol=0, abs_tol=0)
     )
     report["identical"] = paper_same and _replay_joint(log, stack, section, report)
-    return report
 
 
 def _replay_joint(

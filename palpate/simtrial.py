@@ -37,8 +37,8 @@ from robot.dynamixel.driver import DynamixelBus
 from robot.indentation import Observation, State, TrialPlan
 from robot.rig import RigSettings, ServoFbgRig
 from robot.trial.log import TrialLogWriter
-from robot.trial.record import end_record, estimate_record, header_common
-from robot.trial.run import run_trial
+from robot.trial.record import estimate_record, header_common
+from robot.trial.run import end_record, run_trial
 from robot.trial.setup import (
     detector_for,
     guards_for,
@@ -170,11 +170,15 @@ def run_sim_trial(
     with _emulators(transport, stack, clock, world, hook, timing) as emulators:
         bus, board, servo_port, handler, board_port = emulators
         servos.bus = bus
-        driver = DynamixelBus.from_config(stack.servos, port=servo_port, packet_handler=handler)
+        driver = DynamixelBus.from_config(
+            _reply_timeout(stack, transport, hook), port=servo_port, packet_handler=handler
+        )
         reader = FrameReader.from_config(board_port, stack.sensor, stack.board, clock=clock)
         settings = _rig_settings(
             spec, scene, stack, fast_faults=hook is not None and transport == "fast"
         )
+        # the rig waits each tick for exactly what the board has sent, never for a frame not sent
+        settings = dataclasses.replace(settings, sent_bytes=lambda: board.stats.bytes_sent)
         with DriveController(driver, stack.drive) as drive, reader:
             board.start()
             rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
@@ -189,13 +193,16 @@ def run_sim_trial(
                     rig, clock, plan, guards, detector, log, on_tick=on_tick, prober=prober
                 )
                 estimate = estimate_sim_trial(result, spec, scene, stack, geo)
+                indentation = world.indentation
+                truth = None if indentation is None else indentation.misalignment
                 if log is not None:
+                    # the world's truth the controller never sees, for the report (and --resume)
+                    log.write({"kind": "world", "true_misalignment": truth})
                     log.write(estimate_record(estimate))
                     log.write(end_record(result))
     log_path = None if log is None else str(log.path)
     outcome = outcome_of(spec, geo, result, estimate, log_path, series)
-    indentation = world.indentation
-    outcome.true_misalignment = None if indentation is None else indentation.misalignment
+    outcome.true_misalignment = truth
     return outcome
 
 
@@ -205,6 +212,24 @@ def bus_timing(fidelity: FidelityConfig, servos: ServoBusConfig) -> BusTiming | 
         return None
     baud = fidelity.bus_baudrate if fidelity.bus_baudrate is not None else servos.baudrate
     return BusTiming(baudrate=baud, latency_timer_s=fidelity.latency_timer_ms * 1e-3)
+
+
+SIM_REPLY_TIMEOUT_MS = 2000.0
+
+
+def _reply_timeout(
+    stack: StackConfig, transport: Transport, hook: EmulatorHook | None
+) -> ServoBusConfig:
+    """The servo bus as the driver sees it: over ptys the emulator answers from a thread that a
+    busy machine may not run for a while, so a reply may be late but is never lost, and a
+    generous timeout keeps the trial independent of the machine's load. With fault injection
+    (replies really lost) the configured timeout stands."""
+    servos = stack.servos
+    if transport == "wire" and hook is None:
+        servos = dataclasses.replace(
+            servos, timeout_ms=max(servos.timeout_ms, SIM_REPLY_TIMEOUT_MS)
+        )
+    return servos
 
 
 def _rig_settings(

@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -44,9 +45,13 @@ class RigSettings:
     # FBG contact reads the axial strain with the bow of a not-quite-straight beam taken out.
     # None: the mean strain (right for a straight beam only).
     fbg_bending_mode: tuple[float, ...] | None = None
-    sync_to_clock: bool = False  # simulation: wait for the frame of the current clock time
+    # Simulation: before using a tick's frames, wait until what the emulator has sent up to the
+    # current clock time has come through the transport (``sent_bytes``: the bytes it has put on
+    # the wire so far; without it, the frame due by ``frame_period`` after the last one).
+    sync_to_clock: bool = False
+    sent_bytes: Callable[[], int] | None = None
     frame_period: float = 1e-3  # s between board frames
-    frame_wait_s: float = 0.2  # real-time bound on that wait
+    frame_wait_s: float = 2.0  # real-time bound on that wait (it never waits for a frame not sent)
     roll_speed: float = math.radians(90.0)  # rad/s for roll goals
 
 
@@ -82,10 +87,13 @@ class ServoFbgRig:
     def zero(self, samples: int = 20) -> StrainChain:
         """Capture the strain baseline at rest over ``samples`` frames (the sensor is free)."""
         frames: list[Frame] = []
+        # Sleep first: a stream that has just started has no frame due yet (and, synchronised
+        # to the clock, sleep a frame period at least, so that one is due).
+        pause = self.settings.tick
+        if self.settings.sync_to_clock:
+            pause = max(pause, self.settings.frame_period)
         for _ in range(samples * 10):
-            # Sleep first: a stream that has just started has no frame due yet, and waiting for
-            # one would only spin until the real-time bound.
-            self.clock.sleep(self.settings.tick)
+            self.clock.sleep(pause)
             frames += self._receive()
             if len(frames) >= samples:
                 break
@@ -116,10 +124,9 @@ class ServoFbgRig:
             fault = f"bus transport: {exc}"
             lost = True
         joints = self._joints or JointState(math.nan, math.nan)
-        try:
-            frames = self._receive()
-        except SensorPortError:
-            frames = []
+        # A lost board port is not an error here: the reader counts it and reopens the port,
+        # the stream goes stale, and the state machine's FBG-lost guard decides.
+        frames = self._receive()
         if frames:
             self._frame = frames[-1]
             self._frame_t = t
@@ -200,19 +207,29 @@ class ServoFbgRig:
     # -- helpers -----------------------------------------------------------------------------
     def _receive(self) -> list[Frame]:
         """Frames that arrived since the last call. With ``sync_to_clock`` (simulation) wait, up
-        to ``frame_wait_s`` of real time, until the frame stamped at the current clock time has
-        come through the transport, so every path sees the same frames each tick."""
+        to ``frame_wait_s`` of real time, until what the emulator sent up to the current clock
+        time has come through the transport, so every path sees the same frames each tick."""
         frames = self.reader.poll()
         if self.settings.sync_to_clock:
-            due = self.clock.now() - self.settings.frame_period * 0.5
             deadline = time.monotonic() + self.settings.frame_wait_s
-            while (not frames or frames[-1].time < due) and time.monotonic() < deadline:
-                last = self.reader.last_frame
-                if last is not None and last.time >= due:
-                    break
+            while self._behind() and self.reader.connected and time.monotonic() < deadline:
                 frames += self.reader.read()
         self.frames += frames
         return frames
+
+    def _behind(self) -> bool:
+        """Simulation: has the emulator sent something the reader has not received yet?"""
+        sent = self.settings.sent_bytes
+        if sent is not None:
+            return self.reader.counters.bytes_received < sent()
+        # Without the emulator's count: the frame after the newest received is due if its time
+        # (one frame period on) has come. The timestamps are whole microseconds, so the time is
+        # known to half a microsecond; a frame the emulator holds back because its true time
+        # is later than now (by more than its 0.1 us slack) is not waited for.
+        last = self.reader.last_frame
+        if last is None:
+            return True
+        return last.time + self.settings.frame_period <= self.clock.now() + 0.5e-6
 
 
 def _clamp(x: float, limit: float) -> float:

@@ -84,6 +84,21 @@ def fit_strain_coefficient(
     n = x.shape[0]
     if n <= params:
         raise ValueError(f"need more than {params} points, got {n}")
+    try:  # absurd values (1e300) overflow the sums of squares: an input error, not k = 0
+        with np.errstate(over="raise", invalid="raise"):
+            return _fit(x, y, confidence, through_origin, n - params)
+    except FloatingPointError:
+        raise ValueError(
+            "strain and shift values out of range (the fit overflows): "
+            f"|strain| up to {np.max(np.abs(x)):.3g}, |shift| up to {np.max(np.abs(y)):.3g} m"
+        ) from None
+
+
+def _fit(
+    x: np.ndarray, y: np.ndarray, confidence: float, through_origin: bool, dof: int
+) -> CalibrationFit:
+    """The least-squares line and its interval (see :func:`fit_strain_coefficient`)."""
+    n = x.shape[0]
     if through_origin:
         sxx = float(x @ x)
         if sxx == 0:
@@ -101,11 +116,12 @@ def fit_strain_coefficient(
         ss_tot = float((y - ym) @ (y - ym))
     resid = y - (k * x + intercept)
     ss_res = float(resid @ resid)
-    dof = n - params
     s2 = ss_res / dof
     se = math.sqrt(s2 / sxx)
     t = float(stdtrit(dof, 0.5 + confidence / 2))  # Student's t quantile
     r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0
+    if not all(math.isfinite(v) for v in (k, intercept, se, r2)):
+        raise FloatingPointError("non-finite fit")
     return CalibrationFit(
         k_eps=k,
         ci=(k - t * se, k + t * se),
@@ -124,9 +140,19 @@ def load_pairs_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     ValueError names the file and, where it applies, the line.
     """
     p = Path(path)
-    with p.open(newline="", encoding="utf-8") as fh:
-        lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
-    rows = list(csv.reader(lines))
+    try:
+        with p.open(newline="", encoding="utf-8") as fh:
+            lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    except UnicodeDecodeError as exc:
+        raise ValueError(
+            f"{p}: not a text (UTF-8) file: {exc.reason} at byte {exc.start}"
+        ) from None
+    except OSError as exc:
+        raise ValueError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    try:
+        rows = list(csv.reader(lines))
+    except csv.Error as exc:  # a NUL byte, an unterminated quote at the end
+        raise ValueError(f"{p}: not a CSV file: {exc}") from None
     if not rows:
         raise ValueError(f"{p}: empty file")
     head = [h.strip() for h in rows[0]]

@@ -8,6 +8,17 @@ from __future__ import annotations
 
 import errno
 
+try:  # POSIX: pyserial lets termios.error (not an OSError) through from tcflush and tcsetattr
+    import termios
+
+    PORT_ERRORS: tuple[type[Exception], ...] = (OSError, termios.error)
+except ImportError:  # pragma: no cover - Windows
+    PORT_ERRORS = (OSError,)
+"""What a serial port raises when it fails under its user (pyserial's SerialException is an
+OSError): an unplugged device, a pty whose other end closed."""
+OPEN_ERRORS: tuple[type[Exception], ...] = (*PORT_ERRORS, ValueError)
+"""What opening a serial port raises when it cannot (ValueError: a malformed pyserial URL)."""
+
 DIALOUT_HINT = (
     "permission denied: add your user to the 'dialout' group "
     "(sudo usermod -aG dialout $USER, then log out and in again) or give the device to that "

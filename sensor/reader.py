@@ -16,10 +16,19 @@ Rejection accounting (each rejected candidate increments exactly one counter):
 After a rejection the parser hunts for the next sync word one byte further on, so a valid frame
 that begins inside rejected bytes is still found. While hunting, bytes that hold no sync word
 are only counted in ``bytes_discarded``.
+
+A port that fails under the reader (end of file, ``EIO``, pyserial's "device reports readiness
+to read but returned no data": a board unplugged, a pty whose master closed) is a transient, not
+an error: the reader counts it (``port_errors``), closes the port and opens it again with a
+back-off on its clock (``reopens`` counts the successes), and meanwhile returns no frames. The
+stream then goes stale, and what to do about a stale stream is the caller's decision (the trial's
+FBG-lost guard). Only opening the port in the first place raises :class:`SensorPortError`.
 """
 
 from __future__ import annotations
 
+import contextlib
+import threading
 import time
 import zlib
 from dataclasses import asdict, dataclass
@@ -30,10 +39,11 @@ import serial
 
 from config.schema import BoardConfig, SensorConfig
 from sensor.clock import Clock, SystemClock
-from sensor.ports import open_failure
+from sensor.ports import OPEN_ERRORS, PORT_ERRORS, open_failure
 from wire.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
 
 SEQ_MOD = 2**32
+REOPEN_BACKOFF_S = (0.01, 1.0)  # first and longest wait between attempts to reopen a lost port
 
 
 class SensorPortError(OSError):
@@ -72,6 +82,8 @@ class ReaderCounters:
     frames_lost: int = 0
     out_of_order: int = 0
     stale_events: int = 0
+    port_errors: int = 0  # reads that failed (EOF, EIO, no data behind readiness): port lost
+    reopens: int = 0  # times a lost port was opened again
 
     def as_dict(self) -> dict[str, int]:
         return asdict(self)
@@ -186,9 +198,9 @@ class FrameReader:
 
     ``port`` is a device path, a pty path, a pyserial URL (``loop://``), or an open serial object
     (then the caller keeps ownership of its settings; the reader still closes it).
-    ``clock`` stamps arrivals for stale detection (:class:`SystemClock` by default; pass the
-    simulator's virtual clock in simulation). ``read_timeout_s`` bounds one blocking read on the
-    real transport.
+    ``clock`` stamps arrivals for stale detection and times the reopening back-off
+    (:class:`SystemClock` by default; pass the simulator's virtual clock in simulation).
+    ``read_timeout_s`` bounds one blocking read on the real transport.
     """
 
     def __init__(
@@ -206,10 +218,14 @@ class FrameReader:
         self.layout = layout
         self.clock: Clock = clock if clock is not None else SystemClock()
         self.stale_timeout_s = stale_timeout_s
+        self.read_timeout_s = read_timeout_s
         self.counters = ReaderCounters()
         self._parser = FrameParser(layout, self.counters)
+        self._baudrate = baudrate
+        self._path: str | None = None
         if isinstance(port, str):
             self.port_name = port
+            self._path = port
             self._serial: SerialLike = _open(port, baudrate, read_timeout_s)
         else:
             self.port_name = str(getattr(port, "port", None) or getattr(port, "name", "") or port)
@@ -221,6 +237,12 @@ class FrameReader:
         self._last_arrival = self.clock.now()
         self._stale = False
         self.last_frame: Frame | None = None
+        self._connected = True
+        self._closed = False
+        self._reopen_at = 0.0
+        self._backoff = REOPEN_BACKOFF_S[0]
+        self._idle = threading.Event()  # never set: a bounded wait while the port is down
+        self.last_port_error = ""
 
     @classmethod
     def from_config(
@@ -241,27 +263,36 @@ class FrameReader:
     # -- reading -------------------------------------------------------------------------
 
     def poll(self) -> list[Frame]:
-        """Parse whatever bytes are already waiting; never blocks."""
+        """Parse whatever bytes are already waiting; never blocks, never raises on a lost
+        port (it is counted and reopened later)."""
         if self._frames_in is not None:
             return self._arrived(self._parser.accept(self._frames_in.take_frames()))
+        if not self._usable():
+            return self._ingest(b"")
         try:
             waiting = self._serial.in_waiting
             data = self._serial.read(waiting) if waiting else b""
-        except (serial.SerialException, OSError) as exc:
-            raise SensorPortError(f"board port {self.port_name!r}: read failed: {exc}") from exc
+        except PORT_ERRORS as exc:
+            self._lost(exc)
+            data = b""
         return self._ingest(data)
 
     def read(self) -> list[Frame]:
-        """Block up to the read timeout for the first byte, then parse all that is waiting."""
+        """Block up to the read timeout for the first byte, then parse all that is waiting.
+        While the port is lost (and not yet reopened) wait that long and return nothing."""
         if self._frames_in is not None:  # in memory: there is nothing to wait for
             return self.poll()
+        if not self._usable():
+            self._idle.wait(self.read_timeout_s)
+            return self._ingest(b"")
         try:
             data = self._serial.read(max(1, self._serial.in_waiting))
             waiting = self._serial.in_waiting
             if data and waiting:
                 data += self._serial.read(waiting)
-        except (serial.SerialException, OSError) as exc:
-            raise SensorPortError(f"board port {self.port_name!r}: read failed: {exc}") from exc
+        except PORT_ERRORS as exc:
+            self._lost(exc)
+            data = b""
         return self._ingest(data)
 
     def read_frames(self, count: int, timeout_s: float) -> list[Frame]:
@@ -288,9 +319,57 @@ class FrameReader:
             self._last_arrival = self.clock.now()
             self._stale = False
             self.last_frame = frames[-1]
+            self._backoff = REOPEN_BACKOFF_S[0]
         else:
             self.check_stale()
         return frames
+
+    # -- a lost port ---------------------------------------------------------------------
+
+    @property
+    def connected(self) -> bool:
+        """False from a failed read until the port has been opened again."""
+        return self._connected
+
+    def _lost(self, exc: BaseException) -> None:
+        """A read failed: count it, close the port, try to reopen it at the next call."""
+        self.counters.port_errors += 1
+        self.last_port_error = f"{type(exc).__name__}: {exc}"
+        if self._connected:
+            self._connected = False
+            self._retry_later()
+            with contextlib.suppress(Exception):
+                self._serial.close()
+
+    def _retry_later(self) -> None:
+        """The next reopening attempt after the back-off, which doubles each time (up to its
+        limit) until frames flow again."""
+        self._reopen_at = self.clock.now() + self._backoff
+        self._backoff = min(2 * self._backoff, REOPEN_BACKOFF_S[1])
+
+    def _usable(self) -> bool:
+        """Connected, or reopened now (when the back-off allows an attempt)."""
+        if self._connected:
+            return True
+        if self._closed or self.clock.now() < self._reopen_at:
+            return False
+        try:
+            self._reopen()
+        except OPEN_ERRORS as exc:
+            self.last_port_error = f"reopen: {exc}"
+            self._retry_later()
+            return False
+        self._connected = True
+        self.counters.reopens += 1
+        return True
+
+    def _reopen(self) -> None:
+        if self._path is not None:
+            self._serial = _open(self._path, self._baudrate, self.read_timeout_s)
+            return
+        opener = getattr(self._serial, "open", None)  # a pyserial object opens its port again
+        if callable(opener) and not getattr(self._serial, "is_open", False):
+            opener()
 
     # -- stream health -------------------------------------------------------------------
 
@@ -312,6 +391,7 @@ class FrameReader:
     # -- lifetime ------------------------------------------------------------------------
 
     def close(self) -> None:
+        self._closed = True
         self._serial.close()
 
     def __enter__(self) -> FrameReader:
@@ -329,5 +409,5 @@ class FrameReader:
 def _open(port: str, baudrate: int, timeout_s: float) -> SerialLike:
     try:
         return serial.serial_for_url(port, baudrate=baudrate, timeout=timeout_s)
-    except (serial.SerialException, OSError, ValueError) as exc:
+    except OPEN_ERRORS as exc:
         raise SensorPortError(open_failure("board", port, exc)) from exc

@@ -8,6 +8,7 @@ import json
 import logging
 from pathlib import Path
 
+from palpate.argtypes import non_negative_int
 from palpate.benchmarks import SECTIONS
 from palpate.benchmarks.report import BenchContext, BenchSection
 
@@ -20,7 +21,9 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--quick", action="store_true", help="fewer repeats and a coarser grid")
     parser.add_argument("--out", type=Path, default=Path("out/bench"), help="folder for plots")
-    parser.add_argument("--seed", type=int, default=0, help="seed of every random draw")
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="seed of every random draw"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -65,9 +65,12 @@ def run(args: argparse.Namespace) -> int:
     path = files[0]
     if path.suffix.lower() == ".csv":
         strain, shift = load_pairs_csv(path)
-        fit = fit_strain_coefficient(
-            strain, shift, confidence=args.confidence, through_origin=args.through_origin
-        )
+        try:
+            fit = fit_strain_coefficient(
+                strain, shift, confidence=args.confidence, through_origin=args.through_origin
+            )
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
     else:
         stack = load_stack(args.config)
         length = (args.exposed_length_mm or stack.sensor.exposed_length_mm) * MM

@@ -25,6 +25,7 @@ from estimation.design import (
     DesignSpace,
     design_sensor,
 )
+from palpate.argtypes import non_negative_int, positive_int
 from palpate.campaign import campaign_trials, default_workers
 from palpate.designcheck import (
     METHODS,
@@ -106,8 +107,10 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--scene", type=Path, help="scene YAML whose fidelity and campaign settings the check uses"
     )
-    parser.add_argument("--moduli", type=int, default=4, help="phantoms across the range")
-    parser.add_argument("--lengths", type=int, default=2, help="exposed lengths per phantom")
+    parser.add_argument("--moduli", type=positive_int, default=4, help="phantoms across the range")
+    parser.add_argument(
+        "--lengths", type=positive_int, default=2, help="exposed lengths per phantom"
+    )
     parser.add_argument(
         "--contact-uncertainty-mm",
         type=float,
@@ -115,11 +118,11 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="contact-detection error (1 sigma) in the simulated campaign",
     )
     parser.add_argument(
-        "--seed", type=int, default=0, help="makes the simulated check reproducible"
+        "--seed", type=non_negative_int, default=0, help="makes the simulated check reproducible"
     )
     parser.add_argument(
         "--workers",
-        type=int,
+        type=positive_int,
         default=default_workers(),
         help="trials of the check run in parallel (processes, threads or local Dask workers)",
     )
@@ -223,7 +226,7 @@ def run(args: argparse.Namespace) -> int:
         _print(result, constraints, args, outcomes, wall)
     if not result.success:
         return EXIT_NO_DESIGN
-    if outcomes and all(o.state != "done" for o in outcomes):
+    if any(o.state != "done" for o in outcomes):  # a trial of the check faulted
         return 1
     return 0
 

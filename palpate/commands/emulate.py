@@ -21,6 +21,7 @@ from typing import Any
 from config import load, load_stack, resolve
 from config.bench import load_bench
 from config.scene import SceneConfig
+from palpate.argtypes import positive_float
 from palpate.simbench import SimulatedBench, stations_for
 from sensor.reader import layout_from_config
 from sim.board import BoardEmulator, constant_source
@@ -45,7 +46,10 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seed", type=int, default=0, help="seed of the emulated FBG noise")
     parser.add_argument(
-        "--seconds", type=float, default=None, help="stop after this long (default: until Ctrl-C)"
+        "--seconds",
+        type=positive_float,
+        default=None,
+        help="stop after this long (default: until Ctrl-C)",
     )
 
 

@@ -1,4 +1,9 @@
-"""Re-run the estimation on a recorded trial log and compare with what the trial reported."""
+"""Re-run the estimation on a recorded trial log and compare with what the trial reported.
+
+Exit 0 when both estimates are reproduced exactly; 1 when they differ or the log is truncated (a
+trial killed while it ran: its records are kept, there is no estimate to reproduce); 2 when the
+file is not a trial log or has lines that do not follow the format (each named with its line
+number and the field that is wrong)."""
 
 from __future__ import annotations
 
@@ -21,8 +26,12 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(str(exc)) from None
     if args.json:
         print(json.dumps(report, indent=2))
+        if report.get("damaged"):
+            return 2
     else:
         print(f"trial {report['trial']} ({report['log']})")
+        if report.get("damaged"):  # bad input: lines that do not follow the log format
+            raise ValueError(f"{args.log}: {report['message']}")
         if "message" in report:
             print(report["message"])
             return 1

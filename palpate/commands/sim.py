@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -11,6 +13,7 @@ from pathlib import Path
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import StackConfig
+from palpate.argtypes import non_negative_int, positive_int
 from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.campaign import (
     CampaignRun,
@@ -20,12 +23,17 @@ from palpate.campaign import (
     run_campaigns,
     summarize_campaign,
 )
+from palpate.cli import EXIT_FAULT, EXIT_OK
 from palpate.executors import add_executor_arguments, open_executor
 from palpate.preflight import check_campaign, check_reachable
 from palpate.progress import progress_bar
+from palpate.resume import resume_outcomes
+from palpate.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec
 from palpate.simworld import tissue_description
 from palpate.verdicts import Tally, by_sample, summary_lines, tally
+
+log = logging.getLogger(__name__)
 
 CAMPAIGNS = {"robot": ("robot",), "bench": ("bench",), "paper": ("bench", "robot")}
 
@@ -38,13 +46,18 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="a shipped scene; paper: both (bench then robot) through one pool",
     )
     parser.add_argument("--scene", type=Path, help="a scene YAML (overrides --campaign)")
-    parser.add_argument("--seed", type=int, default=0, help="makes the run reproducible")
     parser.add_argument(
-        "--out", type=Path, default=Path("out/sim"), help="folder for the logs and plots"
+        "--seed", type=non_negative_int, default=0, help="makes the run reproducible"
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("out/sim"),
+        help="each run writes its logs and plots to a new folder OUT/<scene>/<date-time>/",
     )
     parser.add_argument(
         "--workers",
-        type=int,
+        type=positive_int,
         default=default_workers(),
         help="trials run in parallel (processes, threads or local Dask workers)",
     )
@@ -52,7 +65,13 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--wire", action="store_true", help="servos and board over ptys (the hardware path)"
     )
-    parser.add_argument("--limit", type=int, help="run only the first N trials")
+    parser.add_argument("--limit", type=positive_int, help="run only the first N trials")
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the newest run of the same command under --out (a run killed mid-way): "
+        "its complete trials are read from their logs, the rest run",
+    )
     parser.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
     parser.add_argument(
         "--faults",
@@ -82,13 +101,23 @@ class _Campaign:
     scene: SceneConfig
     stack: StackConfig
     specs: list[TrialSpec]
-    log_dir: Path
     transport: Transport
+    run_dir: Path = Path()
+    done: dict[str, TrialOutcome] = field(default_factory=dict)  # read back on --resume
     outcomes: list[TrialOutcome] = field(default_factory=list)
     wall: float = 0.0
 
+    @property
+    def log_dir(self) -> Path:
+        return self.run_dir / "logs"
+
+    def to_run(self) -> list[TrialSpec]:
+        return [s for s in self.specs if s.trial_id not in self.done]
+
 
 def run(args: argparse.Namespace) -> int:
+    """Exit 0 when every trial ended as planned (DONE), 1 when any did not (the tables are
+    printed all the same), 2 on bad input (see docs/reliability.md)."""
     if args.faults:
         from palpate.faults import run_command
 
@@ -99,31 +128,63 @@ def run(args: argparse.Namespace) -> int:
         paths = [resolve(f"scenes/{name}.yaml") for name in CAMPAIGNS[args.campaign]]
     # every scene is loaded and checked first: a bad one stops the run before any trial moves
     campaigns = [_prepare(path, args) for path in paths]
-    total = sum(len(c.specs) for c in campaigns)
+    with contextlib.ExitStack() as locks:
+        for c in campaigns:
+            _open_run(c, args, locks)
+        wall_all = _run(campaigns, args)
+        if args.compare_methods:
+            _compare(campaigns, args)
+        elif args.compare_paper:
+            _compare_paper(campaigns, args)
+        else:
+            _print_results(campaigns, args, wall_all)
+    faulted = any(o.state != "done" for c in campaigns for o in c.outcomes)
+    return EXIT_FAULT if faulted else EXIT_OK
+
+
+def _run(campaigns: list[_Campaign], args: argparse.Namespace) -> float:
+    """Run every campaign's remaining trials through one pool; fills outcomes and wall times."""
+    total = sum(len(c.to_run()) for c in campaigns)
     bar = progress_bar(total, "campaign")
 
     def progress(o: TrialOutcome) -> None:
         bar.update(1)
         bar.set_postfix_str(o.spec.trial_id)
 
-    t_all = time.perf_counter()
     runs = [
-        CampaignRun(c.specs, c.scene, c.stack, c.transport, c.log_dir, c.specs[0].trial_id)
+        CampaignRun(
+            c.to_run(),
+            c.scene,
+            c.stack,
+            c.transport,
+            c.log_dir,
+            _series_for(c, args),
+            prior=list(c.done.values()),
+        )
         for c in campaigns
     ]
     bar.set_description(" + ".join(c.scene.name for c in campaigns) + " campaign")
+    t_all = time.perf_counter()
     with open_executor(args.executor, max(1, args.workers), args.scheduler) as executor:
         results = run_campaigns(runs, executor=executor, progress=progress)  # one pool for all
+    wall_all = time.perf_counter() - t_all
+    bar.close()
     before = 0.0
     for c, r in zip(campaigns, results, strict=True):
         # the pool overlaps campaigns: each is charged the wall time since the previous finished
-        c.outcomes, c.wall, before = r.outcomes, max(r.finished_s - before, 1e-9), r.finished_s
-    wall_all = time.perf_counter() - t_all
-    bar.close()
-    if args.compare_methods:
-        return _compare(campaigns, args)
-    if args.compare_paper:
-        return _compare_paper(campaigns, args)
+        c.wall, before = max(r.finished_s - before, 1e-9), r.finished_s
+        ran = {o.spec.trial_id: o for o in r.outcomes}
+        c.outcomes = [ran.get(s.trial_id) or c.done[s.trial_id] for s in c.specs]
+    return wall_all
+
+
+def _series_for(c: _Campaign, args: argparse.Namespace) -> str | None:
+    """The trial whose force and strain series the traces plot shows (the first), if it runs."""
+    first = c.specs[0].trial_id
+    return None if args.no_plots or first in c.done else first
+
+
+def _print_results(campaigns: list[_Campaign], args: argparse.Namespace, wall_all: float) -> None:
     payloads = [_report(c, args) for c in campaigns]
     sim_all = sum(o.sim_time for c in campaigns for o in c.outcomes)
     if args.json:
@@ -132,13 +193,12 @@ def run(args: argparse.Namespace) -> int:
         else:
             print(json.dumps({"campaigns": payloads, "wall_s": wall_all}, indent=2))
     elif len(campaigns) > 1:
+        total = sum(len(c.outcomes) for c in campaigns)
         print(
             f"all {total} trials in {wall_all:.1f} s wall for {sim_all:.1f} s simulated: "
             f"{sim_all / wall_all:.1f}x real time (one pool for all: each campaign's wall time "
             "above runs from the previous campaign's last trial)"
         )
-    failed_all = all(o.state != "done" for c in campaigns for o in c.outcomes)
-    return 1 if failed_all else 0
 
 
 def _prepare(path: Path, args: argparse.Namespace) -> _Campaign:
@@ -151,15 +211,35 @@ def _prepare(path: Path, args: argparse.Namespace) -> _Campaign:
     if not specs:
         raise ValueError(f"{path}: the campaign has no trials")
     check_reachable(specs, stack, str(path), str(resolve(scene.robot)))
-    log_dir = args.out / scene.name / "logs"
-    log_dir.mkdir(parents=True, exist_ok=True)
-    for old in log_dir.glob("*.jsonl"):
-        old.unlink()
     transport: Transport = "wire" if args.wire else scene.transport
-    return _Campaign(path, scene, stack, specs, log_dir, transport)
+    return _Campaign(path, scene, stack, specs, transport)
 
 
-def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
+def _open_run(c: _Campaign, args: argparse.Namespace, locks: contextlib.ExitStack) -> None:
+    """The campaign's run folder: a new one, or with ``--resume`` the newest one of the same
+    run, locked while this process writes there; on resume, its complete trials read back."""
+    info = {
+        "scene": c.scene.name,
+        "config": fingerprint(c.scene, c.stack),
+        "seed": args.seed,
+        "limit": args.limit,
+        "transport": c.transport,
+        "trials": len(c.specs),
+    }
+    base = args.out / c.scene.name
+    if args.resume:
+        c.run_dir = locks.enter_context(locked(resumable(base, info)))
+        c.done = resume_outcomes(c.log_dir, c.specs, c.stack)
+        log.info(
+            "resuming %s: %d of %d trials already complete", c.run_dir, len(c.done), len(c.specs)
+        )
+    else:
+        c.run_dir = locks.enter_context(locked(new_run_dir(base)))
+        write_run_info(c.run_dir, info)
+    c.log_dir.mkdir(exist_ok=True)
+
+
+def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> None:
     from palpate.compare import compare_methods, comparison_payload, print_comparison
     from robot.trial.setup import sensor_section
 
@@ -169,10 +249,9 @@ def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
             print(json.dumps(comparison_payload(table, c.scene.name, args.seed), indent=2))
         else:
             print_comparison(table, c.scene.name)
-    return 0
 
 
-def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
+def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> None:
     from palpate.papertables import comparison, print_comparison
 
     payloads = []
@@ -186,7 +265,6 @@ def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> int:
             print()
     if args.json:
         print(json.dumps(payloads[0] if len(payloads) == 1 else {"campaigns": payloads}, indent=2))
-    return 0
 
 
 def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
@@ -198,7 +276,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     paper = median_abs_relative_error(outcomes, "paper")
     failed = [o for o in outcomes if o.state != "done"]
     figures: list[str] = []
-    out_dir = c.log_dir.parent
+    out_dir = c.run_dir
     if not args.no_plots:
         from palpate import plots
 
@@ -206,10 +284,11 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         figures.append(
             str(plots.estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))
         )
-        if outcomes[0].series.get("advance"):
+        if outcomes[0].series.get("advance"):  # not when the first trial was resumed
             figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
     payload: dict[str, object] = {
         "scene": scene.name,
+        "log_dir": str(c.log_dir),
         "transport": c.transport,
         "seed": args.seed,
         "trials": [o.as_dict() for o in outcomes],
@@ -255,6 +334,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     )
     for o in failed:
         print(f"  trial {o.spec.trial_id}: {o.state}: {o.reason}")
+    print(f"run folder: {c.run_dir}")
     print(f"logs: {c.log_dir}")
     for f in figures:
         print(f"plot: {f}")

@@ -21,7 +21,6 @@ import sys
 import tempfile
 from collections import Counter
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -31,9 +30,11 @@ from config.loader import ConfigError, from_mapping
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from palpate.campaign import campaign_trials
+from palpate.executors import process_pool
 from palpate.faults.injector import FaultInjector, GroundTruth
 from palpate.faults.judge import FaultJob, FaultTrialResult, judge, judge_killed
 from palpate.preflight import check_campaign, check_reachable
+from palpate.runs import locked, new_run_dir
 from palpate.simtrial import TrialOutcome, run_sim_trial
 from sim.board import BoardFaults
 
@@ -181,7 +182,7 @@ def run_fault_campaign(
             if progress is not None:
                 progress(results[-1])
         return results
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with process_pool(workers) as pool:
         for res in pool.map(run_fault_trial, jobs):
             results.append(res)
             if progress is not None:
@@ -221,21 +222,31 @@ def run_command(args: Any) -> int:
     """``palpate sim --faults``: exit 0 when every trial stopped safely and kept its data."""
     from config import load, load_stack, resolve
 
+    if getattr(args, "resume", False):
+        raise ValueError("--resume: the fault campaign always runs anew (it judges every trial)")
     scene_path = args.scene if args.scene else resolve("scenes/faults.yaml")
     scene = load(SceneConfig, scene_path)
     stack = load_stack(resolve(scene.robot))
     robot_source = str(resolve(scene.robot))
     check_campaign(scene, stack, str(scene_path), robot_source)
-    out_dir: Path = args.out / scene.name
-    log_dir = out_dir / "logs"
     transport = "wire" if args.wire else scene.transport
-    jobs = fault_jobs(scene, stack, str(scene_path), args.seed, log_dir, transport)
+    # planned and checked in a folder not yet made; then written to a new one, never shared
+    jobs = fault_jobs(scene, stack, str(scene_path), args.seed, Path("logs"), transport)
     if args.limit:
         jobs = jobs[: args.limit]
     check_reachable([j.spec for j in jobs], stack, str(scene_path), robot_source)
-    log_dir.mkdir(parents=True, exist_ok=True)
-    for old in (*log_dir.glob("*.jsonl"), *log_dir.glob("*.blackbox.json")):
-        old.unlink()
+    with locked(new_run_dir(args.out / scene.name)) as run_dir:
+        log_dir = run_dir / "logs"
+        log_dir.mkdir()
+        jobs = [dataclasses.replace(j, log_dir=log_dir) for j in jobs]
+        return _run_and_report(jobs, args, scene.name, transport, log_dir)
+
+
+def _run_and_report(
+    jobs: list[FaultJob], args: Any, scene_name: str, transport: str, log_dir: Path
+) -> int:
+    """Run the fault jobs, print the table (or ``--json``); exit 0 when every trial stopped
+    safely and kept its data."""
 
     def progress(r: FaultTrialResult) -> None:
         mark = "ok" if r.safe and r.data_kept else "FAILED"
@@ -245,7 +256,8 @@ def run_command(args: Any) -> int:
     rows = fault_table(results)
     if args.json:
         payload = {
-            "scene": scene.name,
+            "scene": scene_name,
+            "log_dir": str(log_dir),
             "transport": transport,
             "seed": args.seed,
             "faults": [dataclasses.asdict(r) for r in rows],

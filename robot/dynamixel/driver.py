@@ -12,7 +12,10 @@ from the SDK's ``syncReadTx`` / ``readRx`` rather than ``GroupSyncRead``, becaus
 each status packet's error byte, and the Alert bit in it is how a servo reports a hardware fault.
 
 Safety lives here: every transaction is retried a bounded number of times and then raises
-:class:`~robot.motors.ServoTransportError`; a status error or the Alert bit raises
+:class:`~robot.motors.ServoTransportError`; a port that fails under the driver (a USB adapter
+unplugged: pyserial's EIO or "readiness to read but returned no data") is counted
+(``port_errors``) and opened again with a back-off (``reopens``; :mod:`robot.dynamixel.port`),
+its transactions failing as transport errors meanwhile; a status error or the Alert bit raises
 :class:`~robot.motors.ServoFaultError` with the decoded Hardware Error Status (never retried);
 goals move at most ``max_goal_step`` per call; :meth:`close` (also on leaving the ``with`` block)
 turns torque off on every servo before releasing the port, whatever happened before.
@@ -34,13 +37,14 @@ import dynamixel_sdk as sdk
 from config.schema import ServoBusConfig
 from robot.dynamixel import units
 from robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
+from robot.dynamixel.port import PortRecovery, TimedPortHandler
 from robot.motors import (
     MotorState,
     ServoFaultError,
     ServoIdentityError,
     ServoTransportError,
 )
-from sensor.ports import open_failure
+from sensor.ports import PORT_ERRORS, open_failure
 from wire import dynamixel as tables
 
 R = TypeVar("R")
@@ -73,18 +77,6 @@ class Motor:
     model: str
 
 
-class _TimedPortHandler(sdk.PortHandler):  # type: ignore[misc]  # the SDK is untyped
-    """The SDK's port with a configurable reply timeout instead of its fixed 2 x 16 ms + 2 ms."""
-
-    def __init__(self, port_name: str, timeout_ms: float) -> None:
-        super().__init__(port_name)
-        self.reply_timeout_ms = timeout_ms
-
-    def setPacketTimeout(self, packet_length: int) -> None:
-        self.packet_start_time = self.getCurrentTime()
-        self.packet_timeout = self.tx_time_per_byte * packet_length + self.reply_timeout_ms
-
-
 class DynamixelBus:
     """X-series servos in extended position mode on one Protocol 2.0 bus."""
 
@@ -112,7 +104,7 @@ class DynamixelBus:
         self._motors = {m.name: m for m in motors}
         self._by_id = {m.id: m for m in motors}
         self._ids = [m.id for m in motors]  # the sync read's parameter (made once, not per tick)
-        self._port = _TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
+        self._port = TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
         # the SDK's Protocol 2.0 packet handler, or one with its calls (the simulator's
         # register-level fast path, ``sim.dynamixel.direct``): this class decides the same
         self._ph = sdk.PacketHandler(2.0) if packet_handler is None else packet_handler
@@ -122,6 +114,7 @@ class DynamixelBus:
         self._last_goals: dict[str, float] = {}
         self._connected = False
         self._sysfs = usb_serial_sysfs  # where Linux shows the USB adapter's latency timer
+        self.recovery = PortRecovery(self._port, baudrate)  # a lost port, opened again
 
     @classmethod
     def from_config(
@@ -151,6 +144,16 @@ class DynamixelBus:
     @property
     def port_handler(self) -> Any:
         return self._port
+
+    @property
+    def port_errors(self) -> int:
+        """Transactions that failed in the port itself (it was lost)."""
+        return self.recovery.port_errors
+
+    @property
+    def reopens(self) -> int:
+        """Times a lost port was opened again."""
+        return self.recovery.reopens
 
     # --- lifecycle ---------------------------------------------------------------------------
     def connect(self) -> None:
@@ -373,12 +376,23 @@ class DynamixelBus:
         attempts = 1 + (self._retries if retries is None else retries)
         result = sdk.COMM_TX_FAIL
         for _ in range(attempts):
-            value, result, error = call()
+            if not self.recovery.ready():
+                break
+            try:
+                value, result, error = call()
+            except PORT_ERRORS as exc:  # the port failed (not a reply: the device itself)
+                self._port.is_using = False
+                self.recovery.lose(exc)
+                continue
             if result == sdk.COMM_SUCCESS:
                 if servo_id is not None:
                     self._raise_for_status(servo_id, error)
                 return value
             self._port.is_using = False  # the SDK leaves it set after some failures
+        if self.recovery.lost:
+            name = self._port.getPortName()
+            lost = self.recovery.lost
+            raise ServoTransportError(f"{what}: port {name} lost ({lost}), reopening")
         reason = self._ph.getTxRxResult(result)
         raise ServoTransportError(f"{what}: {reason} ({attempts} attempts)")
 

@@ -11,6 +11,11 @@ samples after it; :attr:`TrialLogWriter.records` counts the lines on disk. A rea
 complete log (has ``end``) from a truncated one. (Batching: one flush per 25 ticks at 250 Hz
 instead of one per line, about 5 % of a bench trial's CPU.)
 
+Each record is checked against its kind's fields (:mod:`robot.trial.logschema`, the one list of
+kinds and fields). A header that fails is an error naming the file and the key; any other line
+that fails is a bad line (its number and problem in :attr:`TrialLog.problems`), except a last
+line cut short by a crash (no newline at its end), which only makes the log truncated.
+
 Floats are written with ``repr`` precision (JSON's default), so replay is exact.
 """
 
@@ -23,6 +28,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
+
+from robot.trial.logschema import LogRecordError, check_record
 
 FORMAT = "palpate-trial-log"
 VERSION = 1
@@ -115,6 +122,13 @@ class TrialLog:
     records: list[dict[str, Any]] = field(default_factory=list)
     complete: bool = False
     bad_lines: int = 0  # a torn last line after a crash, or corruption
+    problems: list[str] = field(default_factory=list)  # "line N: what is wrong", per bad line
+    torn_tail: bool = False  # the last line was cut short (a crash while writing it)
+
+    @property
+    def damaged(self) -> list[str]:
+        """The bad lines that a crash does not explain (all but a torn last line)."""
+        return self.problems[:-1] if self.torn_tail else self.problems
 
     def of_kind(self, kind: str) -> Iterator[dict[str, Any]]:
         return (r for r in self.records if r.get("kind") == kind)
@@ -129,34 +143,54 @@ class TrialLogError(ValueError):
 
 
 def read_log(path: str | Path) -> TrialLog:
-    """Read a trial log, tolerating a torn final line (reported in ``bad_lines``)."""
+    """Read a trial log and check every record (:mod:`robot.trial.logschema`); a bad line is
+    counted and kept out of ``records``. Raises :class:`TrialLogError` naming the file (and the
+    header's key) when the file is not a trial log this version reads."""
     p = Path(path)
     try:
-        lines = p.read_text(encoding="utf-8").splitlines()
+        text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise TrialLogError(f"{p}: no such trial log") from None
+    except UnicodeDecodeError as exc:
+        raise TrialLogError(f"{p}: not a trial log (not UTF-8 text: {exc.reason})") from None
+    except OSError as exc:
+        raise TrialLogError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    lines = text.split("\n")
+    ended = lines[-1] == ""  # the file ends with a newline: no line was cut short
+    if ended:
+        lines.pop()
     if not lines:
         raise TrialLogError(f"{p}: empty file, not a trial log")
+    log = TrialLog(path=p, header=_header(p, lines[0]))
+    for number, line in enumerate(lines[1:], start=2):
+        try:
+            rec = json.loads(line)
+            check_record(rec)
+        except (ValueError, RecursionError) as exc:  # JSONDecodeError, LogRecordError
+            problem = "not JSON" if isinstance(exc, json.JSONDecodeError) else str(exc)
+            log.bad_lines += 1
+            log.problems.append(f"line {number}: {problem}")
+            log.torn_tail = not ended and number == len(lines)
+            continue
+        log.records.append(rec)
+    log.complete = log.end is not None
+    return log
+
+
+def _header(p: Path, line: str) -> dict[str, Any]:
     try:
-        header = json.loads(lines[0])
-    except json.JSONDecodeError:
+        header = json.loads(line)
+    except (ValueError, RecursionError):
         raise TrialLogError(f"{p}: first line is not a JSON header") from None
     if not isinstance(header, dict) or header.get("format") != FORMAT:
         raise TrialLogError(f"{p}: not a {FORMAT} file")
     if header.get("version") != VERSION:
         raise TrialLogError(
-            f"{p}: log version {header.get('version')}, this reader knows {VERSION}"
+            f"{p}: log version {header.get('version')!r:.20}, this reader knows {VERSION}"
         )
-    log = TrialLog(path=p, header=header)
-    for line in lines[1:]:
-        try:
-            rec = json.loads(line)
-        except json.JSONDecodeError:
-            log.bad_lines += 1
-            continue
-        if isinstance(rec, dict):
-            log.records.append(rec)
-        else:
-            log.bad_lines += 1
-    log.complete = log.end is not None
-    return log
+    try:
+        if check_record(header) != "header":
+            raise LogRecordError("kind", f"the first record is {header['kind']!r}, not a header")
+    except LogRecordError as exc:
+        raise TrialLogError(f"{p}: line 1: {exc}") from None
+    return header

@@ -15,7 +15,6 @@ written here, and read back here (:func:`recorded_verdict`), tolerant of logs th
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
@@ -27,10 +26,9 @@ from estimation.southwell import SouthwellFit
 from estimation.verdict import Verdict
 from robot.indentation import TrialPlan
 
-if TYPE_CHECKING:  # types only: run.py and estimate.py import this module
+if TYPE_CHECKING:  # types only: estimate.py is above this module
     from robot.trial.estimate import TrialEstimate
     from robot.trial.inputs import EstimatorInputs
-    from robot.trial.run import TrialResult
 
 UNITS = "SI (m, N, Pa, rad, s); strains dimensionless"
 
@@ -115,17 +113,3 @@ def recorded_verdict(record: dict[str, Any] | None) -> Verdict | None:
     if record is None or not isinstance(record.get("verdict"), dict):
         return None
     return Verdict.from_dict(record["verdict"])
-
-
-def end_record(result: TrialResult) -> dict[str, Any]:
-    """The closing record of a trial log: final state, reason, marks, ticks and duration."""
-    marks = asdict(result.marks)
-    marks["strains_at_buckling"] = list(result.marks.strains_at_buckling)
-    return {
-        "kind": "end",
-        "state": result.state.value,
-        "reason": result.marks.reason,
-        "marks": marks,
-        "ticks": result.ticks,
-        "duration": result.duration if math.isfinite(result.duration) else None,
-    }

@@ -9,8 +9,9 @@ written, so a crash keeps the trial up to the crash.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
 from estimation.detect_buckling import BucklingDetector
@@ -28,7 +29,6 @@ from robot.indentation import (
 )
 from robot.probing import ProbeResult
 from robot.trial.log import TrialLogWriter
-from robot.trial.record import end_record
 from sensor.clock import Clock
 
 
@@ -206,4 +206,18 @@ def _transition_record(tr: Transition) -> dict[str, Any]:
         "reason": tr.reason,
         "advance": tr.advance,
         "strains": list(tr.strains),
+    }
+
+
+def end_record(result: TrialResult) -> dict[str, Any]:
+    """The closing record of a trial log: final state, reason, marks, ticks and duration."""
+    marks = asdict(result.marks)
+    marks["strains_at_buckling"] = list(result.marks.strains_at_buckling)
+    return {
+        "kind": "end",
+        "state": result.state.value,
+        "reason": result.marks.reason,
+        "marks": marks,
+        "ticks": result.ticks,
+        "duration": result.duration if math.isfinite(result.duration) else None,
     }

@@ -43,6 +43,8 @@ from sim.board.source import SampleSource
 from sim.clock import VirtualClock
 from wire.frame import Frame, FrameLayout, Status, check_ranges, encode, frame_from_si
 
+EMIT_SLACK_S = 1e-7  # s: a sample this close to the clock's time is due (see emit_until)
+
 
 class ByteSink(Protocol):
     """Where the fast path writes frames instead of a pty (``sim.inprocess.MemorySerial``)."""
@@ -185,7 +187,9 @@ class BoardEmulator:
         with self._lock:
             if not self._running:
                 return 0
-            due = math.floor((t - self._t0) * self.rate_hz + 1e-9)
+            # a sample is due within EMIT_SLACK_S of its time: a virtual clock that sums ticks
+            # drifts by ~1e-15 s per tick, and the frame due now must not wait for the next call
+            due = math.floor((t - self._t0 + EMIT_SLACK_S) * self.rate_hz)
             chunks: list[Any] = []  # encoded frames, or frames for a frame sink
             taken = 0
             sent_before = self.stats.frames_sent

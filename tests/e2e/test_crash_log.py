@@ -65,12 +65,14 @@ def test_sigkill_mid_trial_keeps_every_record_written(
     assert "truncated log" in capsys.readouterr().out
 
 
-def test_a_torn_last_line_is_counted_not_fatal(tmp_path: Path) -> None:
+def test_a_torn_last_line_is_counted_not_fatal(
+    tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
+) -> None:
     from robot.trial.log import TrialLogWriter
 
     path = tmp_path / "t.jsonl"
-    with TrialLogWriter(path, {"trial": "x"}) as w:
-        w.write({"kind": "sample", "t": 0.0})
+    with TrialLogWriter(path, {"trial": "x", **log_header}) as w:
+        w.write(log_sample)
         assert w.written == 2
         w.flush()
         assert w.records == 2
@@ -78,5 +80,21 @@ def test_a_torn_last_line_is_counted_not_fatal(tmp_path: Path) -> None:
         fh.write('{"kind": "sam')
     log = read_log(path)
     assert log.bad_lines == 1
+    assert log.torn_tail
+    assert log.damaged == []  # a crash explains it
     assert len(log.records) == 1
     assert not log.complete
+
+
+def test_a_bad_line_inside_is_damage_not_a_crash(
+    tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
+) -> None:
+    from robot.trial.log import TrialLogWriter
+
+    path = tmp_path / "t.jsonl"
+    with TrialLogWriter(path, {"trial": "x", **log_header}) as w:
+        w.write({**log_sample, "advance": "abc"})
+        w.write(log_sample)
+    log = read_log(path)
+    assert log.damaged == ["line 2: sample.advance: expected a number or null, got 'abc'"]
+    assert not log.torn_tail

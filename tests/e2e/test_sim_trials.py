@@ -104,7 +104,9 @@ def test_cli_sim_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert len(payload["trials"]) == 2
     assert payload["samples"][0]["sample"] == "S1"
     assert all(t["state"] == "done" for t in payload["trials"])
-    assert len(list((tmp_path / "bench" / "logs").glob("*.jsonl"))) == 2
+    (run,) = (tmp_path / "bench").iterdir()  # its own new run folder
+    assert Path(payload["log_dir"]) == run / "logs"
+    assert len(list((run / "logs").glob("*.jsonl"))) == 2
 
 
 def test_cli_bad_scene_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -3,8 +3,13 @@
 The emulators run in this test process on pseudo-terminals, in real time, with a world behind
 the board (the hardware code path: dynamixel-sdk and pyserial on ptys). The program runs in a
 tmux pane on its own server socket; the test presses keys with ``send-keys``, polls
-``capture-pane`` until the screen shows what it waits for (with a deadline, never a fixed
-sleep), and checks the servos' positions and torque in the emulator.
+``capture-pane`` until the screen shows what it waits for (with a generous deadline, never a
+fixed sleep), and checks the servos' positions and torque in the emulator.
+
+Real time on a shared machine: the emulators answer from threads that a busy machine may not
+run for a while, so the program under test gets a robot file whose reply timeout and stale
+stream timeout are generous (:func:`patient_robot`). The bench's 20 ms and 0.1 s are right on
+dedicated hardware; here they would turn the machine's load into servo and stream faults.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+import yaml
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
@@ -48,7 +54,7 @@ class Terminal:
 
     def _tmux(self, *args: str) -> str:
         done = subprocess.run(
-            [*self.base, *args], capture_output=True, text=True, timeout=10, check=True
+            [*self.base, *args], capture_output=True, text=True, timeout=60, check=True
         )
         return done.stdout
 
@@ -59,7 +65,7 @@ class Terminal:
         return self._tmux("capture-pane", "-p", "-t", "t")
 
     def wait_for(
-        self, *patterns: str, timeout: float = 20.0, within: float = 0.005, **near: float
+        self, *patterns: str, timeout: float = 90.0, within: float = 0.005, **near: float
     ) -> str:
         """Poll the screen until every regex matches and every ``label=value`` reading is
         ``within`` of the value (an encoder tick is 4.9 um of advance, 0.088 deg of roll);
@@ -84,12 +90,22 @@ class Terminal:
         return int(children[0])
 
     def close(self) -> None:
-        subprocess.run([*self.base, "kill-server"], capture_output=True, timeout=10, check=False)
+        subprocess.run([*self.base, "kill-server"], capture_output=True, timeout=60, check=False)
 
 
 def shell_command(argv: list[str]) -> str:
     """Run ``argv`` in the pane, then say how it ended and keep the pane open to read it."""
     return f"{shlex.join(argv)}; echo palpate exited $?; sleep 600"
+
+
+def patient_robot(path: Path) -> Path:
+    """The shipped robot file with a 2 s servo reply timeout and a 10 s stale-stream timeout,
+    written to ``path``: the emulators' lateness on a loaded machine is not a fault here."""
+    data = yaml.safe_load(resolve("robot.yaml").read_text(encoding="utf-8"))
+    data["servos"]["timeout_ms"] = 2000
+    data["board"]["stale_timeout_s"] = 10.0
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
 
 
 @pytest.fixture
@@ -113,6 +129,8 @@ def terminal(tmp_path: Path, bench: SimulatedBench) -> Iterator[Terminal]:
         bench.board_port,
         "--targets",
         str(targets),
+        "--robot",
+        str(patient_robot(tmp_path / "robot.yaml")),
     ]
     term = Terminal(tmp_path / "tmux.sock", shell_command(argv))
     try:
@@ -222,6 +240,7 @@ def test_without_a_terminal_it_refuses_with_exit_2(capsys: pytest.CaptureFixture
 
 
 NEAR_SCENE = """name: near
+robot: {robot}
 samples:
   - {name: S7, modulus_kpa: 1122.86}
 campaign:
@@ -233,12 +252,16 @@ campaign:
 def test_the_default_simulator_shows_contact_and_strains(tmp_path: Path) -> None:
     """No ports: both emulators in-process with a tissue sample; jog into it and back."""
     scene = tmp_path / "near.yaml"
-    scene.write_text(NEAR_SCENE, encoding="utf-8")
+    robot = patient_robot(tmp_path / "robot.yaml")
+    scene.write_text(NEAR_SCENE.replace("{robot}", str(robot)), encoding="utf-8")
     argv = [sys.executable, "-m", "palpate.cli", "teleop", "--scene", str(scene)]
     argv += ["--targets", str(tmp_path / "targets.yaml")]
     term = Terminal(tmp_path / "tmux.sock", shell_command(argv))
     try:
-        term.wait_for("simulator: sample S7", r"state\s+IDLE", "contact    no", advance=0.0)
+        # the first frame may come after the first screen: advancing waits for the stream
+        term.wait_for(
+            "simulator: sample S7", r"state\s+IDLE", "contact    no", "FBG stream ok", advance=0.0
+        )
         term.keys("+", "]")  # 5 mm steps at 5 mm/s
         for mm in (5.0, 10.0):
             term.keys("Up")

@@ -32,8 +32,13 @@ from robot.trial.log import read_log
 from sim.clock import VirtualClock
 
 ROBOT_SCENE = load(SceneConfig, resolve("scenes/robot.yaml"))
-# A quick stage, powered up 2 mm behind the stand-off pose, so a trial takes ~3 s simulated.
-ROBOT_YAML = "drive: {max_speed_mm_per_s: 20, max_accel_mm_per_s2: 200, home_translation_mm: 38}\n"
+# A quick stage, powered up 2 mm behind the stand-off pose, so a trial takes ~3 s simulated; a
+# generous servo reply timeout (the emulator answers from a thread a busy machine may not run
+# for a while: lateness is not a fault here, the trial runs on a virtual clock).
+ROBOT_YAML = (
+    "drive: {max_speed_mm_per_s: 20, max_accel_mm_per_s2: 200, home_translation_mm: 38}\n"
+    "servos: {timeout_ms: 2000}\n"
+)
 TARGETS_YAML = """targets:
   - {name: down, tube: bent30, roll_deg: 0, translation_mm: 40}
   - {name: up, tube: bent30, roll_deg: 180, translation_mm: 40}

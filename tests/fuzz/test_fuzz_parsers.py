@@ -1,8 +1,9 @@
 """Fuzzing (Hypothesis, seeded by the "ci" profile, a few seconds in all): the frame parser, the
-servo emulator's packet handling, the driver's reply handling and the config loader take any
-input and fail only in their documented ways. The targets and their invariants live in
-``palpate/benchmarks/fuzztargets.py`` and ``fuzzconfig.py``; ``palpate bench --only fuzz`` runs them
-long."""
+servo emulator's packet handling, the driver's reply handling, the config loader, replay of
+mutated trial logs and the checks of mutated scenes take any input and fail only in their
+documented ways. The targets and their invariants live in
+``palpate/benchmarks/fuzztargets.py``, ``fuzzconfig.py`` and ``fuzzfiles.py``; ``palpate bench
+--only fuzz`` runs them long."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from hypothesis import strategies as st
 
 from config.scene import SceneConfig
 from config.schema import StackConfig
-from palpate.benchmarks import fuzzconfig
+from palpate.benchmarks import fuzzconfig, fuzzfiles
 from palpate.benchmarks import fuzztargets as fuzz
 from sim.dynamixel import protocol
 
@@ -190,3 +191,57 @@ def test_driver_rejects_an_implausible_position_that_passed_the_crc(
     assert fuzz.driver_reply_case(drv, bus, "set_torque", wild) == "transport"  # type: ignore[arg-type]
     assert fuzz.driver_reply_case(drv, bus, "set_torque", lambda r: r) == "ok"  # type: ignore[arg-type]
     assert fuzz.driver_reply_case(drv, bus, "write_goals", lambda r: r) == "ok"  # type: ignore[arg-type]
+
+
+# -- files a user gives: trial logs (replay) and scene YAML (sim --scene) ----------------------
+
+
+@pytest.fixture(scope="module")
+def valid_logs(tmp_path_factory: pytest.TempPathFactory) -> list[list[str]]:
+    return fuzzfiles.sample_logs(tmp_path_factory.mktemp("logs"))
+
+
+@given(seeds)
+def test_replay_on_mutated_logs(
+    tmp_path_factory: pytest.TempPathFactory, valid_logs: list[list[str]], seed: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    lines = valid_logs[seed % len(valid_logs)]
+    data = fuzzfiles.mutate_log(lines, rng)
+    outcome = fuzzfiles.replay_case(data, tmp_path_factory.getbasetemp() / "fuzz.jsonl")
+    assert outcome in ("identical", "different", "truncated", "damaged", "bad input")
+
+
+def test_replay_fuzz_starts_from_logs_that_replay_identically(
+    tmp_path: Path, valid_logs: list[list[str]]
+) -> None:
+    for lines in valid_logs:
+        data = ("\n".join(lines) + "\n").encode()
+        assert fuzzfiles.replay_case(data, tmp_path / "ok.jsonl") == "identical"
+        assert fuzzfiles.replay_case(data[:-200], tmp_path / "cut.jsonl") == "truncated"
+
+
+@given(seeds)
+def test_sim_scene_checks_on_mutated_scenes(
+    tmp_path_factory: pytest.TempPathFactory, seed: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    texts = fuzzfiles.scene_texts()
+    text = fuzzfiles.mutate_scene(texts[seed % len(texts)], rng)
+    path = tmp_path_factory.getbasetemp() / "scene.yaml"
+    assert fuzzfiles.scene_case(text, path) in ("accepted", "refused")
+
+
+def test_scene_fuzz_starts_from_scenes_that_plan(tmp_path: Path) -> None:
+    for text in fuzzfiles.scene_texts():
+        assert fuzzfiles.scene_case(text, tmp_path / "s.yaml") == "accepted"
+
+
+def test_yaml_alias_bombs_and_deep_nesting_are_refused(tmp_path: Path) -> None:
+    """A few lines whose aliases expand to 9**10 values, and brackets nested 5,000 deep: a
+    ConfigError each, not a hang or a RecursionError."""
+    bomb = ["a0: &a0 [x, x, x, x, x, x, x, x, x]"]
+    bomb += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 10)]
+    path = tmp_path / "s.yaml"
+    assert fuzzfiles.scene_case("\n".join(bomb), path) == "refused"
+    assert fuzzfiles.scene_case("[" * 5000 + "]" * 5000, path) == "refused"

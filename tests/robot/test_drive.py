@@ -109,7 +109,7 @@ def test_unit_conversions_reject_bad_values() -> None:
 @pytest.fixture
 def controller() -> Iterator[tuple[DriveController, EmulatedBus, VirtualClock]]:
     clock = VirtualClock()
-    bus_cfg = ServoBusConfig(max_goal_step_deg=360.0)
+    bus_cfg = ServoBusConfig(max_goal_step_deg=360.0, timeout_ms=2000.0)  # generous: no race
     with EmulatedBus.from_config(bus_cfg, clock=clock) as emulator:
         motors = DynamixelBus.from_config(bus_cfg, port=emulator.port)
         with DriveController(motors, DriveConfig(coupling_mm_per_rad=0.5)) as ctl:

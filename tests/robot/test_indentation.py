@@ -24,8 +24,7 @@ from robot.indentation import (
     TrialPlan,
 )
 from robot.trial.log import TrialLogWriter, read_log
-from robot.trial.record import end_record
-from robot.trial.run import run_trial
+from robot.trial.run import end_record, run_trial
 from sim.clock import VirtualClock
 
 
@@ -214,10 +213,12 @@ def test_machine_runs_one_trial_only() -> None:
         machine.start(1.0)
 
 
-def test_log_keeps_every_record_and_reads_back(tmp_path: Path) -> None:
+def test_log_keeps_every_record_and_reads_back(
+    tmp_path: Path, log_header: dict[str, object]
+) -> None:
     rig = ScriptedRig(VirtualClock())
     path = tmp_path / "trial.jsonl"
-    with TrialLogWriter(path, {"trial": "t1"}) as log:
+    with TrialLogWriter(path, {"trial": "t1", **log_header}) as log:
         result = run(rig, log=log)
         log.write(end_record(result))
     back = read_log(path)
@@ -229,10 +230,12 @@ def test_log_keeps_every_record_and_reads_back(tmp_path: Path) -> None:
     assert back.end["marks"]["x_contact"] == result.marks.x_contact
 
 
-def test_truncated_log_is_reported(tmp_path: Path) -> None:
+def test_truncated_log_is_reported(
+    tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
+) -> None:
     path = tmp_path / "trial.jsonl"
-    with TrialLogWriter(path, {"trial": "t2"}) as log:
-        log.write({"kind": "sample", "t": 0.0})
+    with TrialLogWriter(path, {"trial": "t2", **log_header}) as log:
+        log.write(log_sample)
     with path.open("a", encoding="utf-8") as fh:
         fh.write('{"kind": "sam')  # torn line, as after a kill
     back = read_log(path)
