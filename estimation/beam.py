@@ -17,7 +17,7 @@ Arc positions of gratings are metres from the clamp (the tube tip), s = L - dist
 sensor tip. Arc at s < 0 is inside the tube and straight; arc beyond the pin (s > L) is rejected.
 Signs: the beam bows toward -y with positive curvature in its main lobe (from about 0.3 L to the
 pin, where the paper's gratings are), so bending strains there have the sign of ``fiber_offset``;
-``fit_strains`` also tries the mirror image and reports which one fitted.
+``estimation.strain_fit.fit_strains`` also tries the mirror image and reports which one fitted.
 """
 
 from __future__ import annotations
@@ -33,7 +33,6 @@ from estimation.elastica import fast
 from estimation.elastica.constants import E_OVER_L_MAX, E_OVER_L_PEAK, P_CRIT, P_PEAK
 from estimation.elastica.errors import ElasticaConvergenceError
 from estimation.section import Section
-from estimation.strain_fit import StrainFit, StrainModel, checked_strains, straight_fit
 
 FloatArray = NDArray[np.float64]
 Branch = Literal["rising", "falling"]
@@ -161,11 +160,11 @@ class Beam:
         shortening ratio ``g`` = e_g/L: shape g.shape + (G,). ``grating_strains`` is this at
         ``geometric_shortening(e)``; a caller that knows the shape's e_g (say from the pin
         reaction of an imperfect beam) asks for it directly."""
-        s0, s1 = self._intervals(intervals)
+        s0, s1 = self.intervals(intervals)
         g_arr = np.clip(np.asarray(g, dtype=float), 0.0, E_OVER_L_MAX)[..., None]
         return self.mean_bending(g_arr, s0, s1)
 
-    def _intervals(self, intervals: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    def intervals(self, intervals: ArrayLike) -> tuple[FloatArray, FloatArray]:
         arr = np.asarray(intervals, dtype=float)
         if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
             raise ValueError(f"intervals must have shape (G, 2), got {arr.shape}")
@@ -236,56 +235,3 @@ class Beam:
             step = np.where(safe, (fast.load(g) - p) / np.where(safe, slope, 1.0), 0.0)
             g = np.clip(g - step, lo, hi)
         return np.asarray(g, dtype=float)
-
-    def fit_strains(
-        self,
-        strains: ArrayLike,
-        intervals: ArrayLike,
-        sigma: ArrayLike | None = None,
-        *,
-        include_axial: bool = False,
-        grid: int = 256,
-        xtol: float = 1e-15,
-        max_nfev: int = 200,
-    ) -> StrainFit:
-        """Least-squares beam state from G >= 2 measured grating-mean strains (paper: G = 3).
-
-        Args:
-            strains: (G,) measured mean strains, either sign (see the module note on signs).
-            intervals: (G, 2) grating arcs as in ``grating_strains``.
-            sigma: None, a scalar or (G,) standard deviations (> 0) weighting the residuals.
-            include_axial: model the uniform -P/EA as well (use it if the data contain it).
-            grid, xtol, max_nfev: scan size and the refinement's tolerance and budget.
-
-        Method: the unknown is z = sqrt(e_g / L), in which the bending strains are nearly
-        linear (they grow like sqrt(e_g) at onset), so the fit is well conditioned down to
-        onset. A scan of ``grid`` values of z over the branch, for both buckling directions,
-        picks the global basin; ``least_squares`` then refines z within the neighbouring grid
-        cells. If the best fit has no bending (e.g. all-zero strains), the beam is straight and
-        the strains cannot give P below P_cr: without ``include_axial`` we return the onset
-        state (P = P_cr, e = P_cr L / EA), an upper bound, and say so in ``message``; with it,
-        e is fitted from the uniform strain -e/L.
-        """
-        s0, s1 = self._intervals(intervals)
-        y, weight = checked_strains(strains, sigma, s0.shape)
-        if self.fiber_offset == 0.0:
-            raise ValueError("fiber_offset is 0: the fiber sees no bending strain, nothing to fit")
-        model = StrainModel(self, s0, s1, include_axial)
-        direction, fit = model.fit(y, weight, grid, xtol, max_nfev)
-        z = float(fit.x[0])
-        misfit = model(np.array([z]), direction)[0] - y
-        straight, straight_cost = straight_fit(self, y, weight, include_axial)
-        if straight_cost <= float(np.sum((weight * misfit) ** 2)) * (1.0 + 1e-9):
-            return straight
-        g = min(z * z, E_OVER_L_MAX)
-        p = float(fast.load(np.array(g)))
-        return StrainFit(
-            e=(g + self.slenderness_ratio * p) * self.length,
-            P=p * self.load_unit,
-            e_geometric=g * self.length,
-            residual=float(np.sqrt(np.mean(misfit**2))),
-            direction=direction,
-            buckled=True,
-            success=bool(fit.success),
-            message=f"buckled (first mode): {fit.message}",
-        )

@@ -1,7 +1,8 @@
 """Axial load and end shortening of the sensor beam at every sample of a record, from its strains.
 
 Each grating reads its mean bending strain plus the uniform axial strain -P/EA (Eq. 3, Eq. 12).
-``Beam.fit_strains`` ties P to the bending through the perfect elastica (P >= P_cr once bent).
+``estimation.strain_fit.fit_strains`` ties P to the bending through the perfect elastica (P >= P_cr
+once bent).
 A real beam is not straight: its bending grows smoothly while P is still below P_cr (the
 imperfection the paper saw at small post-buckling displacement), so the load read that way is
 too high until well past the onset. Here P is a free unknown beside the bending amplitude::

@@ -1,33 +1,31 @@
-"""Least-squares beam state from G >= 2 measured grating strains: ``Beam.fit_strains``'s parts.
+"""Least-squares beam state from G >= 2 measured grating strains: :func:`fit_strains` and its parts.
 
 The model (:class:`StrainModel`) gives the grating-mean strains against z = sqrt(e_g / L), in
 which they are nearly linear (they grow like sqrt(e_g) at onset), for either buckling direction;
 its ``fit`` scans z over the branch and refines it. :func:`straight_fit` is the alternative, the
-straight (pre-buckling) beam, which ``Beam.fit_strains`` returns when it fits as well.
+straight (pre-buckling) beam, which :func:`fit_strains` returns when it fits as well.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from estimation.beam import Beam
 from estimation.elastica import fast
 from estimation.elastica._scipy import least_squares
 from estimation.elastica.constants import E_OVER_L_MAX
-
-if TYPE_CHECKING:
-    from estimation.beam import Beam
 
 FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
 class StrainFit:
-    """Least-squares beam state from grating strains (see ``Beam.fit_strains``).
+    """Least-squares beam state from grating strains (see :func:`fit_strains`).
 
     Attributes:
         e: total end shortening (m).
@@ -71,7 +69,7 @@ def checked_strains(
 
 @dataclass(frozen=True, eq=False)
 class StrainModel:
-    """The grating strains of ``Beam.fit_strains``'s model against the amplitude z = sqrt(e_g/L)
+    """The grating strains of :func:`fit_strains`'s model against the amplitude z = sqrt(e_g/L)
     and the buckling direction: arcs ``s0``, ``s1`` (G,) as fractions of L; with
     ``include_axial`` the uniform -P/EA as well."""
 
@@ -148,3 +146,57 @@ def straight_fit(
         ),
     )
     return fit, float(np.sum((weight * y) ** 2))
+
+
+def fit_strains(
+    beam: Beam,
+    strains: ArrayLike,
+    intervals: ArrayLike,
+    sigma: ArrayLike | None = None,
+    *,
+    include_axial: bool = False,
+    grid: int = 256,
+    xtol: float = 1e-15,
+    max_nfev: int = 200,
+) -> StrainFit:
+    """Least-squares beam state from G >= 2 measured grating-mean strains (paper: G = 3).
+
+    Args:
+        strains: (G,) measured mean strains, either sign (see the module note on signs).
+        intervals: (G, 2) grating arcs as in ``grating_strains``.
+        sigma: None, a scalar or (G,) standard deviations (> 0) weighting the residuals.
+        include_axial: model the uniform -P/EA as well (use it if the data contain it).
+        grid, xtol, max_nfev: scan size and the refinement's tolerance and budget.
+
+    Method: the unknown is z = sqrt(e_g / L), in which the bending strains are nearly
+    linear (they grow like sqrt(e_g) at onset), so the fit is well conditioned down to
+    onset. A scan of ``grid`` values of z over the branch, for both buckling directions,
+    picks the global basin; ``least_squares`` then refines z within the neighbouring grid
+    cells. If the best fit has no bending (e.g. all-zero strains), the beam is straight and
+    the strains cannot give P below P_cr: without ``include_axial`` we return the onset
+    state (P = P_cr, e = P_cr L / EA), an upper bound, and say so in ``message``; with it,
+    e is fitted from the uniform strain -e/L.
+    """
+    s0, s1 = beam.intervals(intervals)
+    y, weight = checked_strains(strains, sigma, s0.shape)
+    if beam.fiber_offset == 0.0:
+        raise ValueError("fiber_offset is 0: the fiber sees no bending strain, nothing to fit")
+    model = StrainModel(beam, s0, s1, include_axial)
+    direction, fit = model.fit(y, weight, grid, xtol, max_nfev)
+    z = float(fit.x[0])
+    misfit = model(np.array([z]), direction)[0] - y
+    straight, straight_cost = straight_fit(beam, y, weight, include_axial)
+    if straight_cost <= float(np.sum((weight * misfit) ** 2)) * (1.0 + 1e-9):
+        return straight
+    g = min(z * z, E_OVER_L_MAX)
+    p = float(fast.load(np.array(g)))
+    return StrainFit(
+        e=(g + beam.slenderness_ratio * p) * beam.length,
+        P=p * beam.load_unit,
+        e_geometric=g * beam.length,
+        residual=float(np.sqrt(np.mean(misfit**2))),
+        direction=direction,
+        buckled=True,
+        success=bool(fit.success),
+        message=f"buckled (first mode): {fit.message}",
+    )

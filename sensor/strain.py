@@ -19,7 +19,7 @@ All quantities are SI: wavelengths in m, ``k_eps`` in m per unit strain, ``S_T``
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal, Protocol
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -172,29 +172,3 @@ def grating_intervals(sensor: SensorConfig, exposed_length: float | None = None)
     centres = L - np.asarray(sensor.grating_centres_from_tip(), dtype=np.float64)
     half = sensor.grating_length / 2
     return np.stack([centres - half, centres + half], axis=1)
-
-
-class StrainFitter(Protocol):
-    """What :func:`beam_state` needs: ``estimation.beam.Beam`` satisfies it."""
-
-    def fit_strains(
-        self, strains: FloatArray, intervals: FloatArray, sigma: float | None = None
-    ) -> Any: ...
-
-
-def beam_state(
-    beam: StrainFitter, strains: ArrayLike, intervals: ArrayLike, sigma: float | None = None
-) -> Any:
-    """Beam state and axial force from grating strains through the elastica inverse map.
-
-    A thin adapter over ``Beam.fit_strains`` (returns its ``StrainFit(e, P, residual, success,
-    message)``): ``strains`` (N,) from :class:`StrainChain`, ``intervals`` (N, 2) m from
-    :func:`grating_intervals`, ``sigma`` the strain noise used to weight the fit.
-    """
-    s = np.asarray(strains, dtype=np.float64)
-    iv = np.asarray(intervals, dtype=np.float64)
-    if s.ndim != 1 or iv.shape != (s.shape[0], 2):
-        raise ValueError(
-            f"strains (N,) and intervals (N, 2) expected, got {s.shape} and {iv.shape}"
-        )
-    return beam.fit_strains(s, iv, sigma=sigma)

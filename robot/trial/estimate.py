@@ -43,6 +43,7 @@ from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from estimation.section import Section
 from estimation.southwell import SouthwellFit, southwell
 from estimation.stiffness import StiffnessEstimate, paper_estimate
+from estimation.strain_fit import fit_strains
 from estimation.verdict import TrialFacts, Verdict, judge
 from robot.trial.inputs import EstimatorInputs
 from robot.trial.run import TrialResult
@@ -220,7 +221,7 @@ def estimate_from_marks(
     beam = Beam.from_section(section, length)
     P: float | None = None
     if strains:
-        fit = beam.fit_strains(np.asarray(strains), grating_intervals(stack.sensor, length))
+        fit = fit_strains(beam, np.asarray(strains), grating_intervals(stack.sensor, length))
         if fit.success and fit.P > 0:
             P = float(fit.P)
     return paper_estimate(

@@ -133,10 +133,10 @@ def test_detector_errors() -> None:
         NormThreshold(1e-6).first_alarm(np.zeros(5))
 
 
-def test_first_mode_agrees_with_the_elastica_and_the_adapter_fits_it() -> None:
+def test_first_mode_agrees_with_the_elastica_and_the_strain_fit_inverts_it() -> None:
     """Cross-check against ``estimation.beam`` (the full elastica) near onset."""
     beam_mod = pytest.importorskip("estimation.beam")
-    from sensor.strain import beam_state
+    from estimation.strain_fit import fit_strains
 
     EI, EA = 1.18e-4, 9696.0
     beam = beam_mod.Beam(EI, EA, DY, L)
@@ -145,7 +145,7 @@ def test_first_mode_agrees_with_the_elastica_and_the_adapter_fits_it() -> None:
     full = np.asarray(beam.grating_strains(e_over_L * L, IV))
     linear = first_mode_strains(e_over_L - e_axial, IV, L, DY)
     np.testing.assert_allclose(np.abs(full), np.abs(linear), rtol=0.02)
-    fit = beam_state(beam, full, IV, sigma=1e-6)
+    fit = fit_strains(beam, full, IV, sigma=1e-6)
     assert fit.success
     assert fit.e == pytest.approx(e_over_L * L, rel=1e-3)
     p_cr = X1**2 * EI / L**2

@@ -8,7 +8,6 @@ import pytest
 from config.schema import FbgConfig, SensorConfig
 from sensor.strain import (
     StrainChain,
-    beam_state,
     capture_baseline,
     grating_intervals,
     strain_noise,
@@ -98,24 +97,3 @@ def test_grating_intervals_follow_the_config() -> None:
     # L = 42 mm; centres 10, 18, 26 mm from the tip; 3 mm gratings.
     np.testing.assert_allclose(iv * 1e3, [[30.5, 33.5], [22.5, 25.5], [14.5, 17.5]])
     np.testing.assert_allclose(grating_intervals(SensorConfig(), 0.05)[0] * 1e3, [38.5, 41.5])
-
-
-class FakeBeam:
-    def __init__(self) -> None:
-        self.calls: list[tuple[np.ndarray, np.ndarray, float | None]] = []
-
-    def fit_strains(
-        self, strains: np.ndarray, intervals: np.ndarray, sigma: float | None = None
-    ) -> str:
-        self.calls.append((strains, intervals, sigma))
-        return "fit"
-
-
-def test_beam_state_adapter_passes_through() -> None:
-    beam = FakeBeam()
-    assert (
-        beam_state(beam, [1e-4, 2e-4, 3e-4], grating_intervals(SensorConfig()), sigma=1e-6) == "fit"
-    )
-    assert beam.calls[0][2] == 1e-6
-    with pytest.raises(ValueError, match="intervals"):
-        beam_state(beam, [1e-4, 2e-4], grating_intervals(SensorConfig()))
