@@ -1,12 +1,15 @@
-"""Simulated campaigns: what the control rate costs and what it buys.
+"""Simulated campaigns: what each fidelity level costs and what it buys.
 
-The simulator runs the control loop, the servo bus and the FBG stream at the scene's
-``control_rate_hz`` (the board streams at the same rate, as the shipped scenes do), so the
-rate sets both the CPU a trial costs and the number of samples the estimators see. This
-section runs the bench-top campaign (Table I; every fifth trial with ``--quick``) at a few
-rates, serially in this process, and reports per trial the median wall time and, over the
-trials, the joint fit's median and worst relative error of E, its interval coverage and the
-paper's single-point error. The shipped scenes use 250 Hz.
+The bench-top campaign (Table I; every fifth trial with ``--quick``) runs serially in this
+process at each fidelity level of :data:`LEVELS`: the shipped scene over the wire (emulators on
+pseudo-terminals) and on the fast in-process path, each world effect the shipped scene leaves
+off switched on (gravity, the realistic bus timing), the closed-form tissue instead of the FE
+tables, and lower control/board rates down to the cheapest level ("lean", 20 Hz). Per level: the
+CPU time of one trial (median over the trials; ``time.process_time``, so the emulators' threads
+count and other work on the machine does not), how many times cheaper that is than the shipped
+level, simulated seconds per CPU second ("x real time per core"), the joint fit's median and
+worst relative error of E, its 95 % interval coverage and the paper's single-point error. The
+table is the speed-against-error trade; the figure plots it with the Pareto front.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import itertools
 import math
 import statistics
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -23,48 +27,85 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaign import campaign_trials, median_abs_relative_error, run_campaign, warm_up
-from palpate.simtrial import TrialOutcome
+from palpate.simtrial import Transport, TrialOutcome
 
-RATES_HZ = (100.0, 250.0, 500.0)
+SceneChange = Callable[[SceneConfig], SceneConfig]
+
+
+def _rate(hz: float) -> SceneChange:
+    return lambda s: dataclasses.replace(s, control_rate_hz=hz, board_rate_hz=hz)
+
+
+def _fidelity(**changes: Any) -> SceneChange:
+    return lambda s: dataclasses.replace(s, fidelity=dataclasses.replace(s.fidelity, **changes))
+
+
+def _shipped(s: SceneConfig) -> SceneConfig:
+    return s
 
 
 @dataclasses.dataclass(frozen=True)
-class RateRow:
-    rate_hz: float
+class Level:
+    name: str
+    transport: Transport
+    change: SceneChange
+
+
+REFERENCE = "shipped (250 Hz, FE)"
+CHEAPEST = "lean: 20 Hz"
+LEVELS = (
+    Level(REFERENCE, "wire", _shipped),
+    Level(REFERENCE, "fast", _shipped),
+    Level("+ gravity", "fast", _fidelity(gravity=True)),
+    Level(
+        "+ realistic bus, 1 ms timer",
+        "fast",
+        _fidelity(bus_timing="realistic", latency_timer_ms=1.0),
+    ),
+    Level("closed-form tissue", "fast", _fidelity(tissue_model="closed-form")),
+    Level("100 Hz", "fast", _rate(100.0)),
+    Level("50 Hz", "fast", _rate(50.0)),
+    Level(CHEAPEST, "fast", _rate(20.0)),
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class LevelRow:
+    level: str
+    transport: str
     trials: int
-    seconds_per_trial: float  # median wall time of one trial, serial
-    speedup: float  # simulated / wall seconds over the campaign
+    cpu_per_trial: float  # median CPU seconds of one trial, serial
+    real_time_per_core: float  # simulated seconds / CPU seconds over the campaign
     joint_median: float | None
     joint_worst: float | None
     coverage: float | None
     paper_median: float | None
 
 
-def _rate_row(rate_hz: float, ctx: BenchContext) -> RateRow:
-    scene = load(SceneConfig, resolve("scenes/bench.yaml"))
-    scene = dataclasses.replace(scene, control_rate_hz=rate_hz, board_rate_hz=rate_hz)
+def _level_row(level: Level, ctx: BenchContext) -> LevelRow:
+    scene = level.change(load(SceneConfig, resolve("scenes/bench.yaml")))
     stack = load_stack(resolve(scene.robot))
     specs = campaign_trials(scene, stack, ctx.seed)
     if ctx.quick:
         specs = specs[::5]
-    stamps = [time.perf_counter()]
+    stamps = [time.process_time()]
 
     def progress(_: TrialOutcome) -> None:
-        stamps.append(time.perf_counter())
+        stamps.append(time.process_time())
 
-    outcomes = run_campaign(specs, scene, stack, progress=progress)  # serial: times are per trial
-    per_trial = [b - a for a, b in itertools.pairwise(stamps)]
+    outcomes = run_campaign(specs, scene, stack, transport=level.transport, progress=progress)
     errors = [
         abs(m - o.spec.modulus) / o.spec.modulus
         for o in outcomes
         if (m := o.modulus("joint")) is not None
     ]
     covered = [o.joint is not None and o.joint.covers(o.spec.modulus) for o in outcomes]
-    return RateRow(
-        rate_hz=rate_hz,
+    return LevelRow(
+        level=level.name,
+        transport=level.transport,
         trials=len(outcomes),
-        seconds_per_trial=statistics.median(per_trial),
-        speedup=sum(o.sim_time for o in outcomes) / (stamps[-1] - stamps[0]),
+        cpu_per_trial=statistics.median(b - a for a, b in itertools.pairwise(stamps)),
+        real_time_per_core=sum(o.sim_time for o in outcomes) / (stamps[-1] - stamps[0]),
         joint_median=median_abs_relative_error(outcomes),
         joint_worst=max(errors, default=None),
         coverage=sum(covered) / len(covered) if covered else None,  # as palpate.compare
@@ -76,21 +117,42 @@ def _pct(x: float | None) -> str:
     return "-" if x is None else f"{100 * x:.1f} %"
 
 
-def _plot(rows: list[RateRow], path: Path) -> Path:
+def _label(r: LevelRow) -> str:
+    return f"{r.level}, {r.transport}"
+
+
+def pareto_front(points: list[tuple[float, float]]) -> list[int]:
+    """Indices of the points (cost, error) no other point beats in both (ties kept), by cost."""
+    return sorted(
+        (
+            i
+            for i, (c, e) in enumerate(points)
+            if not any((c2 <= c and e2 <= e) and (c2 < c or e2 < e) for c2, e2 in points)
+        ),
+        key=lambda i: points[i],
+    )
+
+
+def _plot(rows: list[LevelRow], path: Path) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for r in rows:
-        if r.joint_median is None:
-            continue
-        ax.plot(r.seconds_per_trial, 100 * r.joint_median, "o")
-        ax.annotate(f"{r.rate_hz:g} Hz", (r.seconds_per_trial, 100 * r.joint_median), fontsize=8)
-    ax.set_xlabel("wall time per trial (s, serial)")
+    shown = [r for r in rows if r.joint_median is not None]
+    points = [(1e3 * r.cpu_per_trial, 100 * (r.joint_median or 0.0)) for r in shown]
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for r, (x, y) in zip(shown, points, strict=True):
+        ax.plot(x, y, "o" if r.transport == "fast" else "s")
+        ax.annotate(_label(r), (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    front = [points[i] for i in pareto_front(points)]
+    if front:
+        ax.step(*zip(*front, strict=True), where="post", color="k", lw=0.8, label="Pareto front")
+        ax.legend(fontsize=8)
+    ax.set_xscale("log")
+    ax.set_xlabel("CPU time per trial (ms, serial)")
     ax.set_ylabel("joint fit: median |relative error| of E (%)")
-    ax.set_title("Simulated bench campaign: control rate, speed against error")
+    ax.set_title("Simulated bench campaign: fidelity level, speed against error")
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -98,16 +160,17 @@ def _plot(rows: list[RateRow], path: Path) -> Path:
     return path
 
 
-def run(ctx: BenchContext) -> BenchSection:
-    warm_up()
-    rows = [_rate_row(rate, ctx) for rate in RATES_HZ]
-    table = Table(
-        title="Bench-top campaign (Table I) by control rate: speed against error",
+def _table(rows: list[LevelRow], ctx: BenchContext) -> Table:
+    ref = next(r for r in rows if r.level == REFERENCE and r.transport == "fast")
+    return Table(
+        title="Bench-top campaign (Table I) by fidelity level: speed against error",
         columns=[
-            "rate Hz",
+            "level",
+            "transport",
             "trials",
-            "s/trial (median)",
-            "x real time",
+            "CPU ms/trial",
+            "x cheaper",
+            "x real time/core",
             "joint median",
             "joint worst",
             "95% CI coverage",
@@ -115,10 +178,12 @@ def run(ctx: BenchContext) -> BenchSection:
         ],
         rows=[
             [
-                f"{r.rate_hz:g}",
+                r.level,
+                r.transport,
                 r.trials,
-                r.seconds_per_trial,
-                r.speedup,
+                1e3 * r.cpu_per_trial,
+                ref.cpu_per_trial / r.cpu_per_trial,
+                r.real_time_per_core,
                 _pct(r.joint_median),
                 _pct(r.joint_worst),
                 _pct(r.coverage),
@@ -127,17 +192,27 @@ def run(ctx: BenchContext) -> BenchSection:
             for r in rows
         ],
         note=(
-            "serial, in-process fast path, seed "
-            f"{ctx.seed}{', every fifth trial (--quick)' if ctx.quick else ''}; "
-            "the shipped scenes use 250 Hz"
+            f"serial, CPU time (process_time), seed {ctx.seed}"
+            f"{', every fifth trial (--quick)' if ctx.quick else ''}; 'x cheaper' against the "
+            "shipped level on the fast path; every level but the rates keeps 250 Hz"
         ),
     )
+
+
+def run(ctx: BenchContext) -> BenchSection:
+    warm_up()
+    rows = [_level_row(level, ctx) for level in LEVELS]
+    ref = next(r for r in rows if r.level == REFERENCE and r.transport == "fast")
     summary: dict[str, Any] = {
-        f"{r.rate_hz:g}_hz": {
+        _label(r): {
             k: (None if isinstance(v, float) and not math.isfinite(v) else v)
             for k, v in dataclasses.asdict(r).items()
         }
         for r in rows
     }
-    figure = _plot(rows, ctx.out_dir / "campaign_rate.png")
-    return BenchSection(name="campaign", tables=[table], figures=[figure], summary=summary)
+    cheapest = next(r for r in rows if r.level == CHEAPEST)
+    summary["cheapest_vs_shipped"] = ref.cpu_per_trial / cheapest.cpu_per_trial
+    figure = _plot(rows, ctx.out_dir / "campaign_fidelity.png")
+    return BenchSection(
+        name="campaign", tables=[_table(rows, ctx)], figures=[figure], summary=summary
+    )

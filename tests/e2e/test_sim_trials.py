@@ -116,9 +116,10 @@ def test_cli_bad_scene_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert "campaign.kind" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("rate_hz", [100.0, 500.0])
+@pytest.mark.parametrize("rate_hz", [50.0, 100.0, 500.0])
 def test_other_control_rates_run_the_same_trial(rate_hz: float) -> None:
-    """``palpate bench --only campaign`` varies the control (and board) rate; a trial at another
+    """``palpate bench --only campaign`` runs fidelity levels at lower control (and board) rates
+    (50 Hz is the cheapest that keeps the bench's accuracy); a trial at another
     rate must follow the same protocol: it completes, its tick count scales with the rate and
     the joint fit stays close to the sample's modulus."""
     base = run_sim_trial(bench_spec(), BENCH, STACK)
@@ -130,6 +131,6 @@ def test_other_control_rates_run_the_same_trial(rate_hz: float) -> None:
     assert other.sim_time == pytest.approx(base.sim_time, rel=0.1)
     assert other.joint is not None
     assert other.joint.modulus is not None
-    # one trial, not a campaign: at 100 Hz the joint fit's worst case is ~10 % (palpate bench
-    # --only campaign); this one is +5.1 % on the calibrated finite-element world
+    # one trial, not a campaign: at 50-100 Hz the joint fit's worst case is ~5-10 % (palpate
+    # bench --only campaign); this one is -1.7 % (50 Hz) and +5.1 % (100 Hz) on the FE world
     assert other.joint.modulus == pytest.approx(other.spec.modulus, rel=0.08)
