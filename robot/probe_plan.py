@@ -40,8 +40,7 @@ from robot.indentation import TrialPlan
 
 Vector = NDArray[np.float64]
 FloatArray = NDArray[np.float64]
-SWEEP_STEPS = 8  # rays checked along a roll for the retract before it, or more:
-SWEEP_STEP = math.radians(5.0)  # at most this roll apart
+SWEEP_STEPS = 8  # rays checked along a roll for the retract before it
 ROLL_MARGIN = math.radians(1.0)  # probe rolls stay this far inside the roll limits
 MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is read with
 
@@ -234,8 +233,7 @@ class ProbeGeometry:
         """(rolls, advances): rays from roll ``start`` to ``end`` and, on each, the advance (m)
         behind where the surface can be, by ``clearance`` (the touches, and so the prediction,
         are their depth past the surface)."""
-        steps = max(SWEEP_STEPS, math.ceil(abs(end - start) / SWEEP_STEP))
-        rolls = np.linspace(start, end, steps + 1).tolist()
+        rolls = np.linspace(start, end, SWEEP_STEPS + 1).tolist()
         depth = max(t.depth for t in touches)  # the touches are this far past the surface
         safe = []
         for roll in rolls:

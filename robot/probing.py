@@ -31,6 +31,7 @@ from robot.indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPl
 from robot.probe_plan import ProbeGeometry, ProbeResult, ProbeSettings, Touch
 
 MOVE_LOOKAHEAD = math.radians(12.0)  # roll ahead of the present the stage keeps clear of
+NEAR = 0.03  # rad of roll ahead the stage must be clear of before the roll moves on
 ON_RAY = math.radians(2.0)  # within this roll of a touch the tip still faces its dimple
 TOUCH_TOP = 2.0  # a seek goes on to this many thresholds, for the fit of its ramp
 TOUCH_FREE = 0.5  # the tip is free again below this share of the threshold
@@ -210,25 +211,25 @@ class ProbeRoutine:
 
     def _move(self, obs: Observation) -> Command:
         """Roll to the next touch (``_travel``), then settle there."""
-        cmd, arrived = self._travel(obs, self.roll, MOVE_LOOKAHEAD, math.inf)
+        cmd, arrived = self._travel(obs, self.roll, (NEAR, MOVE_LOOKAHEAD), math.inf)
         if arrived:
             self.phase, self._ticks = _Phase.SETTLE, 0
         return cmd
 
     def _travel(
-        self, obs: Observation, roll: float, lookahead: float, cap: float
+        self, obs: Observation, roll: float, spans: tuple[float, float], cap: float
     ) -> tuple[Command, bool]:
         """Roll to ``roll``, the stage following the surface on the rays the roll is about to
-        sweep (``lookahead`` ahead) and never beyond ``cap``: retract and roll at once; the
+        sweep (``spans[1]`` ahead) and never beyond ``cap``: retract and roll at once; the
         roll holds while the tip is on the surface or the stage is not yet behind it on the
-        next few degrees. Whether the stage is there, at rest."""
+        next ``spans[0]`` of roll. Whether the stage is there, at rest."""
         s = self.settings
         if not self._freed(obs):  # back off along the ray until the FBG says the tip is free
             self.goal = min(self.goal, obs.advance - s.clearance)
             return Command(self.goal, obs.roll, s.fast_speed), False
         togo = roll - obs.roll
-        near = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), 0.03), togo))
-        ahead = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), lookahead), togo))
+        near = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), spans[0]), togo))
+        ahead = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), spans[1]), togo))
         on_last_ray = abs(obs.roll - self.touches[-1].roll) < ON_RAY
         goal = min(min(self.goal, ahead) if on_last_ray else ahead, cap)
         at_roll = abs(togo) <= self.plan.roll_tolerance
@@ -247,12 +248,12 @@ class ProbeRoutine:
         return Command(self.goal, self.roll, 0.0, rezero=True)
 
     def _leave(self, obs: Observation) -> Command | ProbeResult:
-        """Roll to the chosen pose (``_travel``), behind the surface on every ray still to
-        sweep and behind the pose's stand-off (the stage goes there anyway), retracting and
-        rolling at once; the trial's positioning takes it to its stand-off from there."""
+        """Roll to the chosen pose (``_travel``), the stage going back behind the surface on
+        every ray still to sweep and behind the pose's stand-off (it goes there anyway) as the
+        roll moves on; the trial's positioning takes it to its stand-off from there."""
         assert self.result is not None
         r = self.result
-        cmd, arrived = self._travel(obs, r.roll, math.inf, r.retract_to)
+        cmd, arrived = self._travel(obs, r.roll, (NEAR, math.inf), r.retract_to)
         if arrived:
             return dataclasses.replace(self.result, retract_to=self.goal)
         return cmd
