@@ -31,6 +31,7 @@ from robot.indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPl
 from robot.probe_plan import ProbeGeometry, ProbeResult, ProbeSettings, Touch
 
 MOVE_LOOKAHEAD = math.radians(12.0)  # roll ahead of the present the stage keeps clear of
+NEAR = 0.03  # rad of roll ahead the stage must be clear of before the roll moves on
 ON_RAY = math.radians(2.0)  # within this roll of a touch the tip still faces its dimple
 TOUCH_TOP = 2.0  # a seek goes on to this many thresholds, for the fit of its ramp
 TOUCH_FREE = 0.5  # the tip is free again below this share of the threshold
@@ -159,17 +160,25 @@ class ProbeRoutine:
         self._free, self._free_ticks, self._loaded_ticks = False, 0, 0
         self.goal = self.touches[-1].advance - s.clearance
         if len(self.touches) == len(self.rolls):
-            self.result = geo.replan(self.touches, self.plan, s)
-            self.goal = min(self.goal, self.result.retract_to)
+            result = geo.replan(self.touches, self.plan, s)
+            roll = _nearest_turn(result.roll, obs.roll, geo.roll_limits)
+            self.result = dataclasses.replace(result, roll=roll)
+            self._plan_sweep(obs.roll, self.result.roll)
             self.phase = _Phase.LEAVE
             return self._leave(obs)
+        if len(self.touches) == 2:
+            self.rolls = _near_side_last(self.rolls, self.touches)
         roll = self.rolls[len(self.touches)]
         x, slack = geo.predict(self.touches, roll, s)
-        rolls, safe = geo.sweep_needs(self.touches, obs.roll, roll, s)
-        self._sweep = (rolls, safe) if rolls[0] <= rolls[-1] else (rolls[::-1], safe[::-1])
+        self._plan_sweep(obs.roll, roll)
         self.limit = x + slack + s.clearance + self.plan.approach_window
         self.phase = _Phase.MOVE
         return self._move(obs)
+
+    def _plan_sweep(self, start: float, end: float) -> None:
+        """The advance behind the surface on the rays from roll ``start`` to ``end``."""
+        rolls, safe = self.geometry.sweep_needs(self.touches, start, end, self.settings)
+        self._sweep = (rolls, safe) if rolls[0] <= rolls[-1] else (rolls[::-1], safe[::-1])
 
     def _freed(self, obs: Observation) -> bool:
         """Whether the tip is off the surface, by the FBG: ``FREE_TICKS`` ticks running with
@@ -201,25 +210,34 @@ class ProbeRoutine:
         return float(min(*ends, *inside)) if inside else float(min(ends))
 
     def _move(self, obs: Observation) -> Command:
-        """Roll to the next touch, the stage following the surface on the rays the roll is
-        about to sweep (``MOVE_LOOKAHEAD`` ahead); the roll holds while the tip is on the
-        surface or the stage is not yet behind it on the next few degrees."""
+        """Roll to the next touch (``_travel``), then settle there."""
+        cmd, arrived = self._travel(obs, self.roll, (NEAR, MOVE_LOOKAHEAD), math.inf)
+        if arrived:
+            self.phase, self._ticks = _Phase.SETTLE, 0
+        return cmd
+
+    def _travel(
+        self, obs: Observation, roll: float, spans: tuple[float, float], cap: float
+    ) -> tuple[Command, bool]:
+        """Roll to ``roll``, the stage following the surface on the rays the roll is about to
+        sweep (``spans[1]`` ahead) and never beyond ``cap``: retract and roll at once; the
+        roll holds while the tip is on the surface or the stage is not yet behind it on the
+        next ``spans[0]`` of roll. Whether the stage is there, at rest."""
         s = self.settings
         if not self._freed(obs):  # back off along the ray until the FBG says the tip is free
             self.goal = min(self.goal, obs.advance - s.clearance)
-            return Command(self.goal, obs.roll, s.fast_speed)
-        togo = self.roll - obs.roll
-        near = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), 0.03), togo))
-        ahead = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), MOVE_LOOKAHEAD), togo))
+            return Command(self.goal, obs.roll, s.fast_speed), False
+        togo = roll - obs.roll
+        near = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), spans[0]), togo))
+        ahead = self._safe(obs.roll, obs.roll + math.copysign(min(abs(togo), spans[1]), togo))
         on_last_ray = abs(obs.roll - self.touches[-1].roll) < ON_RAY
-        goal = min(self.goal, ahead) if on_last_ray else ahead
+        goal = min(min(self.goal, ahead) if on_last_ray else ahead, cap)
         at_roll = abs(togo) <= self.plan.roll_tolerance
         if at_roll and abs(obs.advance - goal) <= self.plan.position_tolerance:
             self.goal = goal
-            self.phase, self._ticks = _Phase.SETTLE, 0
-            return Command(goal, self.roll, 0.0)
+            return Command(goal, roll, 0.0), True
         safe = obs.advance <= near + self.plan.position_tolerance
-        return Command(goal, self.roll if safe else obs.roll, s.fast_speed)
+        return Command(goal, roll if safe else obs.roll, s.fast_speed), False
 
     def _settle(self, obs: Observation) -> Command:
         self._ticks += 1
@@ -230,7 +248,34 @@ class ProbeRoutine:
         return Command(self.goal, self.roll, 0.0, rezero=True)
 
     def _leave(self, obs: Observation) -> Command | ProbeResult:
+        """Roll to the chosen pose (``_travel``), the stage going back behind the surface on
+        every ray still to sweep and behind the pose's stand-off (it goes there anyway) as the
+        roll moves on; the trial's positioning takes it to its stand-off from there."""
         assert self.result is not None
-        if self._freed(obs) and obs.advance <= self.goal + self.plan.position_tolerance:
+        r = self.result
+        cmd, arrived = self._travel(obs, r.roll, (NEAR, math.inf), r.retract_to)
+        if arrived:
             return dataclasses.replace(self.result, retract_to=self.goal)
-        return Command(self.goal, obs.roll, self.settings.fast_speed)
+        return cmd
+
+
+def _near_side_last(rolls: list[float], touches: list[Touch]) -> list[float]:
+    """The touches' rolls with the full steps ordered so the last lies on the side where the
+    first two touches found the surface nearer: along a roll a plane is nearest where the ray
+    meets it square, so the orthogonal pose lies on that side and the way out is short (the
+    same rolls, only the order of the third and fourth)."""
+    if len(rolls) < 4:
+        return rolls
+    (a, b), nearer = rolls[2:4], touches[1].advance < touches[0].advance
+    toward = math.copysign(1.0, rolls[1] - rolls[0]) * (1.0 if nearer else -1.0)
+    if (b - a) * toward < 0:
+        a, b = b, a
+    return [*rolls[:2], a, b, *rolls[4:]]
+
+
+def _nearest_turn(roll: float, near: float, limits: tuple[float, float]) -> float:
+    """``roll`` or a whole turn from it (the same line), whichever within ``limits`` is nearest
+    ``near``: the way out never sweeps the long way round."""
+    turns = [roll + k * math.tau for k in (-1, 0, 1)]
+    inside = [r for r in turns if limits[0] <= r <= limits[1]] or [roll]
+    return min(inside, key=lambda r: abs(r - near))

@@ -102,3 +102,18 @@ def test_the_twist_guard_stops_and_retracts_when_the_inner_gear_lags() -> None:
     assert "3.00 deg bound" in out.reason
     assert out.marks is not None
     assert out.marks.x_contact is None
+
+
+def test_probing_ends_on_the_near_side_and_stays_within_its_simulated_budget() -> None:
+    """The last touch lies on the side of the orthogonal pose (the surface's nearest rays), the
+    way out rolls there at once, and the step's simulated time stays where it was measured
+    (docs/orientation.md): seeded on a virtual clock, so deterministic."""
+    out = run_sim_trial(spec("S8-t25", "bent30"), TILTED, STACK)
+    assert out.state == "done", out.reason
+    assert out.probe is not None
+    first, last = out.probe.touches[0], out.probe.touches[-1]
+    assert (last.roll - first.roll) * (out.probe.roll - first.roll) > 0
+    assert math.degrees(out.misalignment) < 1.0
+    assert out.true_misalignment is not None
+    assert math.degrees(out.true_misalignment) < 1.0
+    assert out.probing_time < 9.5  # s simulated, roll to the pose included (10.1 s before)
