@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from config.schema import TubeConfig
 from estimation.beamstate import axial_strain
-from estimation.surface import SurfaceGeometry, fit_plane, fit_surface
+from estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane, fit_surface
 from robot import kinematics
 from robot.indentation import TrialPlan
 
@@ -43,6 +43,10 @@ FloatArray = NDArray[np.float64]
 SWEEP_STEPS = 8  # rays checked along a roll for the retract before it
 ROLL_MARGIN = math.radians(1.0)  # probe rolls stay this far inside the roll limits
 MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is read with
+# A pose this many of the measured normal's 1-sigma angles past the angle tolerance cannot be
+# told from one within it: it is indented, and the verdict reads its residual (suspect beyond
+# the tolerance) instead of the trial ending unreachable on a noisy normal.
+NORMAL_SIGMAS = 2.0
 
 
 @dataclass(frozen=True)
@@ -266,12 +270,14 @@ class ProbeGeometry:
         if not fit.success:
             return self._unmeasured(touches, plan, settings, fit.message)
         surface = fit.surface(self.tip_radius)
+        normal_sigma = _scaled_sigma(fit, settings.sigma)
         n0 = surface.normal_at(centres[0])
         target = centres[0] - self.tip_radius * n0
         ik = kinematics.solve_for_tube(
             self.tube, target, n0, tip_radius=self.tip_radius,
             translation_limits=self.translation_limits, roll_limits=self.roll_limits,
-            radius=surface.radius, max_residual=settings.max_residual, max_miss=settings.max_miss,
+            radius=surface.radius, max_miss=settings.max_miss,
+            max_residual=settings.max_residual + NORMAL_SIGMAS * normal_sigma,
         )  # fmt: skip
         move = ik.reachable and settings.replan
         roll = ik.roll if move else plan.roll
@@ -284,11 +290,11 @@ class ProbeGeometry:
         n = surface.normal
         return ProbeResult(
             ik.reachable or not settings.replan,
-            _reason(ik, settings),
+            _reason(ik, settings, normal_sigma),
             roll,
             advance,
             ik.residual,
-            fit.normal_sigma,
+            normal_sigma,
             ik.miss,
             (float(n[0]), float(n[1]), float(n[2])),
             fit.model,
@@ -322,12 +328,27 @@ def _plan_pose(
     return kinematics.IKSolution(geo.tube.name, plan.roll, advance, hit, residual, 0, centre, miss)
 
 
-def _reason(ik: kinematics.IKSolution, settings: ProbeSettings) -> str:
+def _scaled_sigma(fit: SurfaceFit, sigma: float) -> float:
+    """The normal's 1-sigma angle, scaled up when the touches scatter about the fitted surface
+    more than their assumed ``sigma`` (m) says (the square root of chi^2 per degree of freedom,
+    as a weighted fit's uncertainty is when the a-priori sigma is in doubt; never scaled down).
+    A plane has 3 parameters, a sphere 4; with no spare touch the assumed sigma stands."""
+    dof = fit.points - (3 if fit.model == "plane" else 4)
+    if dof < 1 or not math.isfinite(fit.rms) or sigma <= 0.0:
+        return fit.normal_sigma
+    ratio = math.sqrt(fit.points / dof) * fit.rms / sigma
+    return fit.normal_sigma * max(1.0, ratio)
+
+
+def _reason(ik: kinematics.IKSolution, settings: ProbeSettings, normal_sigma: float) -> str:
     found = f"residual {math.degrees(ik.residual):.2f} deg, miss {ik.miss * 1e3:.1f} mm"
+    if ik.reachable and ik.residual > settings.max_residual:
+        return f"pose found within the measured normal's uncertainty: {found}"
     if ik.reachable:
         return f"orthogonal pose found: {found}"
     limits = (
-        f"tolerances {math.degrees(settings.max_residual):.1f} deg, "
+        f"tolerances {math.degrees(settings.max_residual):.1f} deg "
+        f"+ {NORMAL_SIGMAS:g} x {math.degrees(normal_sigma):.2f} deg (the normal's 1-sigma), "
         f"{settings.max_miss * 1e3:.0f} mm"
     )
     return f"no orthogonal pose of tube {ik.tube}: {ik.reason} ({found}; {limits})"
