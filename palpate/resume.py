@@ -24,7 +24,7 @@ from estimation.stiffness import StiffnessEstimate
 from palpate.runs import set_aside
 from palpate.simtrial import TrialOutcome, TrialSpec, trial_geometry
 from robot.indentation import TrialMarks
-from robot.probe_plan import ProbeResult, Touch
+from robot.probe_result import ProbeResult, Touch
 from robot.trial.estimate import exposed_length_at
 from robot.trial.log import TrialLog, TrialLogError, read_log
 from robot.trial.record import recorded_verdict

@@ -21,7 +21,7 @@ from estimation.stiffness import StiffnessEstimate
 from estimation.verdict import Verdict
 from palpate.simworld import TrialGeometry, TrialSpec, trial_sample
 from robot.indentation import TrialMarks
-from robot.probing import ProbeResult
+from robot.probe_result import ProbeResult
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from robot.trial.inputs import belief_fields
 from robot.trial.run import TrialResult

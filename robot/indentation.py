@@ -28,12 +28,10 @@ import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 from estimation.detect_buckling import BucklingDetector
-
-if TYPE_CHECKING:  # types only: robot.probing imports this module
-    from robot.probing import ProbeResult
+from robot.probe_result import ProbeResult
 
 
 class State(enum.Enum):

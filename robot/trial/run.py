@@ -27,7 +27,7 @@ from robot.indentation import (
     TrialMarks,
     TrialPlan,
 )
-from robot.probing import ProbeResult
+from robot.probe_result import ProbeResult
 from robot.trial.log import TrialLogWriter
 from sensor.clock import Clock
 
