@@ -109,9 +109,12 @@ def test_a_session_on_the_emulators_ptys_runs_logs_and_releases(tmp_path: Path) 
     (o,) = outcomes
     assert o.state == "done", o.reason
     assert o.estimate is not None
-    assert o.estimate.modulus is not None
-    assert 0.5 < o.estimate.modulus / 314.53e3 < 2.0
-    assert o.estimate.delta > 0
+    assert o.estimate.modulus is not None  # the paper's estimate: E ~ delta^-1.5 from the
+    assert o.estimate.delta > 0  # FBG contact event, so only its presence is asserted here
+    # the joint fit does not read the contact event: it is the estimate to hold to the truth
+    assert o.joint is not None
+    assert o.joint.modulus is not None
+    assert abs(o.joint.modulus / 314.53e3 - 1.0) < 0.1
     log = read_log(Path(str(o.log_path)))
     assert log.complete
     assert log.header["source"] == "bench"
