@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from config.schema import SensorConfig
 from estimation.elastica.constants import P_CRIT
 
 
@@ -88,3 +89,14 @@ def euler_load(EI: float, L: float) -> float:
 
 
 __all__ = ["P_CRIT", "Section", "composite_section", "euler_load"]
+
+
+def sensor_section(sensor: SensorConfig) -> Section:
+    """The composite section (EI, EA, fiber offset) of a configured sensor."""
+    return composite_section(
+        sensor.fiber_radius,
+        sensor.fiber_modulus,
+        sensor.wire_radius,
+        sensor.wire_modulus,
+        sensor.wire_count,
+    )

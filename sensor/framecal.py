@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from config.schema import StackConfig
 from estimation.beam import Beam
-from estimation.section import composite_section
+from estimation.section import sensor_section
 from sensor.calibration import CalibrationFit, fit_strain_coefficient
 from sensor.reader import layout_from_config
 from sensor.strain import grating_intervals
@@ -73,10 +73,7 @@ def calibrate_frames(
     if len(block) <= rest_frames + 10:
         raise ValueError(f"{len(block)} frames: too few (needs more than {rest_frames + 10})")
     s = stack.sensor
-    section = composite_section(
-        s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
-    )
-    beam = Beam.from_section(section, exposed_length)
+    beam = Beam.from_section(sensor_section(s), exposed_length)
     wavelengths = block.wavelengths
     shift = wavelengths - wavelengths[:rest_frames].mean(axis=0)
     u = block.encoder.astype(np.float64) * (stack.drive.lead / TICKS_PER_REV)

@@ -27,7 +27,7 @@ from config.schema import SensorConfig
 from estimation.beam import Beam
 from estimation.elastica import E_OVER_L_MAX, accurate, fast, shooting
 from estimation.elastica._scipy import solve_ivp
-from estimation.section import composite_section
+from estimation.section import sensor_section
 from estimation.strain_fit import fit_strains
 from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
 
@@ -145,10 +145,7 @@ def _pareto(rows: list[Row], path: Any) -> None:
 
 
 def _sensor_table() -> Table:
-    cfg = SensorConfig()
-    sec = composite_section(
-        cfg.fiber_radius, cfg.fiber_modulus, cfg.wire_radius, cfg.wire_modulus, cfg.wire_count
-    )
+    sec = sensor_section(SensorConfig())
     table = Table(
         "Paper sensor: section and buckling loads",
         ["L (mm)", "EI (N m^2)", "dy_fbg (mm)", "P_cr (N)", "P_peak (N)", "e_cr (um)"],
@@ -170,11 +167,7 @@ def _sensor_table() -> Table:
 
 
 def _beam_table(ctx: BenchContext) -> Table:
-    cfg = SensorConfig()
-    sec = composite_section(
-        cfg.fiber_radius, cfg.fiber_modulus, cfg.wire_radius, cfg.wire_modulus, cfg.wire_count
-    )
-    beam = Beam.from_section(sec, L_PAPER)
+    beam = Beam.from_section(sensor_section(SensorConfig()), L_PAPER)
     rng = np.random.default_rng(ctx.seed)
     e = rng.uniform(0.0, 0.02 * L_PAPER, 10_000)
     iv = np.stack([S0 * L_PAPER, S1 * L_PAPER], axis=1)

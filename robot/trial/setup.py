@@ -18,7 +18,8 @@ from config.scene import CampaignConfig
 from config.schema import MM, StackConfig, TubeConfig
 from estimation.beamstate import infer_states, onset_mode
 from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
-from estimation.section import Section, composite_section
+from estimation.section import Section
+from estimation.section import sensor_section as section_of
 from robot.indentation import Guards, Prober, TrialPlan
 from robot.probing import ProbeGeometry, ProbeRoutine, ProbeSettings
 from robot.rig import RigSettings
@@ -30,10 +31,7 @@ FloatArray = NDArray[np.float64]
 
 def sensor_section(stack: StackConfig) -> Section:
     """The sensor's composite section (EI, EA, fiber offset) from the robot configuration."""
-    s = stack.sensor
-    return composite_section(
-        s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
-    )
+    return section_of(stack.sensor)
 
 
 def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Guards:

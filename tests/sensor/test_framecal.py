@@ -9,7 +9,7 @@ import pytest
 
 from config.schema import MM, StackConfig
 from estimation.beam import Beam
-from estimation.section import composite_section
+from estimation.section import sensor_section
 from sensor.framecal import calibrate_frames, read_frames
 from sensor.strain import grating_intervals
 from wire.dynamixel import TICKS_PER_REV
@@ -25,10 +25,7 @@ def stream(
     """Frames of the stage advancing to ``end`` past a rigid reference's contact at x0, the
     peaks shifted by k times the elastica's grating strains at e = u - x0, plus noise."""
     s = STACK.sensor
-    sec = composite_section(
-        s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
-    )
-    beam = Beam.from_section(sec, L)
+    beam = Beam.from_section(sensor_section(s), L)
     step = STACK.drive.lead / TICKS_PER_REV
     counts = np.round(np.linspace(x0 - 2.5e-3, x0 + end, 1500) / step).astype(np.int32)
     counts = np.concatenate([np.full(40, counts[0]), counts])  # at rest first

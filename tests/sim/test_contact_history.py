@@ -10,7 +10,7 @@ import pytest
 from config import load_stack
 from config.sample import SampleConfig
 from config.scene import FidelityConfig
-from estimation.section import composite_section
+from estimation.section import sensor_section
 from sim.contact_history import ViscoelasticContact, step_law
 from sim.contact_table import GridPhysics, equilibrium_on_grid
 from sim.equilibrium import ContactEffects, TissueLaw
@@ -20,13 +20,7 @@ from sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor
-SECTION = composite_section(
-    SENSOR.fiber_radius,
-    SENSOR.fiber_modulus,
-    SENSOR.wire_radius,
-    SENSOR.wire_modulus,
-    SENSOR.wire_count,
-)
+SECTION = sensor_section(SENSOR)
 L = 42e-3
 LAW = world_tissue(SampleConfig(name="S", modulus_kpa=400.0), FidelityConfig(), SENSOR.tip_radius)
 SLS = StandardLinearSolid(tau=0.5, ratio=0.6)

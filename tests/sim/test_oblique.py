@@ -10,7 +10,7 @@ import pytest
 
 from config import load_stack
 from config.scene import FidelityConfig
-from estimation.section import composite_section
+from estimation.section import sensor_section
 from sim.contact_table import GridPhysics, equilibrium_on_grid
 from sim.equilibrium import ContactEffects
 from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
@@ -20,10 +20,7 @@ from sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor
-SECTION = composite_section(
-    SENSOR.fiber_radius, SENSOR.fiber_modulus, SENSOR.wire_radius, SENSOR.wire_modulus,
-    SENSOR.wire_count,
-)  # fmt: skip
+SECTION = sensor_section(SENSOR)
 L = 42e-3
 TISSUE = TissueModel(3.1e5, 0.45, 10e-3, True, SENSOR.tip_radius, True, True)
 P_PINNED = 20.19 * SECTION.EI / L**2  # clamped-pinned onset

@@ -10,7 +10,7 @@ import pytest
 from config import load_stack
 from config.scene import FidelityConfig
 from estimation.beam import Beam
-from estimation.section import composite_section
+from estimation.section import sensor_section
 from sim.contact_table import ContactTable, equilibrium_on_grid
 from sim.equilibrium import solve_contact
 from sim.tissue import TissueModel
@@ -18,13 +18,7 @@ from sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor
-SECTION = composite_section(
-    SENSOR.fiber_radius,
-    SENSOR.fiber_modulus,
-    SENSOR.wire_radius,
-    SENSOR.wire_modulus,
-    SENSOR.wire_count,
-)
+SECTION = sensor_section(SENSOR)
 L = SENSOR.exposed_length
 DOWN = np.array([0.0, 0.0, -1.0])
 TOUCH = 1e-3  # stage translation (m) at which the tip touches the surface
