@@ -1,4 +1,6 @@
-"""What to tell the user when a serial port cannot be opened: one wording for every device.
+"""What to tell the user when a serial port cannot be opened: one wording for every device;
+and when to try again once a port was lost (:class:`Backoff`, for the board reader and the
+servo driver alike).
 
 The common case on Linux is a permission error (EACCES): serial devices belong to the
 ``dialout`` group (``uucp`` on some distributions), and the user is not in it.
@@ -7,6 +9,7 @@ The common case on Linux is a permission error (EACCES): serial devices belong t
 from __future__ import annotations
 
 import errno
+import math
 
 try:  # POSIX: pyserial lets termios.error (not an OSError) through from tcflush and tcsetattr
     import termios
@@ -50,3 +53,27 @@ def os_errno(exc: BaseException) -> int | None:
 
 def _is_permission_error(exc: BaseException) -> bool:
     return isinstance(exc, PermissionError) or os_errno(exc) in (errno.EACCES, errno.EPERM)
+
+
+class Backoff:
+    """When the next attempt to reopen a lost port may run: each failed attempt doubles the
+    wait, from ``first`` to at most ``longest`` (s, on whatever clock the caller passes);
+    :meth:`reset` once the port works, so the next loss may be retried at once."""
+
+    def __init__(self, first: float, longest: float) -> None:
+        self.first = first
+        self.longest = longest
+        self.reset()
+
+    def reset(self) -> None:
+        self._wait = self.first
+        self._next_at = -math.inf
+
+    def allows(self, now: float) -> bool:
+        """Whether an attempt may run at ``now``."""
+        return now >= self._next_at
+
+    def failed(self, now: float) -> None:
+        """An attempt (or the port) failed at ``now``: the next one waits, the wait doubles."""
+        self._next_at = now + self._wait
+        self._wait = min(2 * self._wait, self.longest)

@@ -39,7 +39,7 @@ import serial
 
 from config.schema import BoardConfig, SensorConfig
 from sensor.clock import Clock, SystemClock
-from sensor.ports import OPEN_ERRORS, PORT_ERRORS, open_failure
+from sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff, open_failure
 from wire.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
 
 SEQ_MOD = 2**32
@@ -239,8 +239,7 @@ class FrameReader:
         self.last_frame: Frame | None = None
         self._connected = True
         self._closed = False
-        self._reopen_at = 0.0
-        self._backoff = REOPEN_BACKOFF_S[0]
+        self._backoff = Backoff(*REOPEN_BACKOFF_S)
         self._idle = threading.Event()  # never set: a bounded wait while the port is down
         self.last_port_error = ""
 
@@ -319,7 +318,7 @@ class FrameReader:
             self._last_arrival = self.clock.now()
             self._stale = False
             self.last_frame = frames[-1]
-            self._backoff = REOPEN_BACKOFF_S[0]
+            self._backoff.reset()
         else:
             self.check_stale()
         return frames
@@ -337,27 +336,21 @@ class FrameReader:
         self.last_port_error = f"{type(exc).__name__}: {exc}"
         if self._connected:
             self._connected = False
-            self._retry_later()
+            self._backoff.failed(self.clock.now())  # the wait doubles until frames flow
             with contextlib.suppress(Exception):
                 self._serial.close()
-
-    def _retry_later(self) -> None:
-        """The next reopening attempt after the back-off, which doubles each time (up to its
-        limit) until frames flow again."""
-        self._reopen_at = self.clock.now() + self._backoff
-        self._backoff = min(2 * self._backoff, REOPEN_BACKOFF_S[1])
 
     def _usable(self) -> bool:
         """Connected, or reopened now (when the back-off allows an attempt)."""
         if self._connected:
             return True
-        if self._closed or self.clock.now() < self._reopen_at:
+        if self._closed or not self._backoff.allows(self.clock.now()):
             return False
         try:
             self._reopen()
         except OPEN_ERRORS as exc:
             self.last_port_error = f"reopen: {exc}"
-            self._retry_later()
+            self._backoff.failed(self.clock.now())  # the wait doubles until frames flow
             return False
         self._connected = True
         self.counters.reopens += 1

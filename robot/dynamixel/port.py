@@ -16,7 +16,7 @@ from typing import Any
 
 import dynamixel_sdk as sdk
 
-from sensor.ports import OPEN_ERRORS, PORT_ERRORS
+from sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff
 
 REOPEN_BACKOFF_S = (0.02, 1.0)  # first and longest wall-time wait between reopening attempts
 
@@ -41,17 +41,14 @@ class PortRecovery:
         self._baudrate = baudrate
         self.port_errors = 0  # transactions that failed in the port itself (it was lost)
         self.reopens = 0  # times a lost port was opened again
-        self.backoff_s = REOPEN_BACKOFF_S
+        self.backoff = Backoff(*REOPEN_BACKOFF_S)  # wall time between reopening attempts
         self.lost = ""  # why the port is down ("" while it works)
-        self._reopen_at = 0.0
-        self._backoff = 0.0
 
     def lose(self, exc: Exception) -> None:
         """Count a failed port, close it and allow an attempt to reopen it at once."""
         self.port_errors += 1
         self.lost = str(exc) or type(exc).__name__
-        self._reopen_at = time.monotonic()
-        self._backoff = self.backoff_s[0]
+        self.backoff.reset()
         with contextlib.suppress(*PORT_ERRORS):
             self._port.closePort()
 
@@ -61,15 +58,14 @@ class PortRecovery:
         if not self.lost:
             return True
         now = time.monotonic()
-        if now < self._reopen_at:
+        if not self.backoff.allows(now):
             return False
         try:
             opened = bool(self._port.openPort() and self._port.setBaudRate(self._baudrate))
         except OPEN_ERRORS as exc:
             self.lost, opened = str(exc) or type(exc).__name__, False
         if not opened:
-            self._reopen_at = now + self._backoff
-            self._backoff = min(2 * self._backoff, self.backoff_s[1])
+            self.backoff.failed(now)
             return False
         self.lost = ""
         self.reopens += 1

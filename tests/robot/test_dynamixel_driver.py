@@ -18,6 +18,7 @@ import pytest
 from config.schema import ServoBusConfig, ServoConfig
 from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
+from sensor.ports import Backoff
 from sim.clock import VirtualClock
 from sim.dynamixel import protocol
 from sim.dynamixel.bus import EmulatedBus
@@ -239,7 +240,7 @@ def test_an_adapter_unplugged_and_replugged_is_reopened(
     link = tmp_path / "ttyUSB0"
     link.symlink_to(emulator.port)
     with DynamixelBus.from_config(CFG, port=str(link)) as bus:
-        bus.recovery.backoff_s = (0.0, 0.0)  # every attempt may reopen: no wall-time back-off
+        bus.recovery.backoff = Backoff(0.0, 0.0)  # every attempt may reopen: no wall-time back-off
         bus.set_torque(True)
         emulator.close()  # unplugged
         for _ in range(2):  # lost, then reopening fails while the device is away
