@@ -24,6 +24,19 @@ estimator's model is close to, not identical with, the world it measures.
   For nu = 0.5 bonded the bracket is ``1 + 1.133 chi + 1.283 chi^2 + 0.769 chi^3 - 0.0975
   chi^4``. The series is a small-chi expansion, published with ``chi = sqrt(R delta)/h``.
 
+  The law here (:func:`layer_coefficients`) takes the bonded coefficients as published and
+  replaces the non-bonded ones, which vary with nu although the exact law of a layer sliding on
+  a frictionless base does not (DESIGN.md): to first order in chi the layer adds a uniform
+  approach ``F (1 - nu^2) a0 / (pi E h)``, with ``a0`` the integral over u of ``K(u) - 1``, K the
+  layer's surface-compliance kernel in Hankel space (:func:`layer_kernel`; Lebedev & Ufliand
+  1958). For the bonded kernel this integral gives Dimitriadis' bonded a0 to 0.7 % at
+  nu = 0.3-0.5 (tests); for the frictionless base it is ``SLIDING_A0 = -1.1676`` at every nu,
+  which Dimitriadis' non-bonded a0 equals only at nu = 0.27 (at nu = 0.45 the published
+  first-order term is 13 % too large: the layer reads 1-3 % too stiff at chi = 0.1-0.2).
+  ``b0`` (chi^3) is the kernel's second moment times the ratio the bonded coefficients have to
+  theirs (b0 / int u^2 (K - 1) du = -0.263 at nu = 0.3-0.5): ``SLIDING_B0 = 0.4161``,
+  within 0.5 % of the published non-bonded b0 at nu = 0.45.
+
 The estimator's law (:class:`ContactLaw`) is the published form: ``F_0`` Hertz or Sneddon,
 times the bracket at ``chi = sqrt(R delta)/h`` with no continuation past ``chi = 1`` (a warning
 instead). The simulator uses ``chi = a/h`` with the active law's contact radius and continues the
@@ -63,21 +76,75 @@ _TINY = float(np.finfo(np.float64).tiny)
 
 
 # --------------------------------------------------------------------------- Dimitriadis
-def dimitriadis_coefficients(poisson: float, bonded: bool) -> Coefficients:
-    """(k1, k2, k3, k4): the Dimitriadis bracket is ``1 + k1 chi + k2 chi^2 + k3 chi^3 + k4 chi^4``.
+SLIDING_A0 = -1.1675768
+"""a0 of a layer on a frictionless rigid base: the integral of ``layer_kernel(u, nu, False) - 1``
+over u in [0, inf) (it does not depend on nu; the tests recompute it by quadrature)."""
+
+SLIDING_B0 = 0.4160761
+"""b0 of a layer on a frictionless rigid base: ``BONDED_B0_PER_MOMENT`` times the integral of
+``u^2 (layer_kernel(u, nu, False) - 1)`` (-1.58153)."""
+
+BONDED_B0_PER_MOMENT = -0.2630853
+"""Dimitriadis' bonded b0 over the bonded kernel's second moment at nu = 0.5 (the ratio is
+-0.262 to -0.266 over nu = 0.3-0.5)."""
+
+
+def layer_kernel(u: FloatArray, poisson: float, bonded: bool) -> FloatArray:
+    """K(u), u = xi h: the surface compliance of a layer of thickness h on a rigid base over that
+    of a half-space, for a surface load of wavenumber xi (Lebedev & Ufliand 1958). Bonded
+    (kappa = 3 - 4 nu): ``(2 kappa sinh 2u - 4u)/(2 kappa cosh 2u + 1 + kappa^2 + 4u^2)``;
+    frictionless base: ``(cosh 2u - 1)/(sinh 2u + 2u)``. Both tend to 1 as u grows and to 0
+    at u = 0. For u >= 0 up to ~350 (cosh overflows beyond)."""
+    u = np.asarray(u, dtype=np.float64)
+    if bonded:
+        kappa = 3.0 - 4.0 * float(poisson)
+        num = 2.0 * kappa * np.sinh(2.0 * u) - 4.0 * u
+        return np.asarray(num / (2.0 * kappa * np.cosh(2.0 * u) + 1.0 + kappa**2 + 4.0 * u * u))
+    with np.errstate(invalid="ignore"):  # 0/0 at u = 0, where K is 0
+        k = (np.cosh(2.0 * u) - 1.0) / (np.sinh(2.0 * u) + 2.0 * u)
+    return np.asarray(np.where(u > 0.0, k, 0.0))
+
+
+def _check_poisson(poisson: float) -> float:
+    nu = float(poisson)
+    if not 0.0 <= nu <= 0.5:
+        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
+    return nu
+
+
+def layer_coefficients(poisson: float, bonded: bool) -> Coefficients:
+    """(k1, k2, k3, k4) of the layer law the estimator fits and the closed-form world uses:
+    Dimitriadis' bonded coefficients as published, the frictionless base's from its kernel
+    (``SLIDING_A0``, ``SLIDING_B0``; see the module's docstring).
 
     Raises:
         ValueError: ``poisson`` outside [0, 0.5].
     """
-    nu = float(poisson)
-    if not 0.0 <= nu <= 0.5:
-        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
+    nu = _check_poisson(poisson)
+    if bonded:
+        return dimitriadis_coefficients(nu, bonded=True)
+    return _bracket_coefficients(SLIDING_A0, SLIDING_B0)
+
+
+def dimitriadis_coefficients(poisson: float, bonded: bool) -> Coefficients:
+    """(k1, k2, k3, k4) as Dimitriadis et al. published them: the bracket is
+    ``1 + k1 chi + k2 chi^2 + k3 chi^3 + k4 chi^4``.
+
+    Raises:
+        ValueError: ``poisson`` outside [0, 0.5].
+    """
+    nu = _check_poisson(poisson)
     if bonded:
         a0 = -(1.2876 - 1.4678 * nu + 1.3442 * nu**2) / (1.0 - nu)
         b0 = (0.6387 - 1.0277 * nu + 1.5164 * nu**2) / (1.0 - nu)
     else:
         a0 = -0.347 * (3.0 - 2.0 * nu) / (1.0 - nu)
         b0 = 0.056 * (5.0 - 2.0 * nu) / (1.0 - nu)
+    return _bracket_coefficients(a0, b0)
+
+
+def _bracket_coefficients(a0: float, b0: float) -> Coefficients:
+    """The bracket's (k1, k2, k3, k4) from Dimitriadis' a0 and b0 (his Eq. 12)."""
     pi = math.pi
     k1 = -2.0 * a0 / pi
     k2 = 4.0 * a0**2 / pi**2
@@ -197,7 +264,8 @@ class ContactLaw:
         tip_radius: R (m).
         poisson: the sample's Poisson ratio (known, as in the paper).
         thickness: layer thickness h (m) on a rigid substrate; None for a half-space.
-        bonded: the layer is glued to its substrate (Dimitriadis bonded) or slides (non-bonded).
+        bonded: the layer is glued to its substrate (Dimitriadis bonded) or slides on a
+            frictionless base (:func:`layer_coefficients`).
         large_indentation: Sneddon's sphere instead of the Hertz paraboloid.
         layer_ratio_from: ``"published"``: chi = sqrt(R delta)/h as Dimitriadis published it;
             ``"sphere"``: chi = a/h with Sneddon's contact radius a = R tanh(y). The series was
@@ -219,7 +287,7 @@ class ContactLaw:
             math.isfinite(self.thickness) and self.thickness > 0
         ):
             raise ValueError(f"thickness must be > 0 m or None, got {self.thickness!r}")
-        dimitriadis_coefficients(self.poisson, self.bonded)  # validates poisson
+        layer_coefficients(self.poisson, self.bonded)  # validates poisson
         if self.layer_ratio_from not in ("published", "sphere"):
             raise ValueError(
                 f"layer_ratio_from must be 'published' or 'sphere', got {self.layer_ratio_from!r}"
@@ -257,7 +325,7 @@ class ContactLaw:
         if self.thickness is None:
             return np.asarray(scale * f0), np.asarray(scale * df0)
         chi = root / self.thickness
-        b, db = dimitriadis_bracket(chi, dimitriadis_coefficients(self.poisson, self.bonded))
+        b, db = dimitriadis_bracket(chi, layer_coefficients(self.poisson, self.bonded))
         dchi = da / self.thickness
         return np.asarray(scale * f0 * b), np.asarray(scale * (df0 * b + f0 * db * dchi))
 
@@ -309,7 +377,7 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
             out.append(np.asarray(scale * f0))
             continue
         radius = half.a if law.layer_ratio_from == "sphere" else half.root
-        k = dimitriadis_coefficients(law.poisson, law.bonded)
+        k = layer_coefficients(law.poisson, law.bonded)
         b, _ = dimitriadis_bracket(radius / law.thickness, k)
         out.append(np.asarray(scale * f0 * b))
     return out

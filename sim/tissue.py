@@ -24,6 +24,8 @@ model (Eq. 13), so that the simulated stiffness estimate carries a real model er
   bonded layer:      a0 = -(1.2876 - 1.4678 nu + 1.3442 nu^2)/(1 - nu),
                      b0 =  (0.6387 - 1.0277 nu + 1.5164 nu^2)/(1 - nu)
   non-bonded layer:  a0 = -0.347 (3 - 2 nu)/(1 - nu),   b0 = 0.056 (5 - 2 nu)/(1 - nu)
+                     (as published; used here: a0 = -1.1676, b0 = 0.4161 at every nu, from
+                     the frictionless base's kernel, ``estimation.corrections.layer_coefficients``)
 
   ``chi = sqrt(R delta)/h`` in the paper, which is ``a/h`` for Hertz; we use ``a/h`` with the
   contact radius of the active law so the correction composes with Sneddon (an approximation:
@@ -49,7 +51,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from estimation.corrections import (
     dimitriadis_bracket,
-    dimitriadis_coefficients,
+    layer_coefficients,
     sneddon_bracket,
     sneddon_bracket_at,
     sneddon_y,
@@ -118,8 +120,9 @@ class TissueModel:
 
     def layer_coefficients(self) -> tuple[float, float, float, float]:
         """The Dimitriadis bracket coefficients (k1, k2, k3, k4) of chi^1..chi^4
-        (``estimation.corrections.dimitriadis_coefficients``)."""
-        return dimitriadis_coefficients(self.poisson, self.bonded)
+        (``estimation.corrections.layer_coefficients``: the non-bonded ones from the
+        frictionless base's kernel, not Dimitriadis' nu-dependent fit)."""
+        return layer_coefficients(self.poisson, self.bonded)
 
     # ----------------------------------------------------------------- public laws
     def contact_radius(self, delta: ArrayLike) -> FloatArray:

@@ -6,11 +6,17 @@ import math
 
 import numpy as np
 import pytest
+from scipy.integrate import quad
 
 from estimation.corrections import (
+    BONDED_B0_PER_MOMENT,
+    SLIDING_A0,
+    SLIDING_B0,
     ContactLaw,
     dimitriadis_bracket,
     dimitriadis_coefficients,
+    layer_coefficients,
+    layer_kernel,
     shape_values,
     sneddon_y,
     sneddon_y_at,
@@ -33,6 +39,47 @@ def test_dimitriadis_non_bonded_incompressible_bracket_is_the_published_one() ->
     # ... and 1 + 0.884 chi + 0.781 chi^2 + 0.386 chi^3 + 0.0048 chi^4 for a sliding layer
     k = dimitriadis_coefficients(0.5, bonded=False)
     assert k == pytest.approx((0.884, 0.781, 0.386, 0.0048), abs=6e-4)
+
+
+def kernel_moment(poisson: float, bonded: bool, power: int) -> float:
+    """The integral of u^power (K(u) - 1) over u in [0, inf), by quadrature."""
+    value, _ = quad(lambda u: u**power * (float(layer_kernel(u, poisson, bonded)) - 1.0), 0, 40)
+    return float(value)
+
+
+@pytest.mark.parametrize("poisson", [0.3, 0.4, 0.45, 0.5])
+def test_the_bonded_kernel_gives_dimitriadis_first_order_coefficient(poisson: float) -> None:
+    """a0 is the integral of K - 1 (the layer's uniform extra approach): the bonded kernel
+    reproduces the published bonded a0, which validates the identity used for the sliding one."""
+    published_k1 = dimitriadis_coefficients(poisson, bonded=True)[0]
+    assert -2 * kernel_moment(poisson, True, 0) / math.pi == pytest.approx(published_k1, rel=7e-3)
+
+
+def test_sliding_coefficients_come_from_the_frictionless_kernel_at_every_poisson() -> None:
+    a0 = kernel_moment(0.45, False, 0)
+    assert kernel_moment(0.1, False, 0) == pytest.approx(a0, rel=1e-12)  # K has no nu
+    assert a0 == pytest.approx(SLIDING_A0, abs=1e-6)
+    assert BONDED_B0_PER_MOMENT * kernel_moment(0.45, False, 2) == pytest.approx(
+        SLIDING_B0, abs=1e-6
+    )
+    bonded_b0 = (0.6387 - 1.0277 * 0.5 + 1.5164 * 0.25) / 0.5
+    assert bonded_b0 / kernel_moment(0.5, True, 2) == pytest.approx(BONDED_B0_PER_MOMENT, abs=1e-6)
+    for nu in (0.0, 0.45, 0.5):
+        k = layer_coefficients(nu, bonded=False)
+        assert k[0] == pytest.approx(-2 * SLIDING_A0 / math.pi, rel=1e-12)
+    # the published non-bonded first-order term is right only near nu = 0.27, 13 % high at 0.45
+    published = dimitriadis_coefficients(0.45, bonded=False)[0]
+    assert published / layer_coefficients(0.45, bonded=False)[0] == pytest.approx(1.135, abs=0.005)
+    assert layer_coefficients(0.45, bonded=True) == dimitriadis_coefficients(0.45, bonded=True)
+
+
+def test_layer_kernel_limits() -> None:
+    u = np.array([0.0, 1e-3, 30.0])
+    for bonded in (True, False):
+        k = layer_kernel(u, 0.45, bonded)
+        assert k[0] == 0.0
+        assert 0.0 < k[1] < 1e-2
+        assert k[2] == pytest.approx(1.0, abs=1e-9)
 
 
 def test_bracket_is_one_at_zero_thickness_ratio_and_grows() -> None:
@@ -127,10 +174,10 @@ def test_no_force_before_contact_and_inverse_for_modulus() -> None:
         law.modulus(1.0, 0.0)
 
 
-def test_the_simulator_uses_the_same_published_constants() -> None:
+def test_the_simulator_uses_the_same_constants() -> None:
     for bonded in (True, False):
         tissue = TissueModel(1e5, 0.45, 10e-3, bonded, R, True, True)
-        assert tissue.layer_coefficients() == dimitriadis_coefficients(0.45, bonded)
+        assert tissue.layer_coefficients() == layer_coefficients(0.45, bonded)
     # the sim's composition (chi = a/h with Sneddon's a) is the estimator's alternative one
     tissue = TissueModel(1.0, 0.45, 10e-3, True, R, True, True)
     law = ContactLaw(R, 0.45, 10e-3, True, True, "sphere")

@@ -85,3 +85,14 @@ def test_tissue_too_soft_for_the_sensor_is_none_with_the_reason() -> None:
     assert v.status == "none"
     assert "buckling needs more than the 2.5 mm travel window" in v.reasons[0]
     assert judge(fit(300e3), FACTS, R).status == "ok"
+
+
+def test_an_interval_wider_than_ten_percent_either_side_is_not_ok() -> None:
+    """+-10 %: an interval a belief leaves open holds the truth anywhere, so an ok number must
+    keep its typical error at 5 %; one side past the bound is enough."""
+    assert judge(fit(half=0.095), FACTS, R).status == "ok"
+    lopsided = fit(ci_low=500e3 * 0.97, ci_high=500e3 * 1.12)
+    v = judge(lopsided, FACTS, R)
+    assert v.status == "suspect"
+    assert "+12 %" in v.reasons[0]
+    assert "+-10 %" in v.reasons[0]
