@@ -6,11 +6,13 @@ pseudo-terminals) and on the fast in-process path, each world effect the shipped
 off switched on (gravity, the realistic bus timing), the closed-form tissue instead of the FE
 tables, lower control/board rates (20 Hz is cheap but no longer usable), and the cheapest
 usable level ("lean": 25 Hz with the contact table on a 40 um grid,
-``fidelity.contact_grid_um``). Per level: the CPU time of one trial (median over the trials; ``time.process_time``, so the emulators' threads
-count and other work on the machine does not), how many times cheaper that is than the shipped
-level, simulated seconds per CPU second ("x real time per core"), the joint fit's median and
-worst relative error of E, its 95 % interval coverage, the paper's single-point error and
-whether the level is still usable (:func:`usable`). The table is the speed-against-error trade; the figure plots it with the Pareto front.
+``fidelity.contact_grid_um``). Per level: the CPU time of one trial (median over the trials;
+``time.process_time``, so the emulators' threads count and other work on the machine does
+not), how many times cheaper that is than the shipped level, simulated seconds per CPU second
+("x real time per core"), the joint fit's median and worst relative error of E, its 95 %
+interval coverage, the paper's single-point error and whether the level is still usable
+(:func:`usable`). The table is the speed-against-error trade; the figure plots it with the
+Pareto front of the usable levels.
 """
 
 from __future__ import annotations
@@ -169,14 +171,18 @@ def _plot(rows: list[LevelRow], path: Path) -> Path:
     points = [(1e3 * r.cpu_per_trial, 100 * (r.joint_median or 0.0)) for r in shown]
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for r, (x, y) in zip(shown, points, strict=True):
-        ax.plot(x, y, "o" if r.transport == "fast" else "s")
-        ax.annotate(_label(r), (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
-    front = [points[i] for i in pareto_front(points)]
+        ok = usable(r)
+        ax.plot(x, y, ("o" if r.transport == "fast" else "s") if ok else "x")
+        label = _label(r) if ok else f"{_label(r)}: NOT usable"
+        ax.annotate(label, (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    # the front of the usable levels: a cheap level whose estimates are useless beats nothing
+    kept = [p for r, p in zip(shown, points, strict=True) if usable(r)]
+    front = [kept[i] for i in pareto_front(kept)]
     if front:
         ax.step(*zip(*front, strict=True), where="post", color="k", lw=0.8, label="Pareto front")
         ax.legend(fontsize=8)
     ax.set_xscale("log")
-    ax.set_xlabel("CPU time per trial (ms, serial)")
+    ax.set_xlabel("CPU time per trial (ms, serial); x: not usable (coverage, worst error)")
     ax.set_ylabel("joint fit: median |relative error| of E (%)")
     ax.set_title("Simulated bench campaign: fidelity level, speed against error")
     ax.grid(True, alpha=0.3)
