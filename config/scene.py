@@ -58,6 +58,11 @@ class FidelityConfig:
     bus_timing: Literal["ideal", "realistic"] = "ideal"
     bus_baudrate: int | None = field(default=None, metadata=limits(gt=0, le=10_500_000))
     latency_timer_ms: float = field(default=16.0, metadata=limits(ge=1, le=255))
+    # The contact table's grid along the advance past contact (um; sim/contact_table.py). null
+    # (default): the stage encoder's lattice, so every lookup lands on a solved point (exact);
+    # a coarser grid (rounded to whole encoder counts) solves fewer equilibria per trial and
+    # interpolates linearly between them: a cheaper world, for speed-over-accuracy levels.
+    contact_grid_um: float | None = field(default=None, metadata=limits(gt=0, le=1000))
 
 
 @dataclass(frozen=True)

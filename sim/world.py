@@ -52,6 +52,7 @@ _CONTACT_FLAG = int(Status.CONTACT_EVENT)  # int() of an IntFlag costs ~0.3 us p
 _FORCE_FLAG = int(Status.FORCE_VALID)
 
 
+COARSE_BIN_STEPS = 50  # grid steps in a bin of a coarse contact grid at a fixed length
 ALIGNED = 1e-6  # rad: a misalignment below this is the aligned contact, bit for bit
 
 
@@ -300,14 +301,18 @@ class World:
             effects,
             sign,
         )
+        lattice = self._lattice(past)
+        # at a fixed length a bin's width changes no value (every lookup is a lattice point
+        # of one length, or between two neighbours of it): wide bins pay the ~1-4 ms per
+        # vectorised call less often; a coarse grid's bins hold as many steps as 1 mm of
+        # 20 um ones
+        wide = 1e-3 if lattice is None else max(1e-3, COARSE_BIN_STEPS * lattice[0])
         table = ContactTable(
             _ContactGrid(physics),
             contact_length,
             self.length_grows,
-            lattice=self._lattice(past),
-            # at a fixed length a bin's width changes no value (every lookup is a lattice point
-            # of one length): wide bins pay the ~4 ms per vectorised call less often
-            bin_width=0.25e-3 if self.length_grows else 1e-3,
+            lattice=lattice,
+            bin_width=0.25e-3 if self.length_grows else wide,
         )
         self._tables[roll] = table
         if self.relaxation is not None:
@@ -341,10 +346,15 @@ class World:
 
     def _lattice(self, past: float) -> tuple[float, float] | None:
         """(step, origin) of the encoder lattice in the advance past contact, from the first
-        sample in contact; None without an encoder step."""
+        sample in contact (every ``fidelity.contact_grid_um`` of it when that is set); None
+        without an encoder step or a grid."""
+        grid = self.fidelity.contact_grid_um
         if self.encoder_step is None:
-            return None
-        return self.encoder_step, past % self.encoder_step
+            return None if grid is None else (grid * 1e-6, 0.0)
+        step = self.encoder_step
+        if grid is not None:  # a coarser grid of whole counts: lookups between its points
+            step *= max(1, round(grid * 1e-6 / step))
+        return step, past % self.encoder_step
 
     def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
         """Equilibrium at advances ``u`` (M,) for one exposed length: delta, e, P, |R|, strains

@@ -144,6 +144,33 @@ def test_on_the_encoder_lattice_a_lookup_is_the_solved_equilibrium() -> None:
     assert np.max(np.abs(off_grid[:, 4:] - exact[:, 4:])) > 1e-8
 
 
+def test_a_coarse_contact_grid_is_exact_on_its_points_and_close_between() -> None:
+    """``fidelity.contact_grid_um``: the table solves every k-th encoder count (whole counts
+    from the first sample in contact) and interpolates between them; its points are the
+    lattice table's, the counts between are off by the interpolation, a few ue at most."""
+    step = 20e-3 / 4096
+    w = world(Stage(PATH), grows=False)
+    w.encoder_step = step
+    first = 0.7 * step
+    w.fidelity = dataclasses.replace(FIDELITY, contact_grid_um=40.0)
+    k = round(40e-6 / step)
+    coarse = w._lattice(first)
+    assert coarse is not None
+    assert coarse[0] == pytest.approx(k * step)
+    assert coarse[1] == pytest.approx(first)
+    table = ContactTable(w, L, False, lattice=coarse)
+    us = first + np.arange(0, 130) * step  # every count across the knee
+    exact = np.column_stack(w.solve_on_grid(us, L))
+    looked_up = np.array([[*table.at(u)[:4], *table.at(u)[4]] for u in us.tolist()])
+    on_points = slice(0, None, k)
+    assert np.allclose(looked_up[on_points], exact[on_points], rtol=1e-9, atol=1e-15)
+    strain_error = np.abs(looked_up[:, 4:] - exact[:, 4:])
+    assert np.max(strain_error) > 1e-9  # between the points it is an interpolation
+    assert np.max(strain_error) < 20e-6
+    load_error = np.abs(looked_up[:, 2] - exact[:, 2])
+    assert np.max(load_error) < 0.005 * np.max(exact[:, 2])  # P: within 0.5 % of the range
+
+
 def test_peaks_are_the_array_expression_with_the_same_noise() -> None:
     stage = Stage(PATH)
     w = world(stage, seed=7)
