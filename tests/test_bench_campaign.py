@@ -60,3 +60,9 @@ def test_a_level_is_usable_only_with_coverage_and_a_bounded_worst_error() -> Non
     assert not usable(_row(0.964, 0.40))  # covered but one estimate far off
     assert not usable(_row(0.85, 0.10))
     assert not usable(_row(None, None))  # no estimate at all
+
+
+def test_the_shipped_lean_scene_is_the_lean_level() -> None:
+    """config/scenes/bench-lean.yaml is bench.yaml at the cheapest usable level, nothing else."""
+    shipped = load(SceneConfig, resolve("scenes/bench-lean.yaml"))
+    assert dataclasses.replace(shipped, name=BENCH.name) == _level(CHEAPEST)

@@ -31,6 +31,7 @@ from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaign import campaign_trials, median_abs_relative_error, run_campaign, warm_up
 from palpate.simtrial import Transport, TrialOutcome
+from palpate.verdicts import tally
 from sim.contact_table import equilibrium_on_grid
 
 SceneChange = Callable[[SceneConfig], SceneConfig]
@@ -97,6 +98,7 @@ class LevelRow:
     joint_worst: float | None
     coverage: float | None
     paper_median: float | None
+    verdicts: str = ""  # ok/suspect/none counts, e.g. "53/2/0"
 
 
 def _level_row(level: Level, ctx: BenchContext) -> LevelRow:
@@ -131,6 +133,7 @@ def _level_row(level: Level, ctx: BenchContext) -> LevelRow:
         joint_worst=max(errors, default=None),
         coverage=sum(covered) / len(covered) if covered else None,  # as palpate.compare
         paper_median=median_abs_relative_error(outcomes, "paper"),
+        verdicts="/".join(str(n) for n in tally(outcomes).counts.values()),
     )
 
 
@@ -200,6 +203,7 @@ def _table(rows: list[LevelRow], ctx: BenchContext) -> Table:
             "level",
             "transport",
             "trials",
+            "ok/sus/none",
             "CPU ms/trial",
             "x cheaper",
             "x real time/core",
@@ -214,6 +218,7 @@ def _table(rows: list[LevelRow], ctx: BenchContext) -> Table:
                 r.level,
                 r.transport,
                 r.trials,
+                r.verdicts,
                 1e3 * r.cpu_per_trial,
                 ref.cpu_per_trial / r.cpu_per_trial,
                 r.real_time_per_core,
