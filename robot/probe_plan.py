@@ -41,6 +41,7 @@ Vector = NDArray[np.float64]
 FloatArray = NDArray[np.float64]
 SWEEP_STEPS = 8  # rays checked along a roll for the retract before it
 ROLL_MARGIN = math.radians(1.0)  # probe rolls stay this far inside the roll limits
+SPREAD_STEP = 1e-6  # m, a touch moved along its ray for the spread of a prediction
 MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is read with
 # A pose this many of the measured normal's 1-sigma angles past the angle tolerance cannot be
 # told from one within it: it is indented, and the verdict reads its residual (suspect beyond
@@ -165,9 +166,39 @@ class ProbeGeometry:
         x = self.advance_to(model, roll)
         if not math.isfinite(x):
             x = touches[-1].advance
+        spread = self._spread(touches, roll, x, settings.sigma) if len(touches) >= 3 else math.nan
+        if math.isfinite(spread):
+            return x, spread + 3.0 * settings.sigma
         c = np.asarray(self.touch(roll, x).centre)
         slack = _distance_to_line(c, line) * math.tan(min(tilt, settings.max_tilt))
         return x, slack + 3.0 * settings.sigma
+
+    def _spread(self, touches: list[Touch], roll: float, x: float, sigma: float) -> float:
+        """Three standard deviations (m) of the advance at which the fitted plane meets the ray
+        at ``roll``: each touch moved by ``SPREAD_STEP`` along its own ray, the plane fitted again
+        (first-order propagation, the touches' uncertainty ``sigma`` scaled up by their scatter
+        as the fit's). Along the roll the touches pin the plane's slope well; across it (the
+        circle's bow) less, and a ray that leaves the touches' line sideways sees that: a bound
+        by direction, not the normal's whole uncertainty times the distance. NaN when a moved
+        plane does not meet the ray."""
+        c = np.array([t.centre for t in touches])
+        rays = np.array([t.tangent for t in touches])
+        noise = sigma
+        grads = []
+        for i in range(len(touches) + 1):
+            q = c.copy()
+            if i < len(touches):
+                q[i] += SPREAD_STEP * rays[i]
+            fit = fit_plane(q, sigma=sigma, hint=-rays.mean(axis=0))
+            if not fit.success or fit.centres is None:
+                return math.nan
+            if i == len(touches):  # the unmoved fit: its scatter
+                dof = len(touches) - 3
+                noise = max(sigma, fit.rms * math.sqrt(len(touches) / dof)) if dof > 0 else sigma
+                break
+            grads.append((self.advance_to(fit.centres, roll) - x) / SPREAD_STEP)
+        g = float(np.linalg.norm(grads))
+        return 3.0 * noise * g if math.isfinite(g) else math.nan
 
     def sweep_needs(
         self, touches: list[Touch], start: float, end: float, settings: ProbeSettings
@@ -223,6 +254,7 @@ class ProbeGeometry:
         advance = ik.advance - depth if move else plan.contact_advance
         if not settings.replan:  # measure only: the misalignment of the plan's own pose
             ik = _plan_pose(self, target, n0, surface.radius, plan)
+        roll = nearest_turn(roll, touches[-1].roll, self.roll_limits)  # the way out's roll
         retract = self.sweep_retract(touches, touches[-1].roll, roll, settings)
         retract = min(retract, advance - settings.standoff - settings.clearance)
         n = surface.normal
@@ -249,6 +281,15 @@ class ProbeGeometry:
             True, f"normal not measured: {why}", plan.roll, plan.contact_advance, 0.0,
             math.nan, 0.0, None, "none", None, tuple(touches), retract - settings.clearance,
         )  # fmt: skip
+
+
+def nearest_turn(roll: float, near: float, limits: tuple[float, float]) -> float:
+    """``roll`` or a whole turn from it (the same line), whichever within ``limits`` is nearest
+    ``near``: the way out never sweeps the long way round (nor is its retract planned over the
+    long way: a sweep through a whole turn meets rays nearly along the surface)."""
+    turns = [roll + k * math.tau for k in (-1, 0, 1)]
+    inside = [r for r in turns if limits[0] <= r <= limits[1]] or [roll]
+    return min(inside, key=lambda r: abs(r - near))
 
 
 def _plan_pose(

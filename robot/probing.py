@@ -28,7 +28,7 @@ import numpy as np
 
 from estimation.surface import load_crossing
 from robot.indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPlan
-from robot.probe_plan import ProbeGeometry, ProbeSettings
+from robot.probe_plan import ProbeGeometry, ProbeSettings, nearest_turn
 from robot.probe_result import ProbeResult, Touch
 
 MOVE_LOOKAHEAD = math.radians(12.0)  # roll ahead of the present the stage keeps clear of
@@ -162,7 +162,7 @@ class ProbeRoutine:
         self.goal = self.touches[-1].advance - s.clearance
         if len(self.touches) == len(self.rolls):
             result = geo.replan(self.touches, self.plan, s)
-            roll = _nearest_turn(result.roll, obs.roll, geo.roll_limits)
+            roll = nearest_turn(result.roll, obs.roll, geo.roll_limits)
             self.result = dataclasses.replace(result, roll=roll)
             self._plan_sweep(obs.roll, self.result.roll)
             self.phase = _Phase.LEAVE
@@ -272,11 +272,3 @@ def _near_side_last(rolls: list[float], touches: list[Touch]) -> list[float]:
     if (b - a) * toward < 0:
         a, b = b, a
     return [*rolls[:2], a, b, *rolls[4:]]
-
-
-def _nearest_turn(roll: float, near: float, limits: tuple[float, float]) -> float:
-    """``roll`` or a whole turn from it (the same line), whichever within ``limits`` is nearest
-    ``near``: the way out never sweeps the long way round."""
-    turns = [roll + k * math.tau for k in (-1, 0, 1)]
-    inside = [r for r in turns if limits[0] <= r <= limits[1]] or [roll]
-    return min(inside, key=lambda r: abs(r - near))

@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from robot.probing import Touch, _near_side_last, _nearest_turn
+from robot.probe_plan import nearest_turn
+from robot.probing import Touch, _near_side_last
 
 
 def touch(roll: float, advance: float) -> Touch:
@@ -33,7 +34,7 @@ def test_three_touches_keep_their_order() -> None:
 def test_the_way_out_never_rolls_the_long_way_round() -> None:
     limits = (math.radians(-200.0), math.radians(200.0))
     near = math.radians(190.0)
-    assert _nearest_turn(math.radians(-179.0), near, limits) == pytest.approx(math.radians(181.0))
-    assert _nearest_turn(math.radians(10.0), near, limits) == pytest.approx(math.radians(10.0))
+    assert nearest_turn(math.radians(-179.0), near, limits) == pytest.approx(math.radians(181.0))
+    assert nearest_turn(math.radians(10.0), near, limits) == pytest.approx(math.radians(10.0))
     # beyond the limits one turn on: the long way is the only way
-    assert _nearest_turn(math.radians(-150.0), near, limits) == pytest.approx(math.radians(-150.0))
+    assert nearest_turn(math.radians(-150.0), near, limits) == pytest.approx(math.radians(-150.0))
