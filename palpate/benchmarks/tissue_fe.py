@@ -26,8 +26,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from estimation.corrections import dimitriadis_bracket, dimitriadis_coefficients
 from estimation.hertz import hertz_force
+from estimation.layer import dimitriadis_bracket, dimitriadis_coefficients
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from sim.fem.law import curve_from_table
 from sim.fem.problem import LayerProblem

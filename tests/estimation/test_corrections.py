@@ -9,20 +9,22 @@ import pytest
 from scipy.integrate import quad
 
 from estimation.corrections import (
-    BONDED_B0_PER_MOMENT,
-    SLIDING_A0,
-    SLIDING_B0,
     ContactLaw,
-    dimitriadis_bracket,
-    dimitriadis_coefficients,
-    layer_coefficients,
-    layer_kernel,
     shape_values,
     sneddon_y,
     sneddon_y_at,
     validity_warnings,
 )
 from estimation.hertz import hertz_force
+from estimation.layer import (
+    BONDED_B0_PER_MOMENT,
+    SLIDING_A0,
+    SLIDING_B0,
+    dimitriadis_bracket,
+    dimitriadis_coefficients,
+    layer_coefficients,
+    layer_kernel,
+)
 from sim.tissue import TissueModel
 
 R = 3.5e-3
