@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from config.schema import TubeConfig
 from estimation.beamstate import axial_strain
+from estimation.corrections import MAX_MISALIGNMENT
 from estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane, fit_surface
 from robot import kinematics
 from robot.indentation import TrialPlan
@@ -47,6 +48,9 @@ MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is 
 # told from one within it: it is indented, and the verdict reads its residual (suspect beyond
 # the tolerance) instead of the trial ending unreachable on a noisy normal.
 NORMAL_SIGMAS = 2.0
+# ... but never past MAX_MISALIGNMENT (5 deg), where the indentation is no longer normal (the
+# estimator's validity flag): a normal so uncertain that a pose 30 deg off "cannot be told" from
+# square is not measured well enough to indent on, and the trial says so before it indents.
 
 
 @dataclass(frozen=True)
@@ -246,7 +250,7 @@ class ProbeGeometry:
             self.tube, target, n0, tip_radius=self.tip_radius,
             translation_limits=self.translation_limits, roll_limits=self.roll_limits,
             radius=surface.radius, max_miss=settings.max_miss,
-            max_residual=settings.max_residual + NORMAL_SIGMAS * normal_sigma,
+            max_residual=allowed_residual(settings.max_residual, normal_sigma),
         )  # fmt: skip
         move = ik.reachable and settings.replan
         roll = ik.roll if move else plan.roll
@@ -307,6 +311,12 @@ def _plan_pose(
     return kinematics.IKSolution(geo.tube.name, plan.roll, advance, hit, residual, 0, centre, miss)
 
 
+def allowed_residual(tolerance: float, normal_sigma: float) -> float:
+    """The residual angle (rad) a probed pose may have: the tolerance plus NORMAL_SIGMAS of the
+    measured normal's 1-sigma, capped at the larger of the tolerance and MAX_MISALIGNMENT."""
+    return min(tolerance + NORMAL_SIGMAS * normal_sigma, max(tolerance, MAX_MISALIGNMENT))
+
+
 def _scaled_sigma(fit: SurfaceFit, sigma: float) -> float:
     """The normal's 1-sigma angle, scaled up when the touches scatter about the fitted surface
     more than their assumed ``sigma`` (m) says (the square root of chi^2 per degree of freedom,
@@ -325,10 +335,13 @@ def _reason(ik: kinematics.IKSolution, settings: ProbeSettings, normal_sigma: fl
         return f"pose found within the measured normal's uncertainty: {found}"
     if ik.reachable:
         return f"orthogonal pose found: {found}"
+    allowed = allowed_residual(settings.max_residual, normal_sigma)
+    capped = " = the cap" if allowed < settings.max_residual + NORMAL_SIGMAS * normal_sigma else ""
     limits = (
         f"tolerances {math.degrees(settings.max_residual):.1f} deg "
         f"+ {NORMAL_SIGMAS:g} x {math.degrees(normal_sigma):.2f} deg (the normal's 1-sigma), "
-        f"{settings.max_miss * 1e3:.0f} mm"
+        f"at most {math.degrees(max(settings.max_residual, MAX_MISALIGNMENT)):.0f} deg"
+        f"{capped}, {settings.max_miss * 1e3:.0f} mm"
     )
     return f"no orthogonal pose of tube {ik.tube}: {ik.reason} ({found}; {limits})"
 

@@ -9,7 +9,7 @@ import math
 import pytest
 
 from estimation.surface import SurfaceFit
-from robot.probe_plan import _scaled_sigma
+from robot.probe_plan import _scaled_sigma, allowed_residual
 
 SIGMA = 10e-6  # m, the touches' assumed uncertainty
 
@@ -30,3 +30,15 @@ def test_a_tight_fit_keeps_the_assumed_sigma() -> None:
 @pytest.mark.parametrize(("points", "model"), [(3, "plane"), (4, "sphere")])
 def test_without_a_spare_touch_the_assumed_sigma_stands(points: int, model: str) -> None:
     assert _scaled_sigma(_fit(points, 5 * SIGMA, model), SIGMA) == pytest.approx(math.radians(0.3))
+
+
+def test_the_normals_doubt_widens_the_allowed_residual_only_up_to_five_degrees() -> None:
+    """A pose within 2 sigma of the tolerance is indented (its verdict reads the residual), but
+    never one past 5 deg, where the indentation stops being normal: a 38 deg sample probed with
+    a 17 deg sigma once accepted a pose 34 deg off."""
+    tol = math.radians(2.0)
+    assert allowed_residual(tol, math.radians(0.5)) == pytest.approx(math.radians(3.0))
+    assert allowed_residual(tol, math.radians(17.0)) == pytest.approx(math.radians(5.0))
+    assert allowed_residual(math.radians(8.0), math.radians(1.0)) == pytest.approx(
+        math.radians(8.0)
+    )
