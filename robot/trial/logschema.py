@@ -88,18 +88,24 @@ def boolean(value: Any, key: str) -> None:
         raise _fail(key, "true or false", value)
 
 
-def booleans(*, null: bool = False) -> Check:
-    """A list of true/false (``null``: the list may be null)."""
+def list_of(item: Check, what: str, *, null: bool = False) -> Check:
+    """A list whose every item passes ``item`` (``what`` names them in the error; ``null``: the
+    list may be null)."""
 
     def check(value: Any, key: str) -> None:
         if value is None and null:
             return
         if not isinstance(value, list):
-            raise _fail(key, "a list of true/false", value)
+            raise _fail(key, f"a list of {what}", value)
         for i, v in enumerate(value):
-            boolean(v, f"{key}[{i}]")
+            item(v, f"{key}[{i}]")
 
     return check
+
+
+def booleans(*, null: bool = False) -> Check:
+    """A list of true/false (``null``: the list may be null)."""
+    return list_of(boolean, "true/false", null=null)
 
 
 def one_of(*allowed: str) -> Check:
@@ -112,17 +118,7 @@ def one_of(*allowed: str) -> Check:
 
 def numbers(*, null_items: bool = False, null: bool = False) -> Check:
     """A list of numbers (``null_items``: an item may be null; ``null``: the list may be)."""
-    item = number(null=null_items)
-
-    def check(value: Any, key: str) -> None:
-        if value is None and null:
-            return
-        if not isinstance(value, list):
-            raise _fail(key, "a list of numbers", value)
-        for i, v in enumerate(value):
-            item(v, f"{key}[{i}]")
-
-    return check
+    return list_of(number(null=null_items), "numbers", null=null)
 
 
 def mapping(fields: Mapping[str, Field], *, null: bool = False) -> Check:
