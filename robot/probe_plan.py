@@ -187,20 +187,20 @@ class ProbeGeometry:
         plane does not meet the ray."""
         c = np.array([t.centre for t in touches])
         rays = np.array([t.tangent for t in touches])
-        noise = sigma
+        hint = -rays.mean(axis=0)
         grads = []
-        for i in range(len(touches) + 1):
+        for i in range(len(touches)):
             q = c.copy()
-            if i < len(touches):
-                q[i] += SPREAD_STEP * rays[i]
-            fit = fit_plane(q, sigma=sigma, hint=-rays.mean(axis=0))
+            q[i] += SPREAD_STEP * rays[i]
+            fit = fit_plane(q, sigma=sigma, hint=hint)
             if not fit.success or fit.centres is None:
                 return math.nan
-            if i == len(touches):  # the unmoved fit: its scatter
-                dof = len(touches) - 3
-                noise = max(sigma, fit.rms * math.sqrt(len(touches) / dof)) if dof > 0 else sigma
-                break
             grads.append((self.advance_to(fit.centres, roll) - x) / SPREAD_STEP)
+        unmoved = fit_plane(c, sigma=sigma, hint=hint)  # its scatter scales sigma
+        if not unmoved.success or unmoved.centres is None:
+            return math.nan
+        dof = len(touches) - 3
+        noise = max(sigma, unmoved.rms * math.sqrt(len(touches) / dof)) if dof > 0 else sigma
         g = float(np.linalg.norm(grads))
         return 3.0 * noise * g if math.isfinite(g) else math.nan
 

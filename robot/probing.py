@@ -28,7 +28,7 @@ import numpy as np
 
 from estimation.surface import load_crossing
 from robot.indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPlan
-from robot.probe_plan import ProbeGeometry, ProbeSettings, nearest_turn
+from robot.probe_plan import ProbeGeometry, ProbeSettings
 from robot.probe_result import ProbeResult, Touch
 
 MOVE_LOOKAHEAD = math.radians(12.0)  # roll ahead of the present the stage keeps clear of
@@ -161,9 +161,7 @@ class ProbeRoutine:
         self._free, self._free_ticks, self._loaded_ticks = False, 0, 0
         self.goal = self.touches[-1].advance - s.clearance
         if len(self.touches) == len(self.rolls):
-            result = geo.replan(self.touches, self.plan, s)
-            roll = nearest_turn(result.roll, obs.roll, geo.roll_limits)
-            self.result = dataclasses.replace(result, roll=roll)
+            self.result = geo.replan(self.touches, self.plan, s)  # roll: the way out's turn
             self._plan_sweep(obs.roll, self.result.roll)
             self.phase = _Phase.LEAVE
             return self._leave(obs)
