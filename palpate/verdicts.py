@@ -98,6 +98,11 @@ def counts_text(t: Tally) -> str:
     return ", ".join(f"{t.counts[s]} {s}" for s in STATUSES)
 
 
+def counts_column(t: Tally) -> str:
+    """``12/3/1``: the tables' ok/sus/none column."""
+    return "/".join(str(t.counts[s]) for s in STATUSES)
+
+
 def by_sample(outcomes: Iterable[TrialOutcome]) -> dict[str, Tally]:
     """A :class:`Tally` per sample (rigid references left out), in the outcomes' order."""
     groups: dict[str, list[TrialOutcome]] = {}

@@ -31,7 +31,7 @@ from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaign import campaign_trials, median_abs_relative_error, run_campaign, warm_up
 from palpate.simtrial import Transport, TrialOutcome
-from palpate.verdicts import tally
+from palpate.verdicts import counts_column, tally
 from sim.contact_table import equilibrium_on_grid
 
 SceneChange = Callable[[SceneConfig], SceneConfig]
@@ -133,7 +133,7 @@ def _level_row(level: Level, ctx: BenchContext) -> LevelRow:
         joint_worst=max(errors, default=None),
         coverage=sum(covered) / len(covered) if covered else None,  # as palpate.compare
         paper_median=median_abs_relative_error(outcomes, "paper"),
-        verdicts="/".join(str(n) for n in tally(outcomes).counts.values()),
+        verdicts=counts_column(tally(outcomes)),
     )
 
 

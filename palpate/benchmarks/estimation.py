@@ -25,7 +25,7 @@ from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.calibration import is_reference
 from palpate.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
-from palpate.verdicts import Tally, tally
+from palpate.verdicts import Tally, counts_column, tally
 
 CASES: tuple[tuple[str, str], ...] = (
     ("nominal", "the world is what the estimator is told"),
@@ -58,13 +58,12 @@ def _pct(x: float | None) -> str:
 
 
 def _row(name: str, what: str, t: Tally) -> list[Any]:
-    c = t.counts
     cover = "-" if t.coverage is None else f"{t.covered}/{t.numbers} ({100 * t.coverage:.0f} %)"
     return [
         name,
         what,
         t.trials,
-        f"{c['ok']}/{c['suspect']}/{c['none']}",
+        counts_column(t),
         _pct(t.median_ok),
         _pct(t.worst_ok),
         _pct(t.median_all),

@@ -31,7 +31,7 @@ from palpate.resume import resume_outcomes
 from palpate.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
 from palpate.simtrial import Transport, TrialOutcome, TrialSpec
 from palpate.simworld import tissue_description
-from palpate.verdicts import Tally, by_sample, summary_lines, tally
+from palpate.verdicts import Tally, by_sample, counts_column, summary_lines, tally
 
 log = logging.getLogger(__name__)
 
@@ -372,7 +372,7 @@ def _print_table(name: str, rows: list, tallies: dict[str, Tally]) -> None:  # t
 
         rel = "-" if s.relative_error is None else f"{100 * s.relative_error:+.1f}%"
         t = tallies[r.sample]
-        verdicts = "/".join(str(t.counts[v]) for v in ("ok", "suspect", "none"))
+        verdicts = counts_column(t)
         print(
             f"{r.sample:>8} {r.trials:>6} {verdicts:>11} {k(s.mean):>10} {k(s.actual):>9} "
             f"{k(s.rmse):>9} {k(s.iqr):>9} {rel:>8} {f'{t.covered}/{t.numbers}':>6}"
