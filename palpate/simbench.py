@@ -38,7 +38,7 @@ from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
 from robot.dynamixel.units import rad_from_ticks
 from robot.trial.setup import sensor_section
-from sensor.reader import layout_from_config
+from sensor.parser import layout_from_config
 from sim.board import BoardEmulator, BoardSample
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus

@@ -47,7 +47,8 @@ from robot.trial.setup import (
     sensor_section,
     trial_plan,
 )
-from sensor.reader import FrameReader, layout_from_config
+from sensor.parser import layout_from_config
+from sensor.reader import FrameReader
 from sensor.strain import StrainChain
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock

@@ -31,7 +31,7 @@ from config.schema import StackConfig
 from estimation.beam import Beam
 from estimation.section import sensor_section
 from sensor.calibration import CalibrationFit, fit_strain_coefficient
-from sensor.reader import layout_from_config
+from sensor.parser import layout_from_config
 from sensor.strain import grating_intervals
 from wire.dynamixel import TICKS_PER_REV
 from wire.frameblock import FrameBlock, decode_block

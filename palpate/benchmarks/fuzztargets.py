@@ -3,7 +3,7 @@
 Targets, each a function of one input that raises :class:`FuzzFailureError` (or anything else) when
 the code under test misbehaves:
 
-- ``frame parser``: :class:`sensor.reader.FrameParser` on valid frames mixed with garbage, bit
+- ``frame parser``: :class:`sensor.parser.FrameParser` on valid frames mixed with garbage, bit
   flips and cuts, fed in random chunks; it must never raise, must find every intact frame, and
   must account for every byte (``bytes_received == frames * size + discarded + pending``);
   :func:`wire.frame.decode` on the same bytes raises only ``FrameError``;
@@ -42,7 +42,7 @@ from palpate.benchmarks.fuzzconfig import (
 )
 from robot.dynamixel.driver import DynamixelBus, Motor
 from robot.motors import ServoFaultError, ServoTransportError
-from sensor.reader import FrameParser
+from sensor.parser import FrameParser
 from sim.dynamixel import protocol
 from sim.dynamixel.faults import FaultyBus
 from sim.dynamixel.servo import EmulatedServo

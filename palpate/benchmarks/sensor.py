@@ -36,7 +36,8 @@ from estimation.detect_buckling import (
 from estimation.elastica.constants import P_CRIT
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from sensor.clock import SystemClock
-from sensor.reader import FrameParser, FrameReader
+from sensor.parser import FrameParser
+from sensor.reader import FrameReader
 from sensor.strain import grating_intervals, strain_noise
 from sim.board import BoardEmulator, BoardFaults, BoardSample
 from sim.clock import VirtualClock

@@ -23,7 +23,7 @@ from config.bench import load_bench
 from config.scene import SceneConfig
 from palpate.argtypes import positive_float
 from palpate.simbench import SimulatedBench, stations_for
-from sensor.reader import layout_from_config
+from sensor.parser import layout_from_config
 from sim.board import BoardEmulator, constant_source
 from sim.dynamixel.bus import EmulatedBus
 

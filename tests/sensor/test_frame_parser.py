@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sensor.reader import FrameParser
+from sensor.parser import FrameParser
 from wire.frame import MARKER, Frame, FrameLayout, encode
 
 LAYOUT = FrameLayout(3)

@@ -12,7 +12,8 @@ import pytest
 import serial
 
 from config.schema import BoardConfig, SensorConfig
-from sensor.reader import REOPEN_BACKOFF_S, FrameReader, SensorPortError, layout_from_config
+from sensor.parser import layout_from_config
+from sensor.reader import REOPEN_BACKOFF_S, FrameReader, SensorPortError
 from sim.clock import VirtualClock
 from wire.frame import Frame, FrameLayout, encode
 
