@@ -11,6 +11,7 @@ SECTIONS: dict[str, str] = {
     "sensor": "palpate.benchmarks.sensor",
     "robot": "palpate.benchmarks.robot",
     "campaign": "palpate.benchmarks.campaign",
+    "sides": "palpate.benchmarks.sides",
     "estimation": "palpate.benchmarks.estimation",
     "tissue": "palpate.benchmarks.tissue",
     "tissue-fe": "palpate.benchmarks.tissue_fe",

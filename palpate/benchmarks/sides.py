@@ -1,0 +1,287 @@
+"""Where a shipped trial's CPU goes, by side: the simulator, the control path, the estimator.
+
+The project keeps one control path: the rig, the drive, the Dynamixel driver, the frame reader,
+the indentation state machine and the trial log run in simulation exactly as they run on the
+bench. So the simulator can only be as fast as that path and the estimator allow, however cheap
+the simulated world. This section measures that floor on the shipped bench scene (fast transport,
+serial, trial logs written as ``palpate sim`` writes them): each trial's CPU time
+(``time.process_time``) split at the boundaries below, each part counted exclusively (a call's
+time less the time of the measured calls inside it), with wrappers installed only while the
+section runs and removed afterwards (:func:`measured`).
+
+- simulator: the virtual clock's advance (servo motion, board frames, the world's contact), the
+  emulated servo bus answering the driver's requests, the frame pipe, the contact tables;
+- control path: the trial loop and its ticks less the simulator's calls inside them;
+- estimator: the joint fit, the beam states, the paper's strain fit, and the rest of the
+  trial's estimate (the paper's single point, Southwell, the verdict);
+- set-up: the rest of a trial (geometry, world, emulators, driver, zeroing);
+- start-up: a fresh process's interpreter and imports (``python -c 'import ...'``, CPU of the
+  child), shared by the campaign's trials as ``palpate sim`` shares it.
+
+The derived rows give the campaign's speed if the simulator cost nothing: simulated seconds
+over the CPU of the control path and the estimator (with and without the start-up's share).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import importlib
+import math
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections import Counter, defaultdict
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from config import load, load_stack, resolve
+from config.scene import SceneConfig
+from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from palpate.campaign import campaign_trials, run_campaign, warm_up
+from palpate.simtrial import TrialOutcome
+from sim.contact_table import equilibrium_on_grid
+
+SIMULATOR, CONTROL, ESTIMATOR = "simulator", "control path", "estimator"
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """A function measured: ``owner`` (a module or a class, by import path) and its attribute;
+    ``part`` names it in the table, ``side`` groups the parts."""
+
+    owner: str
+    attribute: str
+    part: str
+    side: str
+
+
+BOUNDARIES = (
+    Boundary("sim.clock:VirtualClock", "advance", "clock advance: servos, board, world", SIMULATOR),
+    Boundary("sim.dynamixel.bus:EmulatedBus", "exchange", "emulated bus requests", SIMULATOR),
+    Boundary("sim.inprocess:FramePipe", "take_frames", "frame pipe", SIMULATOR),
+    Boundary("sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
+    Boundary("palpate.simtrial", "run_trial", "trial loop", CONTROL),
+    Boundary("robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
+    Boundary("robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
+    Boundary("robot.trial.estimate", "infer_states", "beam states", ESTIMATOR),
+    Boundary("robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
+    Boundary("palpate.simresult", "estimate_trial", "rest of the estimate", ESTIMATOR),
+)
+TICKS = "ticks (observe, decide, command)"
+IMPORTS = "import palpate.cli, palpate.campaign, palpate.simtrial, palpate.simresult"
+
+
+class Ledger:
+    """Exclusive CPU time and calls per part: a call's time less its measured callees'."""
+
+    def __init__(self, clock: Callable[[], float] = time.process_time) -> None:
+        self.clock = clock
+        self.seconds: defaultdict[str, float] = defaultdict(float)
+        self.calls: Counter[str] = Counter()
+        self.children: Counter[str] = Counter()  # measured calls made inside each part's calls
+        self._open: list[list[float]] = []  # per open call: [time, count] of its measured callees
+
+    def wrap(self, part: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        @functools.wraps(fn)
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            t0 = self.clock()
+            self._open.append([0.0, 0])
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                elapsed = self.clock() - t0
+                inner, count = self._open.pop()
+                self.seconds[part] += elapsed - inner
+                self.children[part] += int(count)
+                self.calls[part] += 1
+                if self._open:
+                    self._open[-1][0] += elapsed
+                    self._open[-1][1] += 1
+
+        return timed
+
+
+@dataclass(frozen=True)
+class Overhead:
+    """What measuring one call costs (s): inside the callee's part and inside its caller's."""
+
+    inner: float
+    outer: float
+
+
+def overhead(calls: int = 50_000, repeats: int = 3) -> Overhead:
+    """The wrapper's cost, calibrated on a no-op called from a measured loop (best of
+    ``repeats``): the callee's exclusive time is all overhead; the caller's, less the same
+    loop calling the bare no-op, is the rest."""
+
+    def noop() -> None:
+        return None
+
+    def loop(f: Callable[[], None]) -> None:
+        for _ in range(calls):
+            f()
+
+    best = Overhead(math.inf, math.inf)
+    for _ in range(repeats):
+        ledger = Ledger()
+        t0 = time.process_time()
+        loop(noop)
+        bare = time.process_time() - t0
+        ledger.wrap("outer", loop)(ledger.wrap("inner", noop))
+        inner = ledger.seconds["inner"] / calls
+        outer = max(ledger.seconds["outer"] - bare, 0.0) / calls
+        best = Overhead(min(best.inner, inner), min(best.outer, outer))
+    return best
+
+
+def _owner(path: str) -> Any:
+    module, _, cls = path.partition(":")
+    obj: Any = importlib.import_module(module)
+    return getattr(obj, cls) if cls else obj
+
+
+@contextlib.contextmanager
+def measured(boundaries: tuple[Boundary, ...] = BOUNDARIES) -> Iterator[Ledger]:
+    """Wrap every boundary for the duration; the originals are back on exit, even on error."""
+    ledger = Ledger()
+    undo: list[Callable[[], None]] = []
+    try:
+        for b in boundaries:
+            owner = _owner(b.owner)
+            original = owner.__dict__[b.attribute] if isinstance(owner, type) else None
+            fn = getattr(owner, b.attribute)
+            setattr(owner, b.attribute, ledger.wrap(b.part, fn))
+            restore = original if original is not None else fn
+            undo.append(functools.partial(setattr, owner, b.attribute, restore))
+        yield ledger
+    finally:
+        for step in reversed(undo):
+            step()
+
+
+@dataclass(frozen=True)
+class Sides:
+    """The shipped campaign's CPU per trial by part (s), its ticks and simulated time."""
+
+    trials: int
+    ticks: int
+    sim_time: float  # simulated seconds, all trials
+    whole: float  # CPU seconds, all trials
+    parts: dict[str, float]  # CPU seconds by part, all trials; "set-up" is the rest
+    calls: dict[str, int]
+    startup: float  # CPU seconds of one process's interpreter and imports
+    removed: float = 0.0  # CPU seconds of the measurement's own cost, taken out of the parts
+
+    def side(self, name: str) -> float:
+        return sum(self.parts[b.part] for b in BOUNDARIES if b.side == name)
+
+    def real_time_per_core(self, *sides: str, startup: bool) -> float:
+        """Simulated seconds per CPU second if only ``sides`` (and the start-up) cost CPU."""
+        cpu = sum(self.side(s) for s in sides) + (self.startup if startup else 0.0)
+        return self.sim_time / cpu
+
+
+def startup_cpu(repeats: int = 3) -> float:
+    """Median CPU seconds of a fresh interpreter importing what ``palpate sim`` imports."""
+    costs = []
+    for _ in range(repeats):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([sys.executable, "-c", IMPORTS], check=True)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        costs.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return statistics.median(costs)
+
+
+def measure_sides(quick: bool, seed: int, log_dir: Path, limit: int | None = None) -> Sides:
+    """Run the shipped bench campaign (serial, fast) with every boundary measured."""
+    scene = load(SceneConfig, resolve("scenes/bench.yaml"))
+    stack = load_stack(resolve(scene.robot))
+    specs = campaign_trials(scene, stack, seed)
+    specs = specs[::5] if quick else specs
+    specs = specs[:limit] if limit is not None else specs
+    warm_up()
+    equilibrium_on_grid.cache_clear()  # every trial pays for its tables, as in a fresh worker
+    stamps = [time.process_time()]
+
+    def progress(_: TrialOutcome) -> None:
+        stamps.append(time.process_time())
+
+    with measured() as ledger:
+        stamps[0] = time.process_time()
+        outcomes = run_campaign(specs, scene, stack, log_dir=log_dir, progress=progress)
+    # Take the measurement's own cost out: each call's inner share from its part, each
+    # measured callee's outer share from its caller's part (the top-level calls' from the rest).
+    cost = overhead()
+    parts = {
+        b.part: ledger.seconds[b.part]
+        - ledger.calls[b.part] * cost.inner
+        - ledger.children[b.part] * cost.outer
+        for b in BOUNDARIES
+    }
+    calls = sum(ledger.calls.values())
+    removed = calls * (cost.inner + cost.outer)
+    whole = stamps[-1] - stamps[0] - removed
+    parts["set-up"] = whole - sum(parts.values())
+    return Sides(
+        trials=len(outcomes),
+        ticks=ledger.calls[TICKS],
+        sim_time=sum(o.sim_time for o in outcomes),
+        whole=whole,
+        parts=parts,
+        calls=dict(ledger.calls),
+        startup=startup_cpu(2 if quick else 3),
+        removed=removed,
+    )
+
+
+def _table(s: Sides, ctx: BenchContext) -> Table:
+    n, ticks = s.trials, max(s.ticks, 1)
+    rows: list[Sequence[Any]] = []
+    for side in (SIMULATOR, CONTROL, ESTIMATOR):
+        for b in (b for b in BOUNDARIES if b.side == side):
+            rows.append([side, b.part, 1e3 * s.parts[b.part] / n, 1e6 * s.parts[b.part] / ticks])
+        rows.append([side, "= all", 1e3 * s.side(side) / n, 1e6 * s.side(side) / ticks])
+    rows.append(["-", "set-up and the rest", 1e3 * s.parts["set-up"] / n, "-"])
+    rows.append(["-", "whole trial", 1e3 * s.whole / n, 1e6 * s.whole / ticks])
+    rows.append(["-", "start-up share (one process)", 1e3 * s.startup / n, "-"])
+    per_trial = s.sim_time / n
+    free = s.real_time_per_core(CONTROL, ESTIMATOR, startup=True)
+    return Table(
+        title="Shipped bench scene (fast, serial): a trial's CPU by side",
+        columns=["side", "part", "CPU ms/trial", "us/tick"],
+        rows=rows,
+        note=(
+            f"{n} trials, {s.ticks / n:.0f} ticks and {per_trial:.2f} s simulated a trial, seed "
+            f"{ctx.seed}; exclusive CPU (process_time) per part, the wrappers' own cost "
+            f"({1e3 * s.removed / n:.1f} ms a trial, calibrated) taken out; as run: "
+            f"{s.sim_time / (s.whole + s.startup):.1f}x real time per core with the start-up. "
+            f"The 100x budget is {1e3 * per_trial / 100:.1f} ms a trial. If the simulator cost "
+            f"nothing: {free:.1f}x with the start-up, "
+            f"{s.real_time_per_core(CONTROL, ESTIMATOR, startup=False):.1f}x without; the "
+            f"control path alone: {s.real_time_per_core(CONTROL, startup=False):.1f}x."
+        ),
+    )
+
+
+def run(ctx: BenchContext) -> BenchSection:
+    with tempfile.TemporaryDirectory(prefix="palpate-sides-") as tmp:
+        sides = measure_sides(ctx.quick, ctx.seed, Path(tmp))
+    summary: dict[str, Any] = {
+        "trials": sides.trials,
+        "ticks": sides.ticks,
+        "sim_time": sides.sim_time,
+        "cpu_ms_per_trial": {k: 1e3 * v / sides.trials for k, v in sides.parts.items()},
+        "startup_s": sides.startup,
+        "x_real_time_free_simulator": sides.real_time_per_core(CONTROL, ESTIMATOR, startup=True),
+        "x_real_time_control_only": sides.real_time_per_core(CONTROL, startup=False),
+    }
+    return BenchSection(name="sides", tables=[_table(sides, ctx)], summary=summary)
+
+
+__all__ = ["BOUNDARIES", "Ledger", "Sides", "measure_sides", "measured", "run", "startup_cpu"]
