@@ -161,7 +161,6 @@ def run_sim_trial(
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
     stack = trial_stack(scene, stack, geo, retract)
     plan = trial_plan(c, stack, roll=geo.plan_roll, contact=geo.contact_translation, home=retract)
-    prober = prober_for(c, stack, stack.tube(geo.tube)) if spec.kind == "robot" else None
     clock = VirtualClock()
     servos = ServoJoints(stack)
     world = trial_world(spec, scene, stack, geo, servos)

@@ -12,6 +12,7 @@ SECTIONS: dict[str, str] = {
     "robot": "palpate.benchmarks.robot",
     "campaign": "palpate.benchmarks.campaign",
     "sides": "palpate.benchmarks.sides",
+    "probing": "palpate.benchmarks.probing",
     "estimation": "palpate.benchmarks.estimation",
     "tissue": "palpate.benchmarks.tissue",
     "tissue-fe": "palpate.benchmarks.tissue_fe",

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import importlib
 import math
 import resource
 import statistics
@@ -42,6 +41,7 @@ from typing import Any
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
+from palpate.benchmarks.patching import patched
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaign import campaign_trials, run_campaign, warm_up
 from palpate.simtrial import TrialOutcome
@@ -140,29 +140,13 @@ def overhead(calls: int = 50_000, repeats: int = 3) -> Overhead:
     return best
 
 
-def _owner(path: str) -> Any:
-    module, _, cls = path.partition(":")
-    obj: Any = importlib.import_module(module)
-    return getattr(obj, cls) if cls else obj
-
-
 @contextlib.contextmanager
 def measured(boundaries: tuple[Boundary, ...] = BOUNDARIES) -> Iterator[Ledger]:
     """Wrap every boundary for the duration; the originals are back on exit, even on error."""
     ledger = Ledger()
-    undo: list[Callable[[], None]] = []
-    try:
-        for b in boundaries:
-            owner = _owner(b.owner)
-            original = owner.__dict__[b.attribute] if isinstance(owner, type) else None
-            fn = getattr(owner, b.attribute)
-            setattr(owner, b.attribute, ledger.wrap(b.part, fn))
-            restore = original if original is not None else fn
-            undo.append(functools.partial(setattr, owner, b.attribute, restore))
+    wraps = [(b.owner, b.attribute, functools.partial(ledger.wrap, b.part)) for b in boundaries]
+    with patched(wraps):
         yield ledger
-    finally:
-        for step in reversed(undo):
-            step()
 
 
 @dataclass(frozen=True)
