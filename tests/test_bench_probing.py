@@ -13,8 +13,8 @@ from config import load_stack
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.probing import (
     ExactSurfaceGeometry,
-    exact_surface_hooks,
     faster_drive,
+    prober_hooks,
     trial_subset,
 )
 from palpate.simtrial import run_sim_trial
@@ -61,7 +61,7 @@ def test_exact_surface_probes_no_slower_and_the_hooks_go_away() -> None:
     spec = specs[1]  # a 10 deg tilt on the 15 deg tube, sideways
     original = palpate.simtrial.prober_for
     shipped = run_sim_trial(spec, scene, stack)
-    with patched(exact_surface_hooks()):
+    with patched(prober_hooks(exact=True)):
         assert palpate.simtrial.prober_for is not original
         exact = run_sim_trial(spec, scene, stack)
     assert palpate.simtrial.prober_for is original

@@ -7,6 +7,8 @@ section runs a fixed subset of the tilted scene (``config/scenes/tilted.yaml``: 
 trial, spanning tilts, tubes and orientations; every 19th with ``--quick``) at:
 
 - the shipped routine;
+- three touches, the full roll step either side of the plan (the fewest a plane needs; the
+  shipped pattern's quarter step first gives the surface's slope before the wide move);
 - the routine told the true surface (:class:`ExactSurfaceGeometry`): each next touch predicted
   exactly, with no slack, so every retract is only the clearance. No prediction can do better,
   so its time is the floor of the four-touch pattern on this drive; the fit and the re-plan
@@ -74,6 +76,7 @@ class Variant:
 
 VARIANTS = (
     Variant("shipped"),
+    Variant("3 touches (the full step either side)", touches=3),
     Variant("exact surface", exact=True),
     Variant("exact surface, 3 touches", exact=True, touches=3),
     Variant("exact surface, drive limits x2", exact=True, drive_scale=2.0),
@@ -94,21 +97,20 @@ def faster_drive(stack: StackConfig, scale: float) -> StackConfig:
     return dataclasses.replace(stack, drive=drive)
 
 
-def _told_the_truth(routine: ProbeRoutine, surface: Surface, touches: int) -> ProbeRoutine:
-    """``routine`` with the exact-surface geometry; with three touches, the full step either
-    side of the plan (the shipped pattern's second offset is its full step)."""
-    routine.geometry = ExactSurfaceGeometry(routine.geometry, surface)
-    if touches == 3 and len(routine.settings.offsets) >= 2:
-        step = routine.settings.offsets[1]
-        routine.settings = dataclasses.replace(routine.settings, offsets=(step, -step))
-        routine.rolls = routine.geometry.probe_rolls(routine.plan.roll, routine.settings.offsets)
+def _three_touches(routine: ProbeRoutine) -> ProbeRoutine:
+    """``routine`` touching the plan and the full step either side of it (the shipped
+    pattern's second offset is its full step)."""
+    step = routine.settings.offsets[1]
+    routine.settings = dataclasses.replace(routine.settings, offsets=(step, -step))
+    routine.rolls = routine.geometry.probe_rolls(routine.plan.roll, routine.settings.offsets)
     return routine
 
 
-def exact_surface_hooks(touches: int = 4) -> list[tuple[str, str, Callable[[Any], Any]]]:
-    """Replacements (for :func:`palpate.benchmarks.patching.patched`) that hand each trial's
-    prober the trial's true surface: the trial's geometry is kept as it is planned, and the
-    prober factory wraps what it builds."""
+def prober_hooks(exact: bool, touches: int = 4) -> list[tuple[str, str, Callable[[Any], Any]]]:
+    """Replacements (for :func:`palpate.benchmarks.patching.patched`) that change what each
+    trial's prober is: told the trial's true surface (``exact``; the trial's geometry is kept as
+    it is planned), and/or three touches instead of four. The prober factory wraps what it
+    builds."""
     seen: list[TrialGeometry] = []
 
     def keep_geometry(original: Callable[..., TrialGeometry]) -> Callable[..., TrialGeometry]:
@@ -118,19 +120,21 @@ def exact_surface_hooks(touches: int = 4) -> list[tuple[str, str, Callable[[Any]
 
         return planned
 
-    def exact_prober(original: Callable[..., Any]) -> Callable[..., Any]:
+    def changed(routine: ProbeRoutine) -> ProbeRoutine:
+        if exact:
+            routine.geometry = ExactSurfaceGeometry(routine.geometry, seen[-1].surface)
+        return _three_touches(routine) if touches == 3 else routine
+
+    def prober(original: Callable[..., Any]) -> Callable[..., Any]:
         def factory(*args: Any, **kwargs: Any) -> Any:
             build = original(*args, **kwargs)
-            if build is None:
-                return None
-            surface = seen[-1].surface
-            return lambda plan: _told_the_truth(build(plan), surface, touches)
+            return None if build is None else lambda plan: changed(build(plan))
 
         return factory
 
     return [
         ("palpate.simtrial", "trial_geometry", keep_geometry),
-        ("palpate.simtrial", "prober_for", exact_prober),
+        ("palpate.simtrial", "prober_for", prober),
     ]
 
 
@@ -151,7 +155,8 @@ class Row:
 
 def run_variant(variant: Variant, specs: list[Any], scene: SceneConfig, stack: StackConfig) -> Row:
     stack = faster_drive(stack, variant.drive_scale) if variant.drive_scale != 1.0 else stack
-    hooks = exact_surface_hooks(variant.touches) if variant.exact else []
+    changed = variant.exact or variant.touches != 4
+    hooks = prober_hooks(variant.exact, variant.touches) if changed else []
     with patched(hooks):
         outcomes = run_campaign(specs, scene, stack)
     return Row(variant.name, outcomes)
