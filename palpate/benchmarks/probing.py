@@ -19,8 +19,9 @@ trial, spanning tilts, tubes and orientations; every 19th with ``--quick``) at:
 
 Per row: trials done, the probing time (simulated) median / min / max, the true residual at
 indentation (the world's angle between the sensor and the normal) and the joint fit's median
-|relative error| of E. The exact-surface rows replace two functions of ``palpate.simtrial``
-for the duration (``palpate.benchmarks.patching``); shipped code has no hook for it.
+|relative error| of E. Every row but the shipped one replaces two functions of
+``palpate.simtrial`` for the duration (``palpate.benchmarks.patching``); shipped code has no
+hook for it.
 """
 
 from __future__ import annotations
