@@ -231,7 +231,7 @@ def _table(rows: list[LevelRow], ctx: BenchContext) -> Table:
             for r in rows
         ],
         note=(
-            f"serial, CPU time (process_time), seed {ctx.seed}"
+            f"serial, no trial logs, CPU time (process_time), seed {ctx.seed}"
             f"{', every fifth trial (--quick)' if ctx.quick else ''}; 'x cheaper' against the "
             "shipped level on the fast path; every level but the rates keeps 250 Hz; usable: "
             f"coverage >= {100 * USABLE_COVERAGE:.0f} % and worst error <= "
