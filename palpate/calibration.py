@@ -23,7 +23,7 @@ STAGE = "bench-stage"  # the key of the bench-top stage's compliance
 
 
 class Calibrating(Protocol):
-    """What a calibration trial's outcome carries (``palpate.simtrial.TrialOutcome``)."""
+    """What a calibration trial's outcome carries (``palpate.simulation.trial.TrialOutcome``)."""
 
     @property
     def calibration(self) -> ComplianceFit | None: ...

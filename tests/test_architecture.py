@@ -155,7 +155,7 @@ def test_no_two_packages_import_each_other() -> None:
 
 
 def test_no_two_subpackages_import_each_other() -> None:
-    """Inside a layer too: e.g. palpate.faults may use palpate.replaylog, but not a command
+    """Inside a layer too: e.g. palpate.faults may use palpate.reports.replay, but not a command
     module that imports palpate.faults back."""
     assert find_cycle(subpackage_graph()) is None
 

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-import palpate.simtrial
+import palpate.simulation.trial
 from config import load_stack
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.probing import (
@@ -17,7 +17,7 @@ from palpate.benchmarks.probing import (
     prober_hooks,
     trial_subset,
 )
-from palpate.simtrial import run_sim_trial
+from palpate.simulation.trial import run_sim_trial
 from robot import kinematics
 from robot.probe_plan import ProbeGeometry, ProbeSettings
 from robot.probe_result import Touch
@@ -59,12 +59,12 @@ def test_exact_prediction_puts_the_tip_on_the_true_surface() -> None:
 def test_exact_surface_probes_no_slower_and_the_hooks_go_away() -> None:
     specs, scene, stack = trial_subset(quick=True, seed=0)
     spec = specs[1]  # a 10 deg tilt on the 15 deg tube, sideways
-    original = palpate.simtrial.prober_for
+    original = palpate.simulation.trial.prober_for
     shipped = run_sim_trial(spec, scene, stack)
     with patched(prober_hooks(exact=True)):
-        assert palpate.simtrial.prober_for is not original
+        assert palpate.simulation.trial.prober_for is not original
         exact = run_sim_trial(spec, scene, stack)
-    assert palpate.simtrial.prober_for is original
+    assert palpate.simulation.trial.prober_for is original
     again = run_sim_trial(spec, scene, stack)
     assert (again.probing_time, again.modulus("joint")) == (
         shipped.probing_time,

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-import palpate.simtrial
+import palpate.simulation.trial
 import robot.trial.run
 import sim.world
 from config import load, load_stack, resolve
@@ -21,7 +21,7 @@ from palpate.benchmarks.sides import (
     measure_sides,
     measured,
 )
-from palpate.campaign import campaign_trials, run_campaign
+from palpate.campaigns.campaign import campaign_trials, run_campaign
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
 
@@ -51,7 +51,7 @@ def _hooked() -> tuple[object, ...]:
         VirtualClock.__dict__["advance"],
         EmulatedBus.__dict__["exchange"],
         sim.world.equilibrium_on_grid,
-        palpate.simtrial.run_trial,
+        palpate.simulation.trial.run_trial,
         robot.trial.run._tick,
     )
 

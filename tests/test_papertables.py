@@ -8,8 +8,8 @@ import pytest
 
 from config import load, resolve
 from config.scene import SceneConfig
-from palpate.campaign import reported_references
-from palpate.papertables import TABLE_I, TABLE_II, ErrorStructure, TableRow, structure
+from palpate.campaigns.campaign import reported_references
+from palpate.reports.papertables import TABLE_I, TABLE_II, ErrorStructure, TableRow, structure
 
 
 def test_table_one_has_the_structure_the_calibration_aims_at() -> None:

@@ -8,8 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from palpate.cli import main
-from palpate.study import (
+from palpate.campaigns.study import (
     TrialErrors,
     binomial_cdf,
     method_stats,
@@ -17,6 +16,7 @@ from palpate.study import (
     summarize_study,
     wilson,
 )
+from palpate.cli import main
 
 
 def test_wilson_matches_the_closed_form_and_stays_in_0_1() -> None:

@@ -29,9 +29,14 @@ from typing import Any
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
-from palpate.campaign import campaign_trials, median_abs_relative_error, run_campaign, warm_up
-from palpate.simtrial import Transport, TrialOutcome
-from palpate.verdicts import counts_column, tally
+from palpate.campaigns.campaign import (
+    campaign_trials,
+    median_abs_relative_error,
+    run_campaign,
+    warm_up,
+)
+from palpate.reports.verdicts import counts_column, tally
+from palpate.simulation.trial import Transport, TrialOutcome
 from sim.contact_table import equilibrium_on_grid
 
 SceneChange = Callable[[SceneConfig], SceneConfig]
@@ -131,7 +136,7 @@ def _level_row(level: Level, ctx: BenchContext) -> LevelRow:
         real_time_per_core=sum(o.sim_time for o in outcomes) / (stamps[-1] - stamps[0]),
         joint_median=median_abs_relative_error(outcomes),
         joint_worst=max(errors, default=None),
-        coverage=sum(covered) / len(covered) if covered else None,  # as palpate.compare
+        coverage=sum(covered) / len(covered) if covered else None,  # as palpate.reports.methods
         paper_median=median_abs_relative_error(outcomes, "paper"),
         verdicts=counts_column(tally(outcomes)),
     )

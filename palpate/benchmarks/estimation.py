@@ -24,8 +24,8 @@ from config.loader import CONFIG_DIR
 from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.calibration import is_reference
-from palpate.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
-from palpate.verdicts import Tally, counts_column, tally
+from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
+from palpate.reports.verdicts import Tally, counts_column, tally
 
 CASES: tuple[tuple[str, str], ...] = (
     ("nominal", "the world is what the estimator is told"),

@@ -3,7 +3,7 @@ scene YAML (``palpate sim --scene``), both as mutations of valid files.
 
 - ``replay logs``: a real trial's log (bench and robot) with records mutated (values, keys,
   types, NaN, 1e300), lines deleted, duplicated, swapped, cut, or garbage bytes inserted, then
-  :func:`palpate.replaylog.replay`. It must return a report or raise ``ValueError`` (the CLI's
+  :func:`palpate.reports.replay.replay`. It must return a report or raise ``ValueError`` (the CLI's
   bad input, exit 2: ``TrialLogError``, ``ConfigError``); anything else is a failure.
 - ``scene yaml``: a shipped scene (bench, robot, faults) with its YAML text or its mapping
   mutated, then what ``palpate sim --scene`` does before any trial runs (load, check, plan,
@@ -28,10 +28,10 @@ import yaml
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.benchmarks.fuzzconfig import mutate_mapping, mutate_text
-from palpate.campaign import campaign_trials
-from palpate.preflight import check_campaign, check_reachable
-from palpate.replaylog import replay
-from palpate.simtrial import TrialSpec, run_sim_trial
+from palpate.campaigns.campaign import campaign_trials
+from palpate.reports.replay import replay
+from palpate.simulation.preflight import check_campaign, check_reachable
+from palpate.simulation.trial import TrialSpec, run_sim_trial
 
 Rng = np.random.Generator
 RUN_EVERY = 100  # one scene input in this many also runs its first trial

@@ -20,7 +20,7 @@ trial, spanning tilts, tubes and orientations; every 19th with ``--quick``) at:
 Per row: trials done, the probing time (simulated) median / min / max, the true residual at
 indentation (the world's angle between the sensor and the normal) and the joint fit's median
 |relative error| of E. Every row but the shipped one replaces two functions of
-``palpate.simtrial`` for the duration (``palpate.benchmarks.patching``); shipped code has no
+``palpate.simulation.trial`` for the duration (``palpate.benchmarks.patching``); shipped code has no
 hook for it.
 """
 
@@ -38,9 +38,14 @@ from config.schema import StackConfig
 from estimation.surface import SurfaceGeometry
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
-from palpate.campaign import campaign_trials, median_abs_relative_error, run_campaign, warm_up
-from palpate.simtrial import TrialOutcome
-from palpate.simworld import TrialGeometry
+from palpate.campaigns.campaign import (
+    campaign_trials,
+    median_abs_relative_error,
+    run_campaign,
+    warm_up,
+)
+from palpate.simulation.trial import TrialOutcome
+from palpate.simulation.world import TrialGeometry
 from robot.probe_plan import ProbeGeometry, ProbeSettings
 from robot.probe_result import Touch
 from robot.probing import ProbeRoutine
@@ -134,8 +139,8 @@ def prober_hooks(exact: bool, touches: int = 4) -> list[tuple[str, str, Callable
         return factory
 
     return [
-        ("palpate.simtrial", "trial_geometry", keep_geometry),
-        ("palpate.simtrial", "prober_for", prober),
+        ("palpate.simulation.trial", "trial_geometry", keep_geometry),
+        ("palpate.simulation.trial", "prober_for", prober),
     ]
 
 

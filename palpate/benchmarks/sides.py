@@ -44,8 +44,8 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
-from palpate.campaign import campaign_trials, run_campaign, warm_up
-from palpate.simtrial import TrialOutcome
+from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
+from palpate.simulation.trial import TrialOutcome
 from sim.contact_table import equilibrium_on_grid
 
 SIMULATOR, CONTROL, ESTIMATOR = "simulator", "control path", "estimator"
@@ -67,18 +67,21 @@ BOUNDARIES = (
     Boundary("sim.dynamixel.bus:EmulatedBus", "exchange", "emulated bus requests", SIMULATOR),
     Boundary("sim.inprocess:FramePipe", "take_frames", "frame pipe", SIMULATOR),
     Boundary("sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
-    Boundary("palpate.simtrial", "run_trial", "trial loop", CONTROL),
+    Boundary("palpate.simulation.trial", "run_trial", "trial loop", CONTROL),
     Boundary("robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
     Boundary("robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
     Boundary("robot.trial.estimate", "infer_states", "beam states", ESTIMATOR),
     Boundary("robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
-    Boundary("palpate.simresult", "estimate_trial", "rest of the estimate", ESTIMATOR),
+    Boundary("palpate.simulation.result", "estimate_trial", "rest of the estimate", ESTIMATOR),
 )
 TICKS = "ticks (observe, decide, command)"
 SHIPPED, LEAN = "scenes/bench.yaml", "scenes/bench-lean.yaml"
 # (scene, its name in the table, the target in x real time per core)
 SCENES = ((SHIPPED, "shipped bench scene", 100.0), (LEAN, "lean level (bench-lean.yaml)", 500.0))
-IMPORTS = "import palpate.cli, palpate.campaign, palpate.simtrial, palpate.simresult"
+IMPORTS = (
+    "import palpate.cli, palpate.campaigns.campaign, palpate.simulation.trial,"
+    " palpate.simulation.result"
+)
 
 
 class Ledger:

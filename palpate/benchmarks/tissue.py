@@ -34,8 +34,8 @@ from config import load, load_stack, resolve
 from config.sample import SampleConfig
 from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
-from palpate.campaign import campaign_trials, run_campaign, warm_up
-from palpate.simtrial import TrialOutcome
+from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
+from palpate.simulation.trial import TrialOutcome
 from sim.fem import FeTissueLaw, LayerProblem
 from sim.fem.law import curve_from_table
 from sim.fem.table import SHIPPED_DIR, read_table

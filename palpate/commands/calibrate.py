@@ -24,7 +24,7 @@ from config import load_stack
 from config.schema import MM
 from estimation.compliance import ComplianceFit
 from palpate.calibration import calibrate, config_lines, rig_key
-from palpate.replaylog import replay
+from palpate.reports.replay import replay
 from robot.trial.log import read_log
 from sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
 from sensor.framecal import calibrate_frames, read_frames

@@ -26,8 +26,8 @@ from estimation.design import (
     design_sensor,
 )
 from palpate.argtypes import non_negative_int, positive_int
-from palpate.campaign import campaign_trials, default_workers
-from palpate.designcheck import (
+from palpate.campaigns.campaign import campaign_trials, default_workers
+from palpate.campaigns.designcheck import (
     METHODS,
     UNITS,
     CheckSettings,
@@ -36,9 +36,9 @@ from palpate.designcheck import (
     relative_error,
     run_check,
 )
-from palpate.executors import add_executor_arguments
+from palpate.campaigns.executors import add_executor_arguments
 from palpate.progress import progress_bar
-from palpate.simtrial import TrialOutcome
+from palpate.simulation.trial import TrialOutcome
 from sensor.strain import strain_noise
 from wire.dynamixel import TICKS_PER_REV
 

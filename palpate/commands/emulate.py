@@ -1,11 +1,11 @@
 """Start the Dynamixel bus and board emulators on pseudo-terminals and print their paths.
 
-Without ``--scene`` the board streams the sensor at rest (nothing to touch). With ``--scene
-FILE`` the emulated robot has the scene's samples in front of it, at the poses the bench file's
-trials name (``--bench``, default the shipped ``bench.yaml``; ``palpate.simbench.stations_for``),
-with the scene's fidelity (noise, imperfection, tube compliance): a rehearsal of the bench on its
-twin. ``palpate trial --config BENCH.yaml --servo-port PTY --board-port PTY`` then runs end to
-end exactly as on the hardware (the same ports, SDK, reader, trial core and logs), in real time.
+Without ``--scene`` the board streams the sensor at rest (nothing to touch). With ``--scene FILE``
+the emulated robot has the scene's samples in front of it, at the poses the bench file's trials name
+(``--bench``, default the shipped ``bench.yaml``; ``palpate.simulation.twin.stations_for``), with
+the scene's fidelity (noise, imperfection, tube compliance): a rehearsal of the bench on its twin.
+``palpate trial --config BENCH.yaml --servo-port PTY --board-port PTY`` then runs end to end exactly
+as on the hardware (the same ports, SDK, reader, trial core and logs), in real time.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from config import load, load_stack, resolve
 from config.bench import load_bench
 from config.scene import SceneConfig
 from palpate.argtypes import positive_float
-from palpate.simbench import SimulatedBench, stations_for
+from palpate.simulation.twin import SimulatedBench, stations_for
 from sensor.parser import layout_from_config
 from sim.board import BoardEmulator, constant_source
 from sim.dynamixel.bus import EmulatedBus

@@ -11,7 +11,7 @@ import argparse
 import json
 from pathlib import Path
 
-from palpate.replaylog import replay
+from palpate.reports.replay import replay
 from robot.trial.log import TrialLogError
 
 

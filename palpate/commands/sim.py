@@ -15,7 +15,7 @@ from config.scene import SceneConfig
 from config.schema import StackConfig
 from palpate.argtypes import non_negative_int, positive_int
 from palpate.calibration import calibrate, config_lines, rig_key
-from palpate.campaign import (
+from palpate.campaigns.campaign import (
     CampaignRun,
     campaign_trials,
     default_workers,
@@ -23,15 +23,15 @@ from palpate.campaign import (
     run_campaigns,
     summarize_campaign,
 )
+from palpate.campaigns.executors import add_executor_arguments, open_executor
+from palpate.campaigns.resume import resume_outcomes
+from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
 from palpate.cli import EXIT_FAULT, EXIT_OK
-from palpate.executors import add_executor_arguments, open_executor
-from palpate.preflight import check_campaign, check_reachable
 from palpate.progress import progress_bar
-from palpate.resume import resume_outcomes
-from palpate.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
-from palpate.simtrial import Transport, TrialOutcome, TrialSpec
-from palpate.simworld import tissue_description
-from palpate.verdicts import Tally, by_sample, counts_column, summary_lines, tally
+from palpate.reports.verdicts import Tally, by_sample, counts_column, summary_lines, tally
+from palpate.simulation.preflight import check_campaign, check_reachable
+from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
+from palpate.simulation.world import tissue_description
 
 log = logging.getLogger(__name__)
 
@@ -83,13 +83,13 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--compare-methods",
         action="store_true",
         help="the paper's estimate vs the joint fit on the same trials, contact errors 0, "
-        "+-0.1, +-0.3 mm (palpate/compare.py)",
+        "+-0.1, +-0.3 mm (palpate/reports/methods.py)",
     )
     parser.add_argument(
         "--compare-paper",
         action="store_true",
         help="the paper's method beside the paper's Table I (bench) or II (robot): per-sample "
-        "rows and the error structure (palpate/papertables.py)",
+        "rows and the error structure (palpate/reports/papertables.py)",
     )
 
 
@@ -240,7 +240,7 @@ def _open_run(c: _Campaign, args: argparse.Namespace, locks: contextlib.ExitStac
 
 
 def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> None:
-    from palpate.compare import compare_methods, comparison_payload, print_comparison
+    from palpate.reports.methods import compare_methods, comparison_payload, print_comparison
     from robot.trial.setup import sensor_section
 
     for c in campaigns:
@@ -252,7 +252,7 @@ def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> None:
 
 
 def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> None:
-    from palpate.papertables import comparison, print_comparison
+    from palpate.reports.papertables import comparison, print_comparison
 
     payloads = []
     for c in campaigns:
@@ -278,7 +278,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     figures: list[str] = []
     out_dir = c.run_dir
     if not args.no_plots:
-        from palpate import plots
+        from palpate.reports import plots
 
         title = f"{scene.name} campaign: estimated vs actual modulus"
         figures.append(

@@ -2,12 +2,12 @@
 
 Every trial of the scene's campaign is run ``--repeats`` times, each with its own seed (the
 campaign's repeats, seeded per trial as ``palpate sim`` seeds them), through any executor. The
-report gives, per sample and over all trials, for the joint fit and for the paper's estimate:
-the fraction of trials with a number, the median and 95th percentile of |relative error| with
-distribution-free 95 % bounds (order statistics), the worst |relative error| seen, and for the
-joint fit the fraction of its intervals that hold the true modulus with a Wilson 95 % interval
-(``palpate/study.py``). Trials stream their results as they finish (``--results FILE``: one JSON
-line per trial); trial logs only with ``--logs DIR``; a progress bar only on a terminal.
+report gives, per sample and over all trials, for the joint fit and for the paper's estimate: the
+fraction of trials with a number, the median and 95th percentile of |relative error| with
+distribution-free 95 % bounds (order statistics), the worst |relative error| seen, and for the joint
+fit the fraction of its intervals that hold the true modulus with a Wilson 95 % interval
+(``palpate/campaigns/study.py``). Trials stream their results as they finish (``--results FILE``:
+one JSON line per trial); trial logs only with ``--logs DIR``; a progress bar only on a terminal.
 """
 
 from __future__ import annotations
@@ -23,12 +23,12 @@ from typing import IO, Any
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
-from palpate.executors import add_executor_arguments, open_executor
-from palpate.preflight import check_campaign, check_reachable
+from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
+from palpate.campaigns.executors import add_executor_arguments, open_executor
+from palpate.campaigns.study import Bounded, GroupStats, MethodStats, TrialErrors, summarize_study
 from palpate.progress import progress_bar
-from palpate.simtrial import TrialOutcome
-from palpate.study import Bounded, GroupStats, MethodStats, TrialErrors, summarize_study
+from palpate.simulation.preflight import check_campaign, check_reachable
+from palpate.simulation.trial import TrialOutcome
 
 log = logging.getLogger("palpate")
 

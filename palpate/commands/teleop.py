@@ -28,8 +28,8 @@ from config.scene import CampaignConfig, SceneConfig
 from config.schema import StackConfig
 from config.targets import save_target
 from palpate.commands.teleop_screen import draw, key_name, render, screen_width
-from palpate.hardware import open_hardware, run_on_hardware
-from palpate.simbench import SimulatedBench
+from palpate.lab.hardware import open_hardware, run_on_hardware
+from palpate.simulation.twin import SimulatedBench
 from robot.indentation import State
 from robot.rig import ServoFbgRig
 from robot.teleop import Teleop

@@ -19,15 +19,15 @@ from typing import Any
 from config.bench import LoadedBench, load_bench
 from estimation.stiffness import summarize
 from estimation.verdict import STATUSES
-from palpate.benchtrial import (
+from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.lab.hardware import open_hardware, port_problem, run_on_hardware
+from palpate.lab.trial import (
     SKIPPED,
     BenchOutcome,
     BenchTrial,
     plan_bench_trials,
     run_bench_trials,
 )
-from palpate.calibration import calibrate, config_lines, rig_key
-from palpate.hardware import open_hardware, port_problem, run_on_hardware
 from sensor.clock import Clock
 from sensor.reader import SerialLike
 

@@ -1,10 +1,10 @@
 """Fault injection on the emulators and the ground truth the judge reads.
 
-:class:`FaultInjector` satisfies ``palpate.simtrial.EmulatorHook``: it builds the trial's servo
-bus (a :class:`sim.dynamixel.faults.FaultyBus`), moves the tissue when a case says it is closer
-than planned, fires the case's faults on the virtual clock (at the start or at first touch, after
-a delay), and records what the emulators and the world saw (:class:`GroundTruth`), never what the
-controller believes. For a killed case it writes that truth to a black box and SIGKILLs its own
+:class:`FaultInjector` satisfies ``palpate.simulation.trial.EmulatorHook``: it builds the trial's
+servo bus (a :class:`sim.dynamixel.faults.FaultyBus`), moves the tissue when a case says it is
+closer than planned, fires the case's faults on the virtual clock (at the start or at first touch,
+after a delay), and records what the emulators and the world saw (:class:`GroundTruth`), never what
+the controller believes. For a killed case it writes that truth to a black box and SIGKILLs its own
 process.
 """
 
@@ -82,8 +82,8 @@ def _snapshot(bus: EmulatedBus, cfg: ServoBusConfig) -> dict[str, ServoSnapshot]
 
 
 class FaultInjector:
-    """Satisfies ``palpate.simtrial.EmulatorHook``: schedules one case's faults on the virtual
-    clock and records the ground truth the checks use."""
+    """Satisfies ``palpate.simulation.trial.EmulatorHook``: schedules one case's faults on the
+    virtual clock and records the ground truth the checks use."""
 
     def __init__(
         self,

@@ -38,8 +38,8 @@ from config.faults import FaultCase
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from palpate.faults.injector import GroundTruth
-from palpate.replaylog import replay
-from palpate.simtrial import TrialOutcome, TrialSpec
+from palpate.reports.replay import replay
+from palpate.simulation.trial import TrialOutcome, TrialSpec
 from robot.trial.log import read_log
 from sim.board import BoardFaults
 from wire import dynamixel as tables

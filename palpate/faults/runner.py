@@ -29,13 +29,13 @@ from config.faults import FaultCase
 from config.loader import ConfigError, from_mapping
 from config.scene import SceneConfig
 from config.schema import StackConfig
-from palpate.campaign import campaign_trials
-from palpate.executors import process_pool
+from palpate.campaigns.campaign import campaign_trials
+from palpate.campaigns.executors import process_pool
+from palpate.campaigns.runs import locked, new_run_dir
 from palpate.faults.injector import FaultInjector, GroundTruth
 from palpate.faults.judge import FaultJob, FaultTrialResult, judge, judge_killed
-from palpate.preflight import check_campaign, check_reachable
-from palpate.runs import locked, new_run_dir
-from palpate.simtrial import TrialOutcome, run_sim_trial
+from palpate.simulation.preflight import check_campaign, check_reachable
+from palpate.simulation.trial import TrialOutcome, run_sim_trial
 from sim.board import BoardFaults
 
 log = logging.getLogger(__name__)

@@ -1,5 +1,5 @@
 """The trial core: one indentation trial from plan to record, the same on the bench and in the
-simulator (only the wiring differs: ``palpate.benchtrial`` and ``palpate.simtrial``).
+simulator (only the wiring differs: ``palpate.lab.trial`` and ``palpate.simulation.trial``).
 
 - :mod:`.setup`: what a runner builds from a campaign: the sensor's section, the guards, the
   rig's settings (the control period), the stage's position tolerance, the buckling detector and

@@ -1,9 +1,9 @@
 """What every trial runner builds the same way from a campaign: the sensor's section, guards, rig
 settings, the stage's position tolerance, the buckling detector and the trial plan.
 
-One place for the simulated campaign (``palpate.simtrial``), the bench (``palpate.benchtrial``)
-and teleoperation (``palpate teleop``), so a guard, a threshold or a speed means the same
-everywhere.
+One place for the simulated campaign (``palpate.simulation.trial``), the bench
+(``palpate.lab.trial``) and teleoperation (``palpate teleop``), so a guard, a threshold or a speed
+means the same everywhere.
 """
 
 from __future__ import annotations

@@ -13,8 +13,8 @@ it makes the same decisions it makes over the pty.
 What a reply fault does here is what the SDK reports for it on the wire: a dropped reply is a
 ``COMM_RX_TIMEOUT`` (at once: there is no wire to wait on), a corrupted one ``COMM_RX_CORRUPT``.
 Faults that act on the bytes themselves (``sim.dynamixel.faults.FaultyBus``: random loss, flipped
-bytes, a reply filter) need the byte path; ``palpate.simtrial`` keeps the SDK on the in-process
-port when a fault hook is given.
+bytes, a reply filter) need the byte path; ``palpate.simulation.trial`` keeps the SDK on the
+in-process port when a fault hook is given.
 
 Why: on a bench trial the SDK's packet code and the emulator's parser were about a third of the
 loop's CPU (cProfile of ``palpate sim --campaign bench``), for bytes no one looks at.

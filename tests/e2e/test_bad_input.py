@@ -14,7 +14,7 @@ import pytest
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.cli import main
-from palpate.simtrial import TrialSpec, run_sim_trial
+from palpate.simulation.trial import TrialSpec, run_sim_trial
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

@@ -7,8 +7,8 @@ import statistics
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.campaign import campaign_trials, run_campaign
-from palpate.papertables import comparison
+from palpate.campaigns.campaign import campaign_trials, run_campaign
+from palpate.reports.papertables import comparison
 
 
 def test_the_bench_scene_reproduces_table_one_and_the_joint_fit_is_accurate() -> None:

@@ -9,9 +9,9 @@ import pytest
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.compare import compare_methods
-from palpate.replaylog import replay
-from palpate.simtrial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.reports.methods import compare_methods
+from palpate.reports.replay import replay
+from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 from robot.trial.setup import sensor_section
 
 STACK = load_stack()

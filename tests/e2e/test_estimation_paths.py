@@ -10,9 +10,9 @@ import pytest
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.campaign import campaign_trials, run_campaign
+from palpate.campaigns.campaign import campaign_trials, run_campaign
 from palpate.cli import main
-from palpate.replaylog import replay
+from palpate.reports.replay import replay
 from robot.trial.log import read_log
 
 MISMATCH = resolve("scenes/mismatch")

@@ -12,10 +12,15 @@ import pytest
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.campaign import campaign_trials, run_campaign, summarize_campaign
+from palpate.campaigns.campaign import campaign_trials, run_campaign, summarize_campaign
+from palpate.campaigns.executors import (
+    EXECUTORS,
+    ExecutorUnavailableError,
+    SerialExecutor,
+    open_executor,
+)
 from palpate.cli import main
-from palpate.executors import EXECUTORS, ExecutorUnavailableError, SerialExecutor, open_executor
-from palpate.simtrial import TrialOutcome, TrialSpec
+from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

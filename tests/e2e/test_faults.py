@@ -23,7 +23,7 @@ from palpate.faults import (
     judge,
     run_fault_trial,
 )
-from palpate.simtrial import TrialOutcome
+from palpate.simulation.trial import TrialOutcome
 
 SCENE_PATH = resolve("scenes/faults.yaml")
 SCENE = load(SceneConfig, SCENE_PATH)

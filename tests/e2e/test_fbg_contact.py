@@ -14,7 +14,7 @@ import math
 
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
-from palpate.simtrial import TrialSpec, run_sim_trial
+from palpate.simulation.trial import TrialSpec, run_sim_trial
 from robot.rig import RigSettings
 from robot.trial.setup import sensor_section
 

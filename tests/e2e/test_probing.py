@@ -12,7 +12,7 @@ import pytest
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import ServoBusConfig
-from palpate.simtrial import TrialSpec, run_sim_trial
+from palpate.simulation.trial import TrialSpec, run_sim_trial
 from robot.trial.log import read_log
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock

@@ -15,7 +15,7 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import ServoBusConfig
 from estimation.section import euler_load
-from palpate.simtrial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 from robot.trial.setup import sensor_section
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock

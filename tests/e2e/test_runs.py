@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
+from palpate.campaigns.runs import locked, run_dirs
 from palpate.cli import main
-from palpate.runs import locked, run_dirs
 
 BENCH = ["sim", "--campaign", "bench", "--workers", "1", "--no-plots", "--json"]
 

@@ -11,8 +11,8 @@ import pytest
 from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.cli import main
-from palpate.replaylog import replay
-from palpate.simtrial import TrialSpec, run_sim_trial
+from palpate.reports.replay import replay
+from palpate.simulation.trial import TrialSpec, run_sim_trial
 from robot.trial.log import read_log
 
 STACK = load_stack()

@@ -33,7 +33,7 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.targets import load_targets
 from palpate.cli import main
-from palpate.simbench import SimulatedBench
+from palpate.simulation.twin import SimulatedBench
 from wire.dynamixel import TICKS_PER_REV
 
 needs_tmux = pytest.mark.skipif(

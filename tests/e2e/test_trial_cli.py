@@ -21,12 +21,12 @@ import serial
 from config import load, resolve
 from config.bench import LoadedBench, load_bench
 from config.scene import SceneConfig
-from palpate.benchtrial import SKIPPED, BenchOutcome, plan_bench_trials
 from palpate.cli import main
 from palpate.commands.trial import run_session
-from palpate.hardware import HardwareError, explain, open_hardware
-from palpate.replaylog import replay
-from palpate.simbench import SimulatedBench, stations_for, surface_at
+from palpate.lab.hardware import HardwareError, explain, open_hardware
+from palpate.lab.trial import SKIPPED, BenchOutcome, plan_bench_trials
+from palpate.reports.replay import replay
+from palpate.simulation.twin import SimulatedBench, stations_for, surface_at
 from robot.motors import ServoTransportError
 from robot.trial.log import read_log
 from sim.clock import VirtualClock

@@ -9,7 +9,7 @@ import pytest
 
 from config.sample import SampleConfig
 from config.schema import StackConfig
-from palpate.placement import place_sample
+from palpate.simulation.placement import place_sample
 from robot import kinematics
 
 STACK = StackConfig()

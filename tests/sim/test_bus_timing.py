@@ -13,7 +13,7 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import ServoBusConfig
 from palpate.benchmarks.busrate import measured_rate, model_rate
-from palpate.simtrial import TrialSpec, bus_timing, run_sim_trial
+from palpate.simulation.trial import TrialSpec, bus_timing, run_sim_trial
 from robot.dynamixel.driver import DynamixelBus
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus

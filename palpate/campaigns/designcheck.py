@@ -21,9 +21,9 @@ from config.sample import SampleConfig
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from estimation.design import DesignEvaluation
-from palpate.campaign import median_abs_relative_error, run_campaign
-from palpate.executors import open_executor
-from palpate.simtrial import TrialOutcome, TrialSpec
+from palpate.campaigns.campaign import median_abs_relative_error, run_campaign
+from palpate.campaigns.executors import open_executor
+from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}
 

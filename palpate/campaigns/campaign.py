@@ -19,8 +19,8 @@ from config.schema import StackConfig
 from estimation.elastica import fast
 from estimation.stiffness import SampleSummary, summarize
 from palpate.calibration import calibrated, is_reference
-from palpate.executors import SerialExecutor, process_pool
-from palpate.simtrial import Transport, TrialOutcome, TrialSpec, run_sim_trial
+from palpate.campaigns.executors import SerialExecutor, process_pool
+from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
 
 def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> list[TrialSpec]:
@@ -118,8 +118,8 @@ def run_campaign(
     """Run trials (in parallel with ``workers`` > 1 or a given executor); results keep the order
     of ``specs`` and do not depend on the executor (every trial is seeded by its spec).
 
-    ``executor``: any ``concurrent.futures.Executor`` (``palpate.executors.open_executor`` builds
-    process, thread, serial and Dask ones); ``progress`` is called as trials finish."""
+    ``executor``: any ``concurrent.futures.Executor`` (``palpate.campaigns.executors.open_executor``
+    builds process, thread, serial and Dask ones); ``progress`` is called as trials finish."""
     run = CampaignRun(specs, scene, stack, transport, log_dir, series_for)
     return run_campaigns([run], workers=workers, executor=executor, progress=progress)[0].outcomes
 

@@ -4,7 +4,7 @@
 campaign wants it and finds how the robot reaches it (inverse kinematics on the robot, a fixed
 stage on the bench); :func:`trial_world` builds the ``sim.world`` of the trial: the tissue
 (:func:`tissue_model`), the sensor's pose from the joints, and the joints themselves, read off
-the emulated servos' encoders (:class:`ServoJoints`). ``palpate.simtrial`` wires it to the
+the emulated servos' encoders (:class:`ServoJoints`). ``palpate.simulation.trial`` wires it to the
 emulators and the control stack.
 """
 
@@ -20,7 +20,7 @@ import numpy as np
 from config.sample import SampleConfig
 from config.scene import FidelityConfig, SceneConfig
 from config.schema import StackConfig, TubeConfig
-from palpate.placement import place_sample
+from palpate.simulation.placement import place_sample
 from robot import kinematics
 from robot.drive import TRANSLATION, RollerGearDrive
 from robot.dynamixel.units import rad_from_ticks
@@ -90,7 +90,7 @@ def _robot_geometry(
 ) -> TrialGeometry:
     """Plan the trial where the campaign aims it (the IK on the surface the plan believes in:
     facing the tube at the target), and place the sample there as the scene says
-    (:func:`palpate.placement.place_sample`: tilted, moved, curved)."""
+    (:func:`palpate.simulation.placement.place_sample`: tilted, moved, curved)."""
     tube = stack.tube(spec.tube)
     nominal = kinematics.forward(tube, spec.roll, tube.flush_translation + spec.exposed_length)
     r_tip = stack.sensor.tip_radius

@@ -1,7 +1,7 @@
 """A simulated bench to drive through the hardware path: both emulators and a world with tissue.
 
 ``palpate teleop`` runs on it when no port is given, and the tests of ``palpate trial`` and
-``palpate teleop`` point the hardware code (:mod:`palpate.hardware`) at it. The servo emulator
+``palpate teleop`` point the hardware code (:mod:`palpate.lab.hardware`) at it. The servo emulator
 and the board emulator sit on pseudo-terminals (``wire=True``: the hardware path byte for byte)
 or on in-process transports; time is a :class:`sim.clock.VirtualClock` (tests) or wall time
 (interactive). The board's samples come from a :class:`sim.world.World`: the sensor placed by
@@ -33,7 +33,7 @@ from config.sample import SampleConfig
 from config.scene import SceneConfig
 from config.schema import MM, StackConfig, TubeConfig
 from config.targets import load_targets
-from palpate.simworld import tissue_model
+from palpate.simulation.world import tissue_model
 from robot import kinematics
 from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
 from robot.dynamixel.units import rad_from_ticks
@@ -113,7 +113,7 @@ def _scene_sample(scene: SceneConfig, label: str, rigid: bool) -> SampleConfig:
 class SimulatedBench:
     """Emulated servos and board over a world; a context manager (``start`` / ``close``).
 
-    ``servo_port`` and ``board_port`` are what :func:`palpate.hardware.open_hardware` takes:
+    ``servo_port`` and ``board_port`` are what :func:`palpate.lab.hardware.open_hardware` takes:
     pty paths with ``wire=True``, in-process transports otherwise.
     """
 

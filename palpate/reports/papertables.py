@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from estimation.stiffness import summarize
-from palpate.simtrial import TrialOutcome
+from palpate.simulation.trial import TrialOutcome
 
 
 @dataclass(frozen=True)

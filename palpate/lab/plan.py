@@ -1,6 +1,6 @@
 """Scripted trials on the bench, planned: the bench file's trial list and the stored targets as
 :class:`BenchTrial` s (pose and :class:`robot.indentation.TrialPlan`), checked against the
-drive's limits before anything moves (:func:`plan_bench_trials`). ``palpate.benchtrial`` runs
+drive's limits before anything moves (:func:`plan_bench_trials`). ``palpate.lab.trial`` runs
 them.
 
 A stored pose is the stand-off pose: the trial rolls there with the sensor back, advances to it,

@@ -10,8 +10,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from palpate.campaign import SampleRow
-from palpate.simtrial import TrialOutcome
+from palpate.campaigns.campaign import SampleRow
+from palpate.simulation.trial import TrialOutcome
 
 
 def estimates_vs_truth(

@@ -1,6 +1,6 @@
 """One simulated trial, wired exactly like the bench: emulators in, control stack on top.
 
-The world (``sim.world``, built by :mod:`palpate.simworld`) feeds the servo emulator and the
+The world (``sim.world``, built by :mod:`palpate.simulation.world`) feeds the servo emulator and the
 board emulator on one virtual clock; the control stack drives the servos through dynamixel-sdk
 and reads FBG frames through the frame reader, and the trial core (:mod:`robot.trial`, the same
 as on the bench) plans, runs, estimates and records the trial. ``transport="wire"`` puts both
@@ -21,8 +21,8 @@ from typing import Any, Literal, Protocol
 
 from config.scene import FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
-from palpate.simresult import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
-from palpate.simworld import (
+from palpate.simulation.result import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
+from palpate.simulation.world import (
     ServoJoints,
     TrialGeometry,
     TrialSpec,

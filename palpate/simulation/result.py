@@ -19,7 +19,7 @@ from estimation.jointfit import JointFit
 from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
 from estimation.verdict import Verdict
-from palpate.simworld import TrialGeometry, TrialSpec, trial_sample
+from palpate.simulation.world import TrialGeometry, TrialSpec, trial_sample
 from robot.indentation import TrialMarks
 from robot.probe_result import ProbeResult
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial

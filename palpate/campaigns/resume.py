@@ -21,8 +21,8 @@ from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
 from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
-from palpate.runs import set_aside
-from palpate.simtrial import TrialOutcome, TrialSpec, trial_geometry
+from palpate.campaigns.runs import set_aside
+from palpate.simulation.trial import TrialOutcome, TrialSpec, trial_geometry
 from robot.indentation import TrialMarks
 from robot.probe_result import ProbeResult, Touch
 from robot.trial.estimate import exposed_length_at

@@ -12,7 +12,7 @@
 Local pool workers die with the process that started them (:func:`process_pool`): a campaign
 killed with SIGKILL leaves no worker behind waiting forever on its pipe.
 
-No scheduling of our own: every backend is an Executor, ``palpate.campaign.run_campaign``
+No scheduling of our own: every backend is an Executor, ``palpate.campaigns.campaign.run_campaign``
 submits one job per trial and each trial is seeded by its spec, so results do not depend on
 which executor ran them.
 """

@@ -26,7 +26,7 @@ from typing import Any
 
 from config.schema import StackConfig
 from estimation.section import Section
-from palpate.simtrial import TrialOutcome
+from palpate.simulation.trial import TrialOutcome
 from robot.trial.estimate import estimate_from_marks
 
 CONTACT_ERRORS_MM: tuple[float, ...] = (0.0, 0.1, -0.1, 0.3, -0.3)

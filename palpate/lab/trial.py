@@ -1,9 +1,9 @@
 """Scripted trials on the bench: stored poses -> trial plans -> the same trial loop as simulation.
 
-:func:`plan_bench_trials` (``palpate.benchplan``) turns the bench file's trial list and the
+:func:`plan_bench_trials` (``palpate.lab.plan``) turns the bench file's trial list and the
 stored targets into :class:`robot.indentation.TrialPlan` s, checked against the drive's limits
 before anything moves. :func:`run_bench_trials` runs them in order on opened interfaces
-(:mod:`palpate.hardware`) with :func:`robot.trial.run.run_trial` and the
+(:mod:`palpate.lab.hardware`) with :func:`robot.trial.run.run_trial` and the
 :class:`robot.rig.ServoFbgRig`, writes one crash-safe log per trial as it goes (readable by
 ``palpate replay``) and estimates the modulus with the same trial core (:mod:`robot.trial`) as
 ``palpate sim``: the joint fit with its verdict (the paper's estimate beside it), or on a rigid
@@ -27,9 +27,9 @@ from estimation.jointfit import JointFit
 from estimation.section import Section
 from estimation.stiffness import StiffnessEstimate
 from estimation.verdict import Verdict
-from palpate.benchplan import BenchTrial, plan_bench_trials
 from palpate.calibration import calibrate, rig_key, with_compliance
-from palpate.hardware import Hardware
+from palpate.lab.hardware import Hardware
+from palpate.lab.plan import BenchTrial, plan_bench_trials
 from robot.indentation import State
 from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial

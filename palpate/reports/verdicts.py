@@ -10,7 +10,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 from estimation.verdict import STATUSES
-from palpate.simtrial import TrialOutcome
+from palpate.simulation.trial import TrialOutcome
 
 
 @dataclass(frozen=True)

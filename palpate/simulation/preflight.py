@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from config.loader import ConfigError
 from config.scene import SceneConfig
 from config.schema import StackConfig
-from palpate.simworld import TrialSpec, trial_geometry
+from palpate.simulation.world import TrialSpec, trial_geometry
 
 
 def check_campaign(
