@@ -16,6 +16,7 @@ from typing import Any
 
 from config.schema import ServoBusConfig
 from robot.dynamixel.driver import DynamixelBus
+from robot.dynamixel.replies import GOAL_LEN, STATE_LEN
 from sim.clock import VirtualClock
 from sim.dynamixel import protocol
 from sim.dynamixel.bus import EmulatedBus
@@ -24,9 +25,6 @@ from sim.dynamixel.timing import RETURN_DELAY_UNIT_S, BusTiming
 from wire import dynamixel as tables
 
 CASES = ((1_000_000, 16.0), (1_000_000, 1.0), (57_600, 16.0), (57_600, 1.0))
-_STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
-_STATE_LEN = sum(tables.X_SERIES_CONTROL_TABLE["Present_Position"]) - _STATE_START
-_GOAL_LEN = tables.X_SERIES_CONTROL_TABLE["Goal_Position"][1]
 
 
 def measured_rate(timing: BusTiming, cycles: int = 100) -> float:
@@ -50,8 +48,8 @@ def model_rate(timing: BusTiming, servos: int = 3) -> float:
     """The same cycle from :meth:`BusTiming.read_modify_rate` (packet sizes of the driver's
     requests, the servos' default Return Delay Time)."""
     read = len(protocol.encode(protocol.BROADCAST_ID, protocol.INST_SYNC_READ, bytes(4 + servos)))
-    reply = len(protocol.encode_status(1, 0, bytes(_STATE_LEN)))
-    write_params = 4 + servos * (1 + _GOAL_LEN)
+    reply = len(protocol.encode_status(1, 0, bytes(STATE_LEN)))
+    write_params = 4 + servos * (1 + GOAL_LEN)
     write = len(
         protocol.encode(protocol.BROADCAST_ID, protocol.INST_SYNC_WRITE, bytes(write_params))
     )

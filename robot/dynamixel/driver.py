@@ -26,7 +26,6 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
-import struct
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,9 +37,18 @@ from config.schema import ServoBusConfig
 from robot.dynamixel import units
 from robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
 from robot.dynamixel.port import PortRecovery, TimedPortHandler
+from robot.dynamixel.replies import (
+    GOAL_ADDR,
+    GOAL_LEN,
+    STATE_LEN,
+    STATE_START,
+    decode_state,
+    goal_param,
+    hardware_fault,
+    status_fault,
+)
 from robot.motors import (
     MotorState,
-    ServoFaultError,
     ServoIdentityError,
     ServoTransportError,
 )
@@ -49,23 +57,6 @@ from wire import dynamixel as tables
 
 R = TypeVar("R")
 log = logging.getLogger(__name__)
-
-_STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
-_STATE_END = sum(tables.X_SERIES_CONTROL_TABLE["Present_Position"])
-_STATE_LEN = _STATE_END - _STATE_START
-_GOAL_ADDR, _GOAL_LEN = tables.X_SERIES_CONTROL_TABLE["Goal_Position"]
-
-
-def _state_format() -> struct.Struct:
-    """Moving (u8), Present_Velocity and Present_Position (s32) out of one sync-read reply."""
-    velocity = tables.X_SERIES_CONTROL_TABLE["Present_Velocity"][0] - _STATE_START
-    position = tables.X_SERIES_CONTROL_TABLE["Present_Position"][0] - _STATE_START
-    return struct.Struct(f"<B{velocity - 1}xi{position - velocity - 4}xi")
-
-
-_STATE = _state_format()  # one unpack per reply instead of slices and int.from_bytes
-# one servo's part of the goals' sync write: its ID, then its Goal_Position (signed)
-_GOAL_PARAM = struct.Struct("<B" + {1: "b", 2: "h", 4: "i"}[_GOAL_LEN])
 
 
 @dataclass(frozen=True)
@@ -265,7 +256,7 @@ class DynamixelBus:
         for m in self._motors.values():
             bits = self.read_hardware_error(m.name)
             if bits:
-                raise _hardware_fault(m.id, bits)
+                raise hardware_fault(m.id, bits)
 
     def reboot(self, name: str) -> None:
         """Reboot one servo: clears its hardware error, torque off, turn count lost."""
@@ -302,34 +293,18 @@ class DynamixelBus:
         out: dict[str, MotorState] = {}
         for servo_id, (data, error) in replies.items():
             self._raise_for_status(servo_id, error)
-            if len(data) != _STATE_LEN:
-                # the SDK hands over what the status packet had (with its CRC bytes if short)
-                raise ServoTransportError(
-                    f"servo {servo_id}: short reply ({len(data)} of {_STATE_LEN} bytes)"
-                )
-            moving, velocity, position = _STATE.unpack(bytes(data))
-            if abs(position) > tables.EXTENDED_POSITION_LIMIT:
-                # Beyond what extended position mode can reach or be commanded to: a corrupt
-                # reply that passed the CRC, never a goal to start the step clamp from.
-                raise ServoTransportError(
-                    f"servo {servo_id}: implausible present position {position} ticks"
-                )
-            out[self._by_id[servo_id].name] = MotorState(
-                position=units.rad_from_ticks(position),
-                velocity=units.rad_s_from_velocity_units(velocity),
-                moving=bool(moving),
-            )
+            out[self._by_id[servo_id].name] = decode_state(servo_id, data)
         return out
 
     def _sync_read_state(self) -> tuple[dict[int, tuple[list[int], int]], int, int]:
         """One attempt of :meth:`read_state`: the sync read and every servo's reply, by ID."""
         ids = self._ids
-        result = self._ph.syncReadTx(self._port, _STATE_START, _STATE_LEN, ids, len(ids), False)
+        result = self._ph.syncReadTx(self._port, STATE_START, STATE_LEN, ids, len(ids), False)
         replies: dict[int, tuple[list[int], int]] = {}
         if result != sdk.COMM_SUCCESS:
             return replies, result, 0
         for servo_id in ids:
-            data, result, error = self._ph.readRx(self._port, servo_id, _STATE_LEN)
+            data, result, error = self._ph.readRx(self._port, servo_id, STATE_LEN)
             if result != sdk.COMM_SUCCESS:
                 return replies, result, 0
             replies[servo_id] = (data, error)
@@ -348,10 +323,10 @@ class DynamixelBus:
             step = max(-self.max_goal_step, min(self.max_goal_step, goal - last))
             ticks = units.ticks_from_rad(last + step)
             sent[name] = units.rad_from_ticks(ticks)
-            param += _GOAL_PARAM.pack(m.id, ticks)  # ticks_from_rad keeps it in range
+            param += goal_param(m.id, ticks)  # ticks_from_rad keeps it in range
 
         def call() -> tuple[None, int, int]:
-            result = self._ph.syncWriteTxOnly(self._port, _GOAL_ADDR, _GOAL_LEN, param, len(param))
+            result = self._ph.syncWriteTxOnly(self._port, GOAL_ADDR, GOAL_LEN, param, len(param))
             return None, result, 0
 
         self._transact("sync write of goals", call, servo_id=None)
@@ -399,27 +374,7 @@ class DynamixelBus:
     def _raise_for_status(self, servo_id: int, error: int) -> None:
         if not error:
             return
-        number = error & 0x7F
         if error & tables.ALERT_BIT:
             bits = self.read_hardware_error(self._by_id[servo_id].name)
-            raise _hardware_fault(servo_id, bits, number)
-        raise ServoFaultError(
-            servo_id,
-            ", ".join(tables.decode_status_error(error)),
-            error_number=number,
-        )
-
-
-def _hardware_fault(servo_id: int, bits: int, number: int = 0) -> ServoFaultError:
-    names = tables.decode_hardware_error(bits)
-    status = tables.STATUS_ERRORS.get(number)
-    message = "hardware error: " + (", ".join(names) or "none reported")
-    if status:
-        message += f" (and {status})"
-    return ServoFaultError(
-        servo_id,
-        message,
-        error_number=number,
-        hardware_error=bits,
-        hardware_error_names=names,
-    )
+            raise hardware_fault(servo_id, bits, error & 0x7F)
+        raise status_fault(servo_id, error)

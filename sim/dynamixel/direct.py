@@ -28,7 +28,8 @@ from collections.abc import Sequence
 import dynamixel_sdk as sdk
 
 from sim.dynamixel import protocol
-from sim.dynamixel.bus import EmulatedBus, Reply
+from sim.dynamixel.bus import EmulatedBus
+from sim.dynamixel.instructions import Reply
 
 _SDK = sdk.PacketHandler(2.0)  # only for getTxRxResult / getRxPacketError: the same messages
 
