@@ -1,0 +1,60 @@
+"""Are two runs' results the same? Compares two ``palpate ... --json`` outputs field by field,
+leaving out what depends on the clock or on where the run wrote (wall and CPU times, speed-ups,
+run folders and log paths). Prints each difference and exits 1 when there is one.
+
+    python3 bench/same_results.py BEFORE.json AFTER.json
+
+Used to show that a restructure moved code only: run the seeded campaign on both commits (e.g.
+``palpate sim --campaign paper --no-plots --json`` and ``palpate sim --faults --no-plots
+--json``), then compare.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+CLOCK_OR_PLACE = frozenset(
+    {"wall_s", "speedup", "fit_ms_per_trial", "log", "log_dir", "run_dir", "cpu_s", "elapsed_s"}
+)
+
+
+def differences(a: Any, b: Any, path: str = "") -> list[str]:
+    """Every place where ``a`` and ``b`` differ, outside the clock's and the folders' fields."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out: list[str] = []
+        for key in sorted(set(a) | set(b)):
+            if key in CLOCK_OR_PLACE:
+                continue
+            if key not in a or key not in b:
+                out.append(f"{path}/{key}: only in {'after' if key in b else 'before'}")
+            else:
+                out += differences(a[key], b[key], f"{path}/{key}")
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: {len(a)} items before, {len(b)} after"]
+        return [
+            d
+            for i, (x, y) in enumerate(zip(a, b, strict=True))
+            for d in differences(x, y, f"{path}[{i}]")
+        ]
+    return [] if a == b else [f"{path}: {a!r} before, {b!r} after"]
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    before, after = (json.loads(Path(p).read_text(encoding="utf-8")) for p in argv)
+    found = differences(before, after)
+    for line in found:
+        print(line)
+    print(f"{len(found)} differences" if found else "identical (clock and folder fields left out)")
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
