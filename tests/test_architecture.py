@@ -181,13 +181,13 @@ def test_the_check_sees_every_kind_of_import(tmp_path: Path) -> None:
     assert find_cycle({"a": {"b"}, "b": set()}) is None
 
 
-MAX_MODULE_LINES = 450
-MAX_FUNCTION_LINES = 80
+MAX_MODULE_LINES = 400
+MAX_FUNCTION_LINES = 60
 
 
 def oversized(root: Path = ROOT) -> list[str]:
-    """Modules over MAX_MODULE_LINES lines and functions over MAX_FUNCTION_LINES (issue 14: every
-    module fits on a few screens, every function on one)."""
+    """Modules over MAX_MODULE_LINES lines and functions over MAX_FUNCTION_LINES (issues 14 and
+    24: every module fits on a few screens, every function on one)."""
     found = []
     for package in sorted(PACKAGES):
         for path in sorted((root / package).rglob("*.py")):
@@ -212,3 +212,73 @@ def test_the_size_check_sees_a_long_function(tmp_path: Path) -> None:
     (tmp_path / "wire").mkdir()
     (tmp_path / "wire" / "big.py").write_text(f"def big() -> None:\n{body}\n", encoding="utf-8")
     assert [f.split(" ")[1] for f in oversized(tmp_path)] == ["big:"]
+
+
+# The rooms of the application (issue 24), from the bottom up: each may import the rooms named
+# (and itself, and every layer below ``palpate``). ``palpate`` alone is its top-level modules:
+# the CLI's command table and the helpers every room uses (argtypes, progress, calibration).
+_BELOW_REPORTS = frozenset({"palpate", "palpate.simulation", "palpate.campaigns"})
+PALPATE_ROOMS: dict[str, frozenset[str]] = {
+    "palpate": frozenset(),
+    "palpate.simulation": frozenset({"palpate"}),
+    "palpate.lab": frozenset({"palpate"}),
+    "palpate.campaigns": frozenset({"palpate", "palpate.simulation"}),
+    "palpate.reports": _BELOW_REPORTS,
+    "palpate.faults": _BELOW_REPORTS | {"palpate.reports"},
+    "palpate.benchmarks": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
+    "palpate.commands": _BELOW_REPORTS
+    | {"palpate.reports", "palpate.faults", "palpate.benchmarks", "palpate.lab"},
+}
+MAX_PALPATE_TOP_MODULES = 6  # besides __init__, __main__ and cli
+
+
+def palpate_room(module: str) -> str:
+    """The room of a module of ``palpate``: its first sub-package, or ``palpate`` at the top."""
+    parts = module.split(".")
+    room = ".".join(parts[:2])
+    return room if room in PALPATE_ROOMS else "palpate"
+
+
+def palpate_room_breaks(root: Path = ROOT) -> list[str]:
+    """Imports from one room of ``palpate`` into a room it may not use ("file:line module")."""
+    bad = []
+    for path in sorted((root / "palpate").rglob("*.py")):
+        source = palpate_room(module_name(path, root))
+        for line, name in imported_modules(path, root):
+            if name.partition(".")[0] != "palpate" or name == "palpate":
+                continue
+            target = palpate_room(name)
+            if target != source and target not in PALPATE_ROOMS[source]:
+                bad.append(f"{path.relative_to(root)}:{line} {name} ({source} -> {target})")
+    return bad
+
+
+def test_every_module_of_palpate_lives_in_a_known_room() -> None:
+    rooms = {f"palpate.{init.parent.name}" for init in (ROOT / "palpate").glob("*/__init__.py")}
+    assert rooms <= set(PALPATE_ROOMS), "a new sub-package of palpate needs its PALPATE_ROOMS entry"
+    top = sorted(
+        p.stem
+        for p in (ROOT / "palpate").glob("*.py")
+        if p.stem not in {"__init__", "__main__", "cli"}
+    )
+    assert len(top) <= MAX_PALPATE_TOP_MODULES, f"palpate/ top level: {top}"
+
+
+def test_the_rooms_of_palpate_import_only_the_rooms_below() -> None:
+    assert palpate_room_breaks() == []
+
+
+def test_the_room_check_sees_an_arrow_running_back_up(tmp_path: Path) -> None:
+    (tmp_path / "palpate" / "simulation").mkdir(parents=True)
+    (tmp_path / "palpate" / "__init__.py").write_text("", encoding="utf-8")
+    (tmp_path / "palpate" / "simulation" / "__init__.py").write_text("", encoding="utf-8")
+    (tmp_path / "palpate" / "simulation" / "world.py").write_text(
+        "def f():\n    from palpate.reports.plots import draw\n", encoding="utf-8"
+    )
+    (tmp_path / "palpate" / "argtypes.py").write_text(
+        "from palpate.simulation import world\n", encoding="utf-8"
+    )
+    assert [b.rpartition(" (")[2] for b in palpate_room_breaks(tmp_path)] == [
+        "palpate -> palpate.simulation)",
+        "palpate.simulation -> palpate.reports)",
+    ]

@@ -74,7 +74,21 @@ def _world(problem: LayerProblem, x: FloatArray, *, layer: bool = True) -> Float
 
 
 def validation() -> list[str]:
-    out = ["### Validation", ""]
+    out = ["### Validation", "", *_thick_layer_lines()]
+    out += [
+        "",
+        "Thin layer h = R/2, L = 20 h, chi = sqrt(R delta)/h <= 0.5: k1 FE fitted to"
+        " F/F_Hertz - 1 = k1 chi + k2 chi^2 + k3 chi^3; series = Dimitriadis' quartic:",
+        "",
+    ]
+    header = ["base", "nu", "k1 FE", "k1 Dimitriadis"]
+    header += ["FE/series chi=0.2", "FE/series chi=0.5", "FE/(1+k1 chi) chi=0.5"]
+    return out + _table(header, _thin_layer_rows())
+
+
+def _thick_layer_lines() -> list[str]:
+    """A thick layer against Hertz at small depth and Sneddon's exact sphere deep."""
+    out = []
     p = dataclasses.replace(THICK, depth_max=0.01, n_depths=4)
     x, f, a = _solve(p)
     out += ["Thick layer (h = L = 200 R), nu = 0.45, small depth:", ""]
@@ -96,12 +110,11 @@ def validation() -> list[str]:
             for d, r, h in zip(x, f / sneddon, f / _hertz(p, x), strict=True)
         ],
     )
-    out += [
-        "",
-        "Thin layer h = R/2, L = 20 h, chi = sqrt(R delta)/h <= 0.5: k1 FE fitted to"
-        " F/F_Hertz - 1 = k1 chi + k2 chi^2 + k3 chi^3; series = Dimitriadis' quartic:",
-        "",
-    ]
+    return out
+
+
+def _thin_layer_rows() -> list[tuple[object, ...]]:
+    """Per base and nu: the FE's first-order coefficient and its ratio to Dimitriadis' series."""
     rows: list[tuple[object, ...]] = []
     for base in ("bonded", "sliding"):
         for nu in (0.0, 0.3, 0.45, 0.5):
@@ -133,19 +146,7 @@ def validation() -> list[str]:
                     float(ratio[-1] / (1 + k[0] * chi[-1])),
                 )
             )
-    out += _table(
-        [
-            "base",
-            "nu",
-            "k1 FE",
-            "k1 Dimitriadis",
-            "FE/series chi=0.2",
-            "FE/series chi=0.5",
-            "FE/(1+k1 chi) chi=0.5",
-        ],
-        rows,
-    )
-    return out
+    return rows
 
 
 def convergence(resolutions: Sequence[int]) -> list[str]:

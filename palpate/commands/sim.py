@@ -17,6 +17,7 @@ from palpate.argtypes import non_negative_int, positive_int
 from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.campaigns.campaign import (
     CampaignRun,
+    SampleRow,
     campaign_trials,
     default_workers,
     median_abs_relative_error,
@@ -274,18 +275,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     sim_time = sum(o.sim_time for o in outcomes)
     mare = median_abs_relative_error(outcomes)
     paper = median_abs_relative_error(outcomes, "paper")
-    failed = [o for o in outcomes if o.state != "done"]
-    figures: list[str] = []
-    out_dir = c.run_dir
-    if not args.no_plots:
-        from palpate.reports import plots
-
-        title = f"{scene.name} campaign: estimated vs actual modulus"
-        figures.append(
-            str(plots.estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))
-        )
-        if outcomes[0].series.get("advance"):  # not when the first trial was resumed
-            figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
+    figures = [] if args.no_plots else _figures(c, rows)
     payload: dict[str, object] = {
         "scene": scene.name,
         "log_dir": str(c.log_dir),
@@ -315,8 +305,36 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         payload["calibration"] = {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()}
     if args.json:
         return payload
-    _print_table(scene.name, rows, by_sample(outcomes))
-    samples = scene.campaign_samples()
+    _print_report(c, args, rows, found, figures)
+    return payload
+
+
+def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
+    """The campaign's PNG figures in its run folder."""
+    from palpate.reports import plots
+
+    outcomes, out_dir = c.outcomes, c.run_dir
+    title = f"{c.scene.name} campaign: estimated vs actual modulus"
+    figures = [str(plots.estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))]
+    if outcomes[0].series.get("advance"):  # not when the first trial was resumed
+        figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
+    return figures
+
+
+def _print_report(
+    c: _Campaign,
+    args: argparse.Namespace,
+    rows: list[SampleRow],
+    found: dict[str, tuple[float, float]],
+    figures: list[str],
+) -> None:
+    """One campaign's table and summary lines, as a person reads them."""
+    scene, outcomes, wall = c.scene, c.outcomes, c.wall
+    sim_time = sum(o.sim_time for o in outcomes)
+    paper = median_abs_relative_error(outcomes, "paper")
+    failed = [o for o in outcomes if o.state != "done"]
+    _print_table(c.scene.name, rows, by_sample(outcomes))
+    samples = c.scene.campaign_samples()
     levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
     print(f"world tissue: {', '.join(levels)}{note}")
@@ -339,7 +357,6 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     for f in figures:
         print(f"plot: {f}")
     print()
-    return payload
 
 
 def _kpa(d: dict[str, object]) -> dict[str, object]:

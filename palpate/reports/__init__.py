@@ -5,6 +5,7 @@
 - :mod:`.papertables`: ``palpate sim --compare-paper``, Tables I and II beside the simulated ones.
 - :mod:`.plots`: PNG figures of a campaign.
 - :mod:`.replay`: a trial log's estimates re-run and compared with the recorded ones.
+- :mod:`.design`: what ``palpate design`` reports (the sensor, its checks, the simulated check).
 
 May import ``palpate.campaigns``, ``palpate.simulation`` and the top-level helpers; imported by
 the benchmarks, the fault campaign and the commands.
