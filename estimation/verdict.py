@@ -32,6 +32,7 @@ import numpy as np
 from estimation.corrections import ContactLaw
 from estimation.jointfit import JointFit
 from estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
+from estimation.misalignment import Lean
 
 Status = Literal["ok", "suspect", "none"]
 STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")
@@ -80,6 +81,9 @@ class TrialFacts:
         misalignment: angle between the sensor axis and the surface normal (rad), if known.
         misalignment_tolerance: the campaign's tolerance on it (rad), None: not checked.
         compliance_calibrated: the rig's compliance was calibrated (else profiled over a range).
+        orientation_verified: the misalignment was measured (probing's fitted normal) or set
+            by the operator (no probing); False when probing could not measure a normal.
+        lean: the load's lean measured from the strains (``estimation.misalignment``).
     """
 
     state: str = "done"
@@ -89,6 +93,8 @@ class TrialFacts:
     misalignment: float | None = None
     misalignment_tolerance: float | None = None
     compliance_calibrated: bool = True
+    orientation_verified: bool = True
+    lean: Lean | None = None
 
 
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
@@ -114,9 +120,33 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
             f"misalignment {math.degrees(abs(mis)):.1f} deg beyond the campaign's tolerance "
             f"of {math.degrees(tol):g} deg"
         )
+    reasons.extend(_orientation(facts))
     if facts.state != "done":
         reasons.append(f"the trial ended in {facts.state}: {facts.reason}")
     return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+
+
+def _orientation(facts: TrialFacts) -> list[str]:
+    """Why the sensor's orientation to the surface is not known to be square (empty if it is)."""
+    lean = facts.lean
+    if lean is not None and lean.lateral:
+        return [
+            f"misaligned: the strains show a lateral load from the first touch (the tip slid on "
+            f"a surface oblique beyond its friction angle; the load's lean fitted "
+            f"{math.degrees(lean.lean):.1f} +- {math.degrees(lean.sigma):.1f} deg in the fiber's "
+            f"plane, a size three gratings do not pin down)"
+        ]
+    if facts.orientation_verified:
+        return []
+    seen = (
+        "no lean measured"
+        if lean is None or not lean.success
+        else (f"lean {math.degrees(lean.lean):.1f} +- {math.degrees(lean.sigma):.1f} deg")
+    )
+    return [
+        f"orientation unverified: no normal was measured and the strains show no lateral load "
+        f"({seen}), which a sticking contact gives at any tilt within its friction angle"
+    ]
 
 
 def _imprecise(fit: JointFit) -> str | None:

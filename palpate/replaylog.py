@@ -142,7 +142,7 @@ def _replay_joint(
     verdict = None
     if not inputs.rigid:
         state, reason = str(end.get("state")), str(end.get("reason"))
-        verdict = verdict_for(fitted.joint, inputs, state, reason, section)
+        verdict = verdict_for(fitted.joint, inputs, state, reason, section, fitted.lean)
     keys = estimator_keys(fitted.joint, verdict, fitted.southwell, fitted.calibration)
     replayed = json.loads(json.dumps(keys))
     report.update({f"replayed_{k}" if k != "joint" else k: v for k, v in replayed.items()})

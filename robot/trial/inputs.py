@@ -44,6 +44,8 @@ class EstimatorInputs:
         compliance_calibrated: False when ``compliance`` is the uncalibrated prior range.
         misalignment_tolerance: the campaign's tolerance (rad), None: not checked.
         travel_window: the travel past contact allowed (m), None: unknown.
+        orientation_verified: False when probing ran and could not measure a normal (a
+            straight tube): the misalignment told is then not known.
         rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
             (``estimation.compliance``) instead of estimating a modulus.
         version: the inputs' format (VERSION; 1 for logs that predate it).
@@ -66,6 +68,7 @@ class EstimatorInputs:
     misalignment_tolerance: float | None = None
     travel_window: float | None = None
     rigid: bool = False
+    orientation_verified: bool = True
     version: int = VERSION
 
     def as_dict(self) -> dict[str, Any]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from config.schema import SensorConfig
 from estimation.misalignment import Lean, measure_lean
@@ -18,7 +19,7 @@ from estimation.section import Section
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
 
 
-def grating_spans_from_tip(sensor: SensorConfig) -> np.ndarray:
+def grating_spans_from_tip(sensor: SensorConfig) -> NDArray[np.float64]:
     """(G, 2): each used grating's (d0, d1), metres from the sensor tip."""
     centres = np.asarray(sensor.grating_centres_from_tip(), dtype=np.float64)
     half = sensor.grating_length / 2
@@ -45,8 +46,11 @@ def lean_of_rows(
             eps.append(strains)
     if not adv:
         return Lean(False, "no rows before buckling")
-    advance = np.asarray(adv, dtype=np.float64)
-    lengths = advance - flush_translation if kind == "robot" else np.full(advance.size, exposed_length)
+    x = np.asarray(adv, dtype=np.float64)
+    lengths = np.asarray(
+        x - flush_translation if kind == "robot" else np.full(x.size, exposed_length),
+        dtype=np.float64,
+    )
     return measure_lean(
         np.asarray(eps, dtype=np.float64).reshape(-1, gratings),
         lengths,
