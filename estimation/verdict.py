@@ -132,9 +132,9 @@ def _orientation(facts: TrialFacts) -> list[str]:
     if lean is not None and lean.lateral:
         return [
             f"misaligned: the strains show a lateral load from the first touch (the tip slid on "
-            f"a surface oblique beyond its friction angle; the load's lean fitted "
-            f"{math.degrees(lean.lean):.1f} +- {math.degrees(lean.sigma):.1f} deg in the fiber's "
-            f"plane, a size three gratings do not pin down)"
+            f"a surface oblique beyond its friction angle; a pinned tip fits "
+            f"{lean.aligned_chi2:.0f} noise variances worse); the angle's size is not "
+            f"measurable from three gratings"
         ]
     if facts.orientation_verified:
         return []
