@@ -80,8 +80,8 @@ class Lean:
             tip's best fit: its size is not a measurement (module docstring).
         sigma: the profile's 1-sigma half-width (rad) plus ``MODEL_FLOOR`` in quadrature.
         rows: loaded rows the fit used.
-        load_share: the largest load fitted over the free tip's capacity (a pinned tip's
-            record goes past 1; a slipping tip's stays below).
+        load_share: the largest load of the better fit (free or pinned tip) over the free
+            tip's capacity (a pinned tip's record goes past 1; a slipping tip's stays below).
         aligned_chi2: how much worse no lean at all fits, in units of the noise variance.
     """
 
@@ -255,13 +255,13 @@ def _profile(model: _Model) -> Lean:
         lo, hi = (lo, b) if model.rss(a)[0] < model.rss(b)[0] else (a, hi)
     c = 0.5 * (lo + hi)
     rss_free, P = model.rss(c)
-    rss_pinned = model.rss(0.0, pinned=True)[0]
+    rss_pinned, P_pinned = model.rss(0.0, pinned=True)
     rows = model.y.shape[0]
     dof = max(rows * (model.y.shape[1] - 2) - 1, 1)  # each row: its load and its bow
     s2 = max(min(rss_free, rss_pinned) / dof, 1e-30)
     sigma_c = _half_width(grid, (rss - rss_free) / s2)
     sigma = math.hypot(sigma_c / (1.0 + c * c), MODEL_FLOOR)
-    share = float(np.max(P / model.cap))
+    share = float(np.max((P if rss_free < rss_pinned else P_pinned) / model.cap))
     chi2 = (rss_pinned - rss_free) / s2
     return Lean(True, "", math.atan(c), sigma, rows, share, chi2)
 
