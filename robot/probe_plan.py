@@ -69,6 +69,8 @@ class ProbeSettings:
         max_residual, max_miss: the tolerances of the orthogonal pose.
         standoff: where the trial's approach starts before the expected contact.
         replan: False measures and logs the misalignment but keeps the plan's pose.
+        budget: simulated or real seconds probing may take (:func:`probe_budget`, from the
+            drive's limits); past it the trial ends ``unreachable`` (inf: no budget).
     """
 
     offsets: tuple[float, ...]
@@ -83,6 +85,7 @@ class ProbeSettings:
     max_miss: float = 30e-3
     standoff: float = 1e-3
     replan: bool = True
+    budget: float = math.inf
 
 
 class ProbeGeometry:
