@@ -44,3 +44,32 @@ def test_a_slipping_straight_tube_is_named_misaligned_from_its_strains() -> None
     assert out.lean.lateral
     assert any(r.startswith("misaligned: the strains") for r in out.verdict.reasons)
     assert out.as_dict()["strain_lean"]["lateral"] is True
+
+
+OFFSET = load(SceneConfig, resolve("scenes/oblique/offset.yaml"))
+
+
+def test_a_sample_that_is_not_there_ends_unreachable_with_torque_on() -> None:
+    """The first touch finds nothing within the window: a geometric answer (unreachable, the
+    reason named), not a fault and not a state timeout; well within probing's budget."""
+    modulus = next(s.modulus for s in OFFSET.samples if s.name == "S8-absent")
+    spec = TrialSpec(
+        "absent", "robot", "S8-absent", modulus, 0.45, "bent30", "downward", 0.0, 42e-3, 2
+    )
+    out = run_sim_trial(spec, OFFSET, STACK)
+    assert out.state == "unreachable", out.reason
+    assert "no surface within" in out.reason
+    assert "timeout" not in out.reason
+    assert out.sim_time < 60.0
+    assert out.verdict is not None
+    assert out.verdict.status != "ok"
+
+
+def test_probings_budget_comes_from_the_drive_and_stays_below_the_state_timeout() -> None:
+    from robot.indentation import STATE_TIMEOUT
+    from robot.probing import probe_budget
+
+    offsets = (0.125, 0.5, -0.5)
+    slow = probe_budget(offsets, 3e-3, 2.5e-3, 5e-3, math.radians(90), 0.4)
+    fast = probe_budget(offsets, 3e-3, 5e-3, 10e-3, math.radians(180), 0.4)
+    assert 0 < fast < slow < STATE_TIMEOUT
