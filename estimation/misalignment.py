@@ -55,7 +55,7 @@ FloatArray = NDArray[np.float64]
 LOAD_SHARE = 0.95  # of the free tip's capacity (pi/2)^2 EI / L^2: rows above are left out
 MAX_BENDING = 600e-6  # strain: rows bent more are past the onset mode's small-amplitude shape
 MIN_ROWS = 10  # loaded rows the fit needs
-MAX_ROWS = 200  # rows beyond are thinned evenly (the fit's cost is linear in them)
+MAX_ROWS = 120  # rows beyond are thinned evenly (the fit's cost is linear in them)
 MODEL_FLOOR = math.radians(0.3)  # rad added in quadrature: the shapes' own error (see docs)
 DETECT_CHI2 = 100.0  # a lateral load when no lean fits worse by this (10 sigma): measured
 # 1-6.5 on sticking and aligned records, 2.6e4-4e4 on slipping ones (docs/orientation.md)
@@ -63,11 +63,11 @@ LENGTH_STEP = 1e-4  # m: rows are grouped by exposed length to this step for the
 _BELOW = 120  # candidate loads per row below LOAD_SHARE of the capacity
 _ABOVE = 120  # and above it, up to _ABOVE_MAX capacities (a pinned tip's loads, to 1.2 P_cr)
 _ABOVE_MAX = 10.0
-_GOLDEN_C = 24  # golden-section steps on c
-_GOLDEN = 18  # golden-section steps on each row's load
+_GOLDEN_C = 16  # golden-section steps on c
+_GOLDEN = 14  # golden-section steps on each row's load
 _PHI = (math.sqrt(5.0) - 1.0) / 2.0
 GRID_DEG = 40.0  # the lean searched over +-this
-GRID_POINTS = 41
+GRID_POINTS = 21
 
 
 @dataclass(frozen=True)
