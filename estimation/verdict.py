@@ -39,6 +39,7 @@ STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")
 CORRECTED = ("corrected with", "correction applied")
 NO_BUCKLING = "no buckling"  # the state machine's reason when the travel window ran out
 DESIGN_HINT = "see `palpate design`"
+NORMAL_SIGMAS = 2.0  # a measured misalignment is within the tolerance when this many sigmas are
 IMPRECISE = 0.10
 """Relative half-width of the 95 % interval beyond which a number is not ``ok``. Where the
 interval is what a belief leaves open (a thickness range, Poisson's ratio), the truth may lie
@@ -84,6 +85,7 @@ class TrialFacts:
         orientation_verified: the misalignment was measured (probing's fitted normal) or set
             by the operator (no probing); False when probing could not measure a normal.
         lean: the load's lean measured from the strains (``estimation.misalignment``).
+        misalignment_sigma: the measured normal's 1-sigma angle (rad), None if not measured.
     """
 
     state: str = "done"
@@ -95,6 +97,7 @@ class TrialFacts:
     compliance_calibrated: bool = True
     orientation_verified: bool = True
     lean: Lean | None = None
+    misalignment_sigma: float | None = None
 
 
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
@@ -137,15 +140,27 @@ def _orientation(facts: TrialFacts) -> list[str]:
             f"measurable from three gratings"
         ]
     if facts.orientation_verified:
-        return []
-    seen = (
-        "no lean measured"
-        if lean is None or not lean.success
-        else (f"lean {math.degrees(lean.lean):.1f} +- {math.degrees(lean.sigma):.1f} deg")
-    )
+        return _within_tolerance(facts)
+    seen = "not measured" if lean is None or not lean.success else "none"
     return [
-        f"orientation unverified: no normal was measured and the strains show no lateral load "
-        f"({seen}), which a sticking contact gives at any tilt within its friction angle"
+        f"orientation unverified: no normal was measured (a straight tube's touches all lie on "
+        f"one line) and the strains show no lateral load ({seen}), which a sticking contact "
+        f"gives at any tilt within its friction angle"
+    ]
+
+
+def _within_tolerance(facts: TrialFacts) -> list[str]:
+    """Why a measured misalignment within the tolerance is not known to be (empty if it is):
+    the measured normal's ``NORMAL_SIGMAS`` sigmas take it past the tolerance."""
+    tol, mis, sigma = facts.misalignment_tolerance, facts.misalignment, facts.misalignment_sigma
+    if tol is None or mis is None or sigma is None or not math.isfinite(sigma):
+        return []
+    if abs(mis) > tol or abs(mis) + NORMAL_SIGMAS * sigma <= tol:
+        return []
+    return [
+        f"misalignment {math.degrees(abs(mis)):.1f} +- {math.degrees(sigma):.1f} deg (the "
+        f"measured normal's 1-sigma): not verified within the campaign's tolerance of "
+        f"{math.degrees(tol):g} deg at {NORMAL_SIGMAS:g} sigmas"
     ]
 
 

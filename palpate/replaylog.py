@@ -28,7 +28,7 @@ from robot.trial.estimate import (
     fit_rows,
     verdict_for,
 )
-from robot.trial.inputs import VERSION
+from robot.trial.inputs import VERSION, probe_inputs
 from robot.trial.log import TrialLog, TrialLogError, read_log
 from robot.trial.record import estimator_keys
 
@@ -134,7 +134,7 @@ def _replay_joint(
         return True
     probe = next(log.of_kind("probe"), None)
     if probe is not None:  # the estimator was told the misalignment probing measured
-        raw = {**raw, "misalignment": probe["misalignment"]}
+        raw = {**raw, **probe_inputs(probe)}
     inputs = EstimatorInputs.from_dict(raw)
     rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
     fitted = fit_rows(rows, inputs, stack, section)

@@ -115,6 +115,13 @@ class TrialOutcome:
         }
 
 
+def _sigma(probe: ProbeResult | None) -> float | None:
+    """The measured normal's 1-sigma angle (rad), None when no normal was measured."""
+    if probe is None or not math.isfinite(probe.normal_sigma):
+        return None
+    return probe.normal_sigma
+
+
 def _deg(x: float | None) -> float | None:
     return None if x is None else math.degrees(x)
 
@@ -123,8 +130,7 @@ def estimate_sim_trial(
     result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
 ) -> TrialEstimate:
     flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
-    verified = result.probe is None or result.probe.normal is not None
-    inputs = estimator_inputs(spec, scene, stack, geo, misalignment_of(result, geo), verified)
+    inputs = estimator_inputs(spec, scene, stack, geo, misalignment_of(result, geo), result.probe)
     return estimate_trial(
         result,
         kind=spec.kind,
@@ -180,7 +186,7 @@ def estimator_inputs(
     stack: StackConfig,
     geo: TrialGeometry,
     misalignment: float | None = None,
-    orientation_verified: bool = True,
+    probe: ProbeResult | None = None,
 ) -> EstimatorInputs:
     """What the joint fit is told: the sample as the operator believes it (the scene's
     ``assumed:``, else the sample's own values), the rig's calibrated compliance, the
@@ -204,6 +210,7 @@ def estimator_inputs(
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
         travel_window=c.max_travel_past_contact_mm * 1e-3,
         rigid=sample.rigid,
-        orientation_verified=orientation_verified,
+        orientation_verified=probe is None or probe.normal is not None,
+        misalignment_sigma=_sigma(probe),
         **belief,
     )

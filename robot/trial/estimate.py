@@ -217,6 +217,7 @@ def verdict_for(
         compliance_calibrated=inputs.compliance_calibrated,
         orientation_verified=inputs.orientation_verified,
         lean=lean,
+        misalignment_sigma=inputs.misalignment_sigma,
     )
     return judge(joint, facts, inputs.tip_radius)
 

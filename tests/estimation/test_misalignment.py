@@ -105,3 +105,22 @@ def test_ok_requires_a_verified_orientation() -> None:
         v = judge(_ok_fit(), TrialFacts(orientation_verified=verified, lean=slid), 3.5e-3)
         assert v.status == "suspect"
         assert any(r.startswith("misaligned: the strains show a lateral load") for r in v.reasons)
+
+
+def test_a_measured_misalignment_is_verified_within_the_tolerance_at_two_sigmas() -> None:
+    tol = math.radians(2.0)
+
+    def facts(mis_deg: float, sigma_deg: float) -> TrialFacts:
+        return TrialFacts(
+            misalignment=math.radians(mis_deg),
+            misalignment_tolerance=tol,
+            misalignment_sigma=math.radians(sigma_deg),
+        )
+
+    assert judge(_ok_fit(), facts(0.4, 0.3), 3.5e-3).status == "ok"
+    loose = judge(_ok_fit(), facts(1.6, 0.3), 3.5e-3)
+    assert loose.status == "suspect"
+    assert any("not verified within" in r for r in loose.reasons)
+    beyond = judge(_ok_fit(), facts(2.5, 0.3), 3.5e-3)
+    assert any("beyond the campaign's tolerance" in r for r in beyond.reasons)
+    assert not any("not verified within" in r for r in beyond.reasons)  # said once
