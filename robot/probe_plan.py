@@ -69,6 +69,8 @@ class ProbeSettings:
         max_residual, max_miss: the tolerances of the orthogonal pose.
         standoff: where the trial's approach starts before the expected contact.
         replan: False measures and logs the misalignment but keeps the plan's pose.
+        search: how far past the approach window the first touch looks for a sample that is
+            not where the plan says (m).
         budget: simulated or real seconds probing may take (:func:`probe_budget`, from the
             drive's limits); past it the trial ends ``unreachable`` (inf: no budget).
     """
@@ -86,6 +88,7 @@ class ProbeSettings:
     standoff: float = 1e-3
     replan: bool = True
     budget: float = math.inf
+    search: float = 0.0
 
 
 class ProbeGeometry:

@@ -62,18 +62,21 @@ def probe_budget(
     fast_speed: float,
     roll_speed: float,
     settle: float,
+    search: float = 0.0,
 ) -> float:
     """Seconds a probing pattern needs at most on this drive, times ``BUDGET_MARGIN``: each
     touch a seek over the approach window, the clearance and ``BUDGET_SLACK`` at the probe
-    ``speed`` and the lift back at ``fast_speed``, the settle (s) for its strain zero; the
-    rolls of the pattern there and back at ``roll_speed`` (rad/s) and a whole turn for the way
-    out. A pattern that has not found the surface by then will not: the answer is geometric
-    (``unreachable``), before any state timeout."""
+    ``speed`` and the lift back at ``fast_speed``, the settle (s) for its strain zero; the first
+    touch's ``search`` (m) past its window; the rolls of the pattern there and back at
+    ``roll_speed`` (rad/s) and a whole turn for the way out. A pattern that has not found the
+    surface by then will not: the answer is geometric (``unreachable``), before any state
+    timeout."""
     seek = approach_window + ProbeSettings.clearance + BUDGET_SLACK
     touches = 1 + len(offsets)
     per_touch = seek / speed + seek / fast_speed + settle
+    first = search / speed  # the first touch's look past the window
     rolls = 2.0 * sum(abs(o) for o in offsets) + math.tau
-    return BUDGET_MARGIN * (touches * per_touch + rolls / roll_speed)
+    return BUDGET_MARGIN * (first + touches * per_touch + rolls / roll_speed)
 
 
 class _Phase(enum.Enum):
@@ -107,7 +110,8 @@ class ProbeRoutine:
         self.rolls = geometry.probe_rolls(plan.roll, settings.offsets)
         self.touches: list[Touch] = []
         self.phase = _Phase.SEEK
-        self.limit = plan.contact_advance + plan.approach_window
+        upper = geometry.translation_limits[1]  # the first touch also looks past the window
+        self.limit = min(plan.contact_advance + plan.approach_window + settings.search, upper)
         self.goal = math.nan
         self.result: ProbeResult | None = None
         self._sweep: tuple[list[float], list[float]] = ([], [])  # rolls, safe advance on each

@@ -35,6 +35,7 @@ def sensor_section(stack: StackConfig) -> Section:
     return section_of(stack.sensor)
 
 
+PROBE_SEARCH = 6e-3  # m the first touch looks past the approach window (samples 1-5 mm off)
 BUDGET_SHARE = 0.8  # probing's budget never exceeds this share of the state timeout
 SETTLE_ALLOWANCE = 0.4  # s per touch at rest for the strain zero (10 ticks at 25 Hz or more)
 
@@ -107,6 +108,7 @@ def prober_for(
             max_miss=campaign.miss_tolerance_mm * MM,
             standoff=plan.standoff,
             replan=probing is True,
+            search=PROBE_SEARCH,
         )
         budget = probe_budget(
             settings.offsets,
@@ -115,6 +117,7 @@ def prober_for(
             settings.fast_speed,
             stack.drive.max_roll_speed,
             SETTLE_ALLOWANCE,
+            settings.search,
         )
         settings = dataclasses.replace(settings, budget=min(budget, BUDGET_SHARE * STATE_TIMEOUT))
         return ProbeRoutine(geometry, settings, plan)
