@@ -286,11 +286,21 @@ class ProbeGeometry:
     def _unmeasured(
         self, touches: list[Touch], plan: TrialPlan, settings: ProbeSettings, why: str
     ) -> ProbeResult:
-        retract = min(touches[-1].advance, plan.contact_advance) - settings.standoff
+        contact = _found_contact(touches, plan)
+        retract = min(touches[-1].advance, contact) - settings.standoff
         return ProbeResult(
-            True, f"normal not measured: {why}", plan.roll, plan.contact_advance, 0.0,
+            True, f"normal not measured: {why}", plan.roll, contact, 0.0,
             math.nan, 0.0, None, "none", None, tuple(touches), retract - settings.clearance,
         )  # fmt: skip
+
+
+def _found_contact(touches: list[Touch], plan: TrialPlan) -> float:
+    """Where the plan's own ray met the surface: its first touch that held (where its load
+    began), else the plan's contact (a sample away from the plan is approached where it is)."""
+    for t in touches:
+        if not t.slipped and abs(t.roll - plan.roll) <= plan.roll_tolerance:
+            return t.advance - t.depth
+    return plan.contact_advance
 
 
 def nearest_turn(roll: float, near: float, limits: tuple[float, float]) -> float:

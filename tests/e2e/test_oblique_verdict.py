@@ -73,3 +73,17 @@ def test_probings_budget_comes_from_the_drive_and_stays_below_the_state_timeout(
     slow = probe_budget(offsets, 3e-3, 2.5e-3, 5e-3, math.radians(90), 0.4)
     fast = probe_budget(offsets, 3e-3, 5e-3, 10e-3, math.radians(180), 0.4)
     assert 0 < fast < slow < STATE_TIMEOUT
+
+
+def test_a_displaced_sample_is_found_and_indented_where_it_is() -> None:
+    """5 mm beyond the plan (past the approach window): the first touch looks past it, and the
+    straight tube approaches where its touch found the surface."""
+    modulus = next(s.modulus for s in OFFSET.samples if s.name == "S8-off5-t0")
+    spec = TrialSpec(
+        "off5", "robot", "S8-off5-t0", modulus, 0.45, "straight", "downward", 0.0, 42e-3, 2
+    )
+    out = run_sim_trial(spec, OFFSET, STACK)
+    assert out.state == "done", out.reason
+    assert out.joint is not None
+    assert out.joint.modulus is not None
+    assert abs(out.joint.modulus / out.spec.modulus - 1) < 0.05
