@@ -48,7 +48,7 @@ from estimation.stiffness import StiffnessEstimate, paper_estimate
 from estimation.strain_fit import fit_strains
 from estimation.verdict import TrialFacts, Verdict, judge
 from robot.trial.inputs import EstimatorInputs
-from robot.trial.lean import lean_of_rows
+from robot.trial.lean import lean_of_rows, rows_in
 from robot.trial.run import TrialResult
 from sensor.strain import grating_intervals
 
@@ -74,15 +74,7 @@ def loading_rows(
     rows: Iterable[tuple[str, float, Sequence[float]]], gratings: int
 ) -> tuple[FloatArray, FloatArray]:
     """(advance (N,), strains (N, G)) of the loading rows (state, advance, strains) in order."""
-    adv: list[float] = []
-    eps: list[Sequence[float]] = []
-    for state, advance, strains in rows:
-        if state in LOADING_STATES and len(strains) == gratings:
-            adv.append(advance)
-            eps.append(strains)
-    return np.asarray(adv, dtype=np.float64), np.asarray(eps, dtype=np.float64).reshape(
-        -1, gratings
-    )
+    return rows_in(rows, LOADING_STATES, gratings)
 
 
 def strain_sigma(residual: FloatArray, gratings: int) -> float:

@@ -15,15 +15,31 @@ from numpy.typing import NDArray
 from config.schema import SensorConfig
 from estimation.misalignment import Lean, measure_lean
 from estimation.section import Section
+from sensor.strain import grating_intervals
 
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
 
 
+def rows_in(
+    rows: Iterable[tuple[str, float, Sequence[float]]], states: frozenset[str], gratings: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(advance (N,), strains (N, G)) of the (state, advance, strains) rows in ``states`` with
+    all ``gratings``, in order."""
+    adv: list[float] = []
+    eps: list[Sequence[float]] = []
+    for state, advance, strains in rows:
+        if state in states and len(strains) == gratings:
+            adv.append(advance)
+            eps.append(strains)
+    x = np.asarray(adv, dtype=np.float64)
+    return x, np.asarray(eps, dtype=np.float64).reshape(-1, gratings)
+
+
 def grating_spans_from_tip(sensor: SensorConfig) -> NDArray[np.float64]:
-    """(G, 2): each used grating's (d0, d1), metres from the sensor tip."""
-    centres = np.asarray(sensor.grating_centres_from_tip(), dtype=np.float64)
-    half = sensor.grating_length / 2
-    return np.stack([centres - half, centres + half], axis=1)
+    """(G, 2): each used grating's (d0, d1), metres from the sensor tip (the arcs of
+    ``sensor.strain.grating_intervals`` at L = 0, s = -d, turned round)."""
+    arcs = grating_intervals(sensor, 0.0)
+    return np.stack([-arcs[:, 1], -arcs[:, 0]], axis=1)
 
 
 def lean_of_rows(
@@ -38,21 +54,15 @@ def lean_of_rows(
     """The lean from (state, advance, strains) rows: on the robot L = advance - flush
     translation, on the bench ``exposed_length``."""
     gratings = len(sensor.used_gratings)
-    adv: list[float] = []
-    eps: list[Sequence[float]] = []
-    for state, advance, strains in rows:
-        if state in PRE_BUCKLING and len(strains) == gratings:
-            adv.append(advance)
-            eps.append(strains)
-    if not adv:
+    x, strains = rows_in(rows, PRE_BUCKLING, gratings)
+    if not x.size:
         return Lean(False, "no rows before buckling")
-    x = np.asarray(adv, dtype=np.float64)
     lengths = np.asarray(
         x - flush_translation if kind == "robot" else np.full(x.size, exposed_length),
         dtype=np.float64,
     )
     return measure_lean(
-        np.asarray(eps, dtype=np.float64).reshape(-1, gratings),
+        strains,
         lengths,
         grating_spans_from_tip(sensor),
         section.EA,
