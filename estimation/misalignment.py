@@ -42,6 +42,7 @@ mode stops describing the pinned beam), thinned to ``MAX_ROWS``. Shapes: N rows,
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -98,6 +99,29 @@ class Lean:
         """The strains show a lateral load (the tip slid on an oblique surface): no lean at
         all fits worse by more than ``DETECT_CHI2`` noise variances."""
         return self.success and self.aligned_chi2 > DETECT_CHI2
+
+    def record(self) -> dict[str, object]:
+        """The fields as JSON values (a trial log's estimate record; inf sigma as null)."""
+        d: dict[str, object] = dataclasses.asdict(self)
+        d["sigma"] = self.sigma if math.isfinite(self.sigma) else None
+        return d
+
+    @classmethod
+    def from_record(cls, d: dict[str, object]) -> Lean:
+        """From :meth:`record`; ValueError for a record that is not one."""
+        try:
+            sigma = d["sigma"]
+            return cls(
+                bool(d["success"]),
+                str(d["message"]),
+                float(d["lean"]),  # type: ignore[arg-type]
+                math.inf if sigma is None else float(sigma),  # type: ignore[arg-type]
+                int(d["rows"]),  # type: ignore[call-overload]
+                float(d["load_share"]),  # type: ignore[arg-type]
+                float(d["aligned_chi2"]),  # type: ignore[arg-type]
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"a lean record needs the fields of Lean: {exc}") from exc
 
     def as_dict(self) -> dict[str, object]:
         return {

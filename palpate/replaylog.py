@@ -143,7 +143,8 @@ def _replay_joint(
     if not inputs.rigid:
         state, reason = str(end.get("state")), str(end.get("reason"))
         verdict = verdict_for(fitted.joint, inputs, state, reason, section, fitted.lean)
-    keys = estimator_keys(fitted.joint, verdict, fitted.southwell, fitted.calibration)
+    lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
+    keys = estimator_keys(fitted.joint, verdict, fitted.southwell, fitted.calibration, lean)
     replayed = json.loads(json.dumps(keys))
     report.update({f"replayed_{k}" if k != "joint" else k: v for k, v in replayed.items()})
     report["recorded_joint"] = recorded.get("joint")
