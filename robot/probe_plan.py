@@ -295,11 +295,16 @@ class ProbeGeometry:
 
 
 def _found_contact(touches: list[Touch], plan: TrialPlan) -> float:
-    """Where the plan's own ray met the surface: its first touch that held (where its load
-    began), else the plan's contact (a sample away from the plan is approached where it is)."""
+    """The contact to approach without a normal: the plan's, unless the plan's own ray touched
+    the surface (its first touch that held, where its load began) where the plan's approach
+    would not meet it (before its stand-off or past half its window): a sample away from the
+    plan is approached where it is, one where the plan says as planned."""
     for t in touches:
         if not t.slipped and abs(t.roll - plan.roll) <= plan.roll_tolerance:
-            return t.advance - t.depth
+            found = t.advance - t.depth
+            lo = plan.contact_advance - plan.standoff
+            hi = plan.contact_advance + 0.5 * plan.approach_window
+            return plan.contact_advance if lo < found < hi else found
     return plan.contact_advance
 
 
