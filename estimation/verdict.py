@@ -32,12 +32,14 @@ import numpy as np
 from estimation.corrections import ContactLaw
 from estimation.jointfit import JointFit
 from estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
+from estimation.misalignment import Lean
 
 Status = Literal["ok", "suspect", "none"]
 STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")
 CORRECTED = ("corrected with", "correction applied")
 NO_BUCKLING = "no buckling"  # the state machine's reason when the travel window ran out
 DESIGN_HINT = "see `palpate design`"
+NORMAL_SIGMAS = 2.0  # a measured misalignment is within the tolerance when this many sigmas are
 IMPRECISE = 0.10
 """Relative half-width of the 95 % interval beyond which a number is not ``ok``. Where the
 interval is what a belief leaves open (a thickness range, Poisson's ratio), the truth may lie
@@ -80,6 +82,10 @@ class TrialFacts:
         misalignment: angle between the sensor axis and the surface normal (rad), if known.
         misalignment_tolerance: the campaign's tolerance on it (rad), None: not checked.
         compliance_calibrated: the rig's compliance was calibrated (else profiled over a range).
+        orientation_verified: the misalignment was measured (probing's fitted normal) or set
+            by the operator (no probing); False when probing could not measure a normal.
+        lean: the load's lean measured from the strains (``estimation.misalignment``).
+        misalignment_sigma: the measured normal's 1-sigma angle (rad), None if not measured.
     """
 
     state: str = "done"
@@ -89,6 +95,9 @@ class TrialFacts:
     misalignment: float | None = None
     misalignment_tolerance: float | None = None
     compliance_calibrated: bool = True
+    orientation_verified: bool = True
+    lean: Lean | None = None
+    misalignment_sigma: float | None = None
 
 
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
@@ -114,9 +123,45 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
             f"misalignment {math.degrees(abs(mis)):.1f} deg beyond the campaign's tolerance "
             f"of {math.degrees(tol):g} deg"
         )
+    reasons.extend(_orientation(facts))
     if facts.state != "done":
         reasons.append(f"the trial ended in {facts.state}: {facts.reason}")
     return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+
+
+def _orientation(facts: TrialFacts) -> list[str]:
+    """Why the sensor's orientation to the surface is not known to be square (empty if it is)."""
+    lean = facts.lean
+    if lean is not None and lean.lateral:
+        return [
+            f"misaligned: the strains show a lateral load from the first touch (the tip slid on "
+            f"a surface oblique beyond its friction angle; a pinned tip fits "
+            f"{lean.aligned_chi2:.0f} noise variances worse); the angle's size is not "
+            f"measurable from three gratings"
+        ]
+    if facts.orientation_verified:
+        return _within_tolerance(facts)
+    seen = "not measured" if lean is None or not lean.success else "none"
+    return [
+        f"orientation unverified: no normal was measured (a straight tube's touches all lie on "
+        f"one line) and the strains show no lateral load ({seen}), which a sticking contact "
+        f"gives at any tilt within its friction angle"
+    ]
+
+
+def _within_tolerance(facts: TrialFacts) -> list[str]:
+    """Why a measured misalignment within the tolerance is not known to be (empty if it is):
+    the measured normal's ``NORMAL_SIGMAS`` sigmas take it past the tolerance."""
+    tol, mis, sigma = facts.misalignment_tolerance, facts.misalignment, facts.misalignment_sigma
+    if tol is None or mis is None or sigma is None or not math.isfinite(sigma):
+        return []
+    if abs(mis) > tol or abs(mis) + NORMAL_SIGMAS * sigma <= tol:
+        return []
+    return [
+        f"misalignment {math.degrees(abs(mis)):.1f} +- {math.degrees(sigma):.1f} deg (the "
+        f"measured normal's 1-sigma): not verified within the campaign's tolerance of "
+        f"{math.degrees(tol):g} deg at {NORMAL_SIGMAS:g} sigmas"
+    ]
 
 
 def _imprecise(fit: JointFit) -> str | None:

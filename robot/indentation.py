@@ -52,6 +52,7 @@ class State(enum.Enum):
 
 TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})
 PLANNED_ENDS = frozenset({State.DONE, State.UNREACHABLE})  # torque stays on: nothing went wrong
+STATE_TIMEOUT = 60.0  # s in any one state (a guard: a state that never ends is a fault)
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 
 
@@ -79,7 +80,7 @@ class Guards:
     max_travel_past_contact: float = 2.5e-3  # m; the beam or the tissue is at risk beyond
     strain_limit: float = 5e-3  # fiber strain (dimensionless); protects the fiber
     stream_timeout: float = 0.1  # s without a fresh FBG frame
-    state_timeout: float = 60.0  # s in any one state
+    state_timeout: float = STATE_TIMEOUT  # s in any one state
     early_contact_margin: float = 0.5e-3  # contact this much before the plan is "unexpected"
     bus_grace: float = 0.5  # s of lost servo replies tolerated while retracting (goals still go)
     max_twist: float | None = None  # rad, inner vs outer roller gear; None: not watched
@@ -329,9 +330,10 @@ class IndentationMachine:
         out = self._probing.step(obs)
         if isinstance(out, Command):
             return out
-        if isinstance(out, str):
-            self._fault(obs, out)
-            return self._hold(obs)
+        if isinstance(out, str):  # no surface where one must be: a geometric answer
+            self.marks.reason = f"unreachable: {out}"
+            self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
+            return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
         self.probe = out
         self.plan = dataclasses.replace(
             self.plan, roll=out.roll, contact_advance=out.contact_advance

@@ -69,6 +69,10 @@ class ProbeSettings:
         max_residual, max_miss: the tolerances of the orthogonal pose.
         standoff: where the trial's approach starts before the expected contact.
         replan: False measures and logs the misalignment but keeps the plan's pose.
+        search: how far past the approach window the first touch looks for a sample that is
+            not where the plan says (m).
+        budget: simulated or real seconds probing may take (:func:`probe_budget`, from the
+            drive's limits); past it the trial ends ``unreachable`` (inf: no budget).
     """
 
     offsets: tuple[float, ...]
@@ -83,6 +87,8 @@ class ProbeSettings:
     max_miss: float = 30e-3
     standoff: float = 1e-3
     replan: bool = True
+    budget: float = math.inf
+    search: float = 0.0
 
 
 class ProbeGeometry:
@@ -280,11 +286,26 @@ class ProbeGeometry:
     def _unmeasured(
         self, touches: list[Touch], plan: TrialPlan, settings: ProbeSettings, why: str
     ) -> ProbeResult:
-        retract = min(touches[-1].advance, plan.contact_advance) - settings.standoff
+        contact = _found_contact(touches, plan)
+        retract = min(touches[-1].advance, contact) - settings.standoff
         return ProbeResult(
-            True, f"normal not measured: {why}", plan.roll, plan.contact_advance, 0.0,
+            True, f"normal not measured: {why}", plan.roll, contact, 0.0,
             math.nan, 0.0, None, "none", None, tuple(touches), retract - settings.clearance,
         )  # fmt: skip
+
+
+def _found_contact(touches: list[Touch], plan: TrialPlan) -> float:
+    """The contact to approach without a normal: the plan's, unless the plan's own ray touched
+    the surface (its first touch that held, where its load began) where the plan's approach
+    would not meet it (before its stand-off or past half its window): a sample away from the
+    plan is approached where it is, one where the plan says as planned."""
+    for t in touches:
+        if not t.slipped and abs(t.roll - plan.roll) <= plan.roll_tolerance:
+            found = t.advance - t.depth
+            lo = plan.contact_advance - plan.standoff
+            hi = plan.contact_advance + 0.5 * plan.approach_window
+            return plan.contact_advance if lo < found < hi else found
+    return plan.contact_advance
 
 
 def nearest_turn(roll: float, near: float, limits: tuple[float, float]) -> float:

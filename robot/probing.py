@@ -13,7 +13,9 @@ between touches is the dangerous part (a roll sweeps the tip sideways, toward wh
 surface may be higher): the stage keeps behind where the surface can be on the rays the roll
 is about to sweep, and an FBG interlock holds the roll whenever the beam shows a load or a bow,
 whatever the surface model says. A touch that never comes within the window where the surface
-must be is a fault; a straight tube (one line at every roll) touches once and cannot tell the
+must be, or a pattern that outlasts its budget (``ProbeSettings.budget``, from the drive's
+limits), is a geometric answer: the trial ends ``unreachable`` with the reason (torque on), never
+on a state timeout; a straight tube (one line at every roll) touches once and cannot tell the
 normal. The result (:class:`ProbeResult`) carries the measured normal, its 1-sigma angle, the
 residual angle (the trial's misalignment) and the miss.
 """
@@ -40,7 +42,41 @@ FREE_TICKS = 3  # ticks running the FBG must show a free tip
 BASELINE_TICKS = 16  # free ticks at the start of a seek that give its axial strain's zero
 TOUCH_BOW = 10.0  # a bow this many thresholds deep ends a touch early (an imperfect beam)
 
-__all__ = ["ProbeGeometry", "ProbeResult", "ProbeRoutine", "ProbeSettings", "Touch"]
+__all__ = [
+    "ProbeGeometry",
+    "ProbeResult",
+    "ProbeRoutine",
+    "ProbeSettings",
+    "Touch",
+    "probe_budget",
+]
+
+BUDGET_SLACK = 2e-3  # m: a seek's allowance for where the surface can be, beyond its window
+BUDGET_MARGIN = 1.5  # the budget over the nominal pattern's time
+
+
+def probe_budget(
+    offsets: tuple[float, ...],
+    approach_window: float,
+    speed: float,
+    fast_speed: float,
+    roll_speed: float,
+    settle: float,
+    search: float = 0.0,
+) -> float:
+    """Seconds a probing pattern needs at most on this drive, times ``BUDGET_MARGIN``: each
+    touch a seek over the approach window, the clearance and ``BUDGET_SLACK`` at the probe
+    ``speed`` and the lift back at ``fast_speed``, the settle (s) for its strain zero; the first
+    touch's ``search`` (m) past its window; the rolls of the pattern there and back at
+    ``roll_speed`` (rad/s) and a whole turn for the way out. A pattern that has not found the
+    surface by then will not: the answer is geometric (``unreachable``), before any state
+    timeout."""
+    seek = approach_window + ProbeSettings.clearance + BUDGET_SLACK
+    touches = 1 + len(offsets)
+    per_touch = seek / speed + seek / fast_speed + settle
+    first = search / speed  # the first touch's look past the window
+    rolls = 2.0 * sum(abs(o) for o in offsets) + math.tau
+    return BUDGET_MARGIN * (first + touches * per_touch + rolls / roll_speed)
 
 
 class _Phase(enum.Enum):
@@ -54,7 +90,8 @@ class _Phase(enum.Enum):
 class ProbeRoutine:
     """The probing step of one trial, a small state machine of its own: hand it each tick's
     :class:`Observation`; it returns the :class:`Command` to send, or, once done, the
-    :class:`ProbeResult` (a ``str`` instead when it failed: no surface where one must be).
+    :class:`ProbeResult` (a ``str`` instead when it found no surface where one must be, or ran
+    out of its budget: the machine ends the trial ``unreachable`` with it).
 
     A touch: SEEK at the probe speed until the FBG's axial strain (the bow along the onset
     shape at the present exposed length taken out, zeroed on the seek's first ticks) reaches
@@ -73,7 +110,8 @@ class ProbeRoutine:
         self.rolls = geometry.probe_rolls(plan.roll, settings.offsets)
         self.touches: list[Touch] = []
         self.phase = _Phase.SEEK
-        self.limit = plan.contact_advance + plan.approach_window
+        upper = geometry.translation_limits[1]  # the first touch also looks past the window
+        self.limit = min(plan.contact_advance + plan.approach_window + settings.search, upper)
         self.goal = math.nan
         self.result: ProbeResult | None = None
         self._sweep: tuple[list[float], list[float]] = ([], [])  # rolls, safe advance on each
@@ -84,6 +122,7 @@ class ProbeRoutine:
         self._zero_roll = plan.roll  # the roll the strains were last zeroed at
         self._ramp: list[tuple[float, float]] = []  # (advance, axial strain) of this seek
         self._ramp_strains: list[tuple[float, ...]] = []  # the strains of those ticks
+        self._started: float | None = None  # time of the first tick
 
     @property
     def roll(self) -> float:
@@ -91,6 +130,15 @@ class ProbeRoutine:
         return self.rolls[min(len(self.touches), len(self.rolls) - 1)]
 
     def step(self, obs: Observation) -> Command | ProbeResult | str:
+        if self._started is None:
+            self._started = obs.t
+        spent = obs.t - self._started
+        if spent > self.settings.budget and self.phase is not _Phase.LEAVE:
+            return (
+                f"probing: the surface was not found within the budget of "
+                f"{self.settings.budget:.1f} s (the drive's limits), {len(self.touches)} of "
+                f"{len(self.rolls)} touches made"
+            )
         handler = {
             _Phase.SEEK: self._seek,
             _Phase.LIFT: self._lift,

@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 from config.schema import StackConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
+from estimation.misalignment import Lean
 from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
 from palpate.campaigns.runs import set_aside
@@ -95,6 +96,7 @@ def _outcome(
         verdict=recorded_verdict(estimate),
         southwell=_optional(SouthwellFit, estimate.get("southwell")),
         calibration=_optional(ComplianceFit, estimate.get("calibration")),
+        lean=Lean.from_record(estimate["lean"]) if isinstance(estimate.get("lean"), dict) else None,
     )
 
 

@@ -30,7 +30,7 @@ from estimation.verdict import Verdict
 from palpate.calibration import calibrate, rig_key, with_compliance
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
-from robot.indentation import State
+from robot.indentation import PLANNED_ENDS
 from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from robot.trial.inputs import belief_fields
@@ -50,6 +50,7 @@ from sensor.strain import StrainChain
 __all__ = ["SKIPPED", "BenchOutcome", "BenchTrial", "plan_bench_trials", "run_bench_trials"]
 
 SKIPPED = "skipped"
+PLANNED = frozenset(s.value for s in PLANNED_ENDS)  # trial ends that keep torque on
 
 
 @dataclass
@@ -140,7 +141,7 @@ def run_bench_trials(
         outcomes.append(outcome)
         if progress is not None:
             progress(outcome)
-        if outcome.state != State.DONE.value:
+        if outcome.state not in PLANNED:  # unreachable is an answer: torque on, the session goes on
             torque_on = False  # run_trial released the servos
             stopped = bench.stop_on_fault
         elif bench.after_trial == "release":

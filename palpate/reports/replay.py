@@ -28,7 +28,7 @@ from robot.trial.estimate import (
     fit_rows,
     verdict_for,
 )
-from robot.trial.inputs import VERSION
+from robot.trial.inputs import VERSION, probe_inputs
 from robot.trial.log import TrialLog, TrialLogError, read_log
 from robot.trial.record import estimator_keys
 
@@ -134,7 +134,7 @@ def _replay_joint(
         return True
     probe = next(log.of_kind("probe"), None)
     if probe is not None:  # the estimator was told the misalignment probing measured
-        raw = {**raw, "misalignment": probe["misalignment"]}
+        raw = {**raw, **probe_inputs(probe)}
     inputs = EstimatorInputs.from_dict(raw)
     rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
     fitted = fit_rows(rows, inputs, stack, section)
@@ -142,8 +142,9 @@ def _replay_joint(
     verdict = None
     if not inputs.rigid:
         state, reason = str(end.get("state")), str(end.get("reason"))
-        verdict = verdict_for(fitted.joint, inputs, state, reason, section)
-    keys = estimator_keys(fitted.joint, verdict, fitted.southwell, fitted.calibration)
+        verdict = verdict_for(fitted.joint, inputs, state, reason, section, fitted.lean)
+    lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
+    keys = estimator_keys(fitted.joint, verdict, fitted.southwell, fitted.calibration, lean)
     replayed = json.loads(json.dumps(keys))
     report.update({f"replayed_{k}" if k != "joint" else k: v for k, v in replayed.items()})
     report["recorded_joint"] = recorded.get("joint")

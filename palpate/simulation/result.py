@@ -16,6 +16,7 @@ from config.scene import SceneConfig
 from config.schema import StackConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
+from estimation.misalignment import Lean
 from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
 from estimation.verdict import Verdict
@@ -47,6 +48,7 @@ class TrialOutcome:
     verdict: Verdict | None = None  # ok, suspect (reasons) or none (why)
     southwell: SouthwellFit | None = None  # the beam's bow, fitted from the record
     calibration: ComplianceFit | None = None  # on a rigid reference: the rig's compliance
+    lean: Lean | None = None  # the load's lean from the strains (estimation.misalignment)
 
     misalignment: float = 0.0  # rad, what the estimator was told (probing's, or the IK's)
     true_misalignment: float | None = None  # rad, the world's at the indentation (sim truth)
@@ -106,10 +108,18 @@ class TrialOutcome:
             "misalignment_deg": math.degrees(self.misalignment),
             "true_misalignment_deg": _deg(self.true_misalignment),
             "probe": None if self.probe is None else self.probe.summary(),
+            "strain_lean": None if self.lean is None else self.lean.as_dict(),
             "probing_s": self.probing_time,
             "sim_time_s": self.sim_time,
             "log": self.log_path,
         }
+
+
+def _sigma(probe: ProbeResult | None) -> float | None:
+    """The measured normal's 1-sigma angle (rad), None when no normal was measured."""
+    if probe is None or not math.isfinite(probe.normal_sigma):
+        return None
+    return probe.normal_sigma
 
 
 def _deg(x: float | None) -> float | None:
@@ -120,7 +130,7 @@ def estimate_sim_trial(
     result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
 ) -> TrialEstimate:
     flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
-    inputs = estimator_inputs(spec, scene, stack, geo, misalignment_of(result, geo))
+    inputs = estimator_inputs(spec, scene, stack, geo, misalignment_of(result, geo), result.probe)
     return estimate_trial(
         result,
         kind=spec.kind,
@@ -163,6 +173,7 @@ def outcome_of(
         verdict=estimate.verdict,
         southwell=estimate.southwell,
         calibration=estimate.calibration,
+        lean=estimate.lean,
         misalignment=misalignment_of(result, geo),
         probe=result.probe,
         probing_time=result.probing_time,
@@ -175,6 +186,7 @@ def estimator_inputs(
     stack: StackConfig,
     geo: TrialGeometry,
     misalignment: float | None = None,
+    probe: ProbeResult | None = None,
 ) -> EstimatorInputs:
     """What the joint fit is told: the sample as the operator believes it (the scene's
     ``assumed:``, else the sample's own values), the rig's calibrated compliance, the
@@ -198,5 +210,7 @@ def estimator_inputs(
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
         travel_window=c.max_travel_past_contact_mm * 1e-3,
         rigid=sample.rigid,
+        orientation_verified=probe is None or probe.normal is not None,
+        misalignment_sigma=_sigma(probe),
         **belief,
     )

@@ -24,6 +24,7 @@ the same inputs and reproduces the fit bit for bit.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Iterable, Sequence
@@ -40,12 +41,14 @@ from estimation.compliance import ComplianceFit, fit_compliance
 from estimation.detect_contact import baseline_deviation
 from estimation.elastica.constants import P_CRIT
 from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
+from estimation.misalignment import Lean
 from estimation.section import Section
 from estimation.southwell import SouthwellFit, southwell
 from estimation.stiffness import StiffnessEstimate, paper_estimate
 from estimation.strain_fit import fit_strains
 from estimation.verdict import TrialFacts, Verdict, judge
 from robot.trial.inputs import EstimatorInputs
+from robot.trial.lean import lean_of_rows, rows_in
 from robot.trial.run import TrialResult
 from sensor.strain import grating_intervals
 
@@ -71,15 +74,7 @@ def loading_rows(
     rows: Iterable[tuple[str, float, Sequence[float]]], gratings: int
 ) -> tuple[FloatArray, FloatArray]:
     """(advance (N,), strains (N, G)) of the loading rows (state, advance, strains) in order."""
-    adv: list[float] = []
-    eps: list[Sequence[float]] = []
-    for state, advance, strains in rows:
-        if state in LOADING_STATES and len(strains) == gratings:
-            adv.append(advance)
-            eps.append(strains)
-    return np.asarray(adv, dtype=np.float64), np.asarray(eps, dtype=np.float64).reshape(
-        -1, gratings
-    )
+    return rows_in(rows, LOADING_STATES, gratings)
 
 
 def strain_sigma(residual: FloatArray, gratings: int) -> float:
@@ -100,6 +95,7 @@ class RecordEstimate:
     joint: JointFit | None
     southwell: SouthwellFit | None = None
     calibration: ComplianceFit | None = None
+    lean: Lean | None = None
 
 
 def fit_record(
@@ -173,13 +169,31 @@ def fit_rows(
     stack: StackConfig,
     section: Section,
 ) -> RecordEstimate:
-    """The estimates from (state, advance, strains) rows: the trial's record or a log's samples."""
+    """The estimates from (state, advance, strains) rows: the trial's record or a log's samples;
+    beside them the load's lean from the rows before buckling (``robot.trial.lean``)."""
+    rows = list(rows)
     advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
-    return fit_record(advance, strains, inputs, stack.sensor, section)
+    fitted = fit_record(advance, strains, inputs, stack.sensor, section)
+    if inputs.rigid:
+        return fitted
+    lean = lean_of_rows(
+        rows,
+        stack.sensor,
+        section,
+        kind=inputs.kind,
+        exposed_length=inputs.exposed_length,
+        flush_translation=inputs.flush_translation,
+    )
+    return dataclasses.replace(fitted, lean=lean)
 
 
 def verdict_for(
-    joint: JointFit | None, inputs: EstimatorInputs, state: str, reason: str, section: Section
+    joint: JointFit | None,
+    inputs: EstimatorInputs,
+    state: str,
+    reason: str,
+    section: Section,
+    lean: Lean | None = None,
 ) -> Verdict:
     """The trial's verdict (``estimation.verdict``) from its fit, its inputs and how it ended."""
     length = inputs.exposed_length
@@ -193,6 +207,9 @@ def verdict_for(
         misalignment=inputs.misalignment,
         misalignment_tolerance=inputs.misalignment_tolerance,
         compliance_calibrated=inputs.compliance_calibrated,
+        orientation_verified=inputs.orientation_verified,
+        lean=lean,
+        misalignment_sigma=inputs.misalignment_sigma,
     )
     return judge(joint, facts, inputs.tip_radius)
 
@@ -250,6 +267,7 @@ class TrialEstimate:
     southwell: SouthwellFit | None = None
     verdict: Verdict | None = None
     calibration: ComplianceFit | None = None
+    lean: Lean | None = None
 
 
 def estimate_trial(
@@ -281,7 +299,15 @@ def estimate_trial(
     seconds = time.perf_counter() - start
     verdict = None
     if not inputs.rigid:
-        verdict = verdict_for(fitted.joint, inputs, result.state.value, result.reason, section)
+        state = result.state.value
+        verdict = verdict_for(fitted.joint, inputs, state, result.reason, section, fitted.lean)
     return TrialEstimate(
-        paper, length, fitted.joint, seconds, fitted.southwell, verdict, fitted.calibration
+        paper,
+        length,
+        fitted.joint,
+        seconds,
+        fitted.southwell,
+        verdict,
+        fitted.calibration,
+        fitted.lean,
     )

@@ -44,6 +44,10 @@ class EstimatorInputs:
         compliance_calibrated: False when ``compliance`` is the uncalibrated prior range.
         misalignment_tolerance: the campaign's tolerance (rad), None: not checked.
         travel_window: the travel past contact allowed (m), None: unknown.
+        orientation_verified: False when probing ran and could not measure a normal (a
+            straight tube): the misalignment told is then not known.
+        misalignment_sigma: the measured normal's 1-sigma angle (rad), None when no normal was
+            measured (no probing, or none found).
         rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
             (``estimation.compliance``) instead of estimating a modulus.
         version: the inputs' format (VERSION; 1 for logs that predate it).
@@ -66,6 +70,8 @@ class EstimatorInputs:
     misalignment_tolerance: float | None = None
     travel_window: float | None = None
     rigid: bool = False
+    orientation_verified: bool = True
+    misalignment_sigma: float | None = None
     version: int = VERSION
 
     def as_dict(self) -> dict[str, Any]:
@@ -163,3 +169,16 @@ def _thickness_m(value: object) -> object:
 def _middle_thickness(r: tuple[float, float]) -> float:
     """The thickness in the middle of a range in 1/h (the thin-layer series' variable)."""
     return 2.0 / (1.0 / r[0] + 1.0 / r[1])
+
+
+def probe_inputs(probe: dict[str, Any]) -> dict[str, Any]:
+    """The :class:`EstimatorInputs` fields a log's ``probe`` record sets: the misalignment
+    probing measured, whether a normal was measured at all and its 1-sigma angle (rad)."""
+    raw = probe.get("normal_sigma")
+    measured = probe.get("normal") is not None
+    sigma = float(raw) if isinstance(raw, int | float) else math.nan
+    return {
+        "misalignment": probe["misalignment"],
+        "orientation_verified": measured,
+        "misalignment_sigma": sigma if measured and math.isfinite(sigma) else None,
+    }

@@ -191,6 +191,8 @@ ESTIMATOR = {  # robot.trial.estimate.EstimatorInputs
     "misalignment_tolerance": opt(number(null=True, ge=0, le=math.pi)),
     "travel_window": opt(number(null=True, gt=0)),
     "rigid": opt(boolean),
+    "orientation_verified": opt(boolean),  # absent before issue 25: verified
+    "misalignment_sigma": opt(number(null=True, ge=0, le=math.pi)),
     "version": opt(integer(ge=1)),
 }
 PROBE = {  # robot.probe_plan.ProbeResult: what probing found (robot trials that probe)

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from config.schema import SensorConfig, TubeConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
+from estimation.misalignment import Lean
 from estimation.section import Section
 from estimation.southwell import SouthwellFit
 from estimation.verdict import Verdict
@@ -84,7 +85,13 @@ def estimate_record(estimate: TrialEstimate) -> dict[str, Any]:
             "message": est.message,
         }
     record.update(
-        estimator_keys(estimate.joint, estimate.verdict, estimate.southwell, estimate.calibration)
+        estimator_keys(
+            estimate.joint,
+            estimate.verdict,
+            estimate.southwell,
+            estimate.calibration,
+            estimate.lean,
+        )
     )
     return record
 
@@ -94,6 +101,7 @@ def estimator_keys(
     verdict: Verdict | None,
     southwell: SouthwellFit | None,
     calibration: ComplianceFit | None = None,
+    lean: Lean | None = None,
 ) -> dict[str, Any]:
     """The estimate record's keys of the joint fit, its verdict and the bow, or of the
     compliance calibration on a rigid reference (as JSON values); ``palpate replay`` compares
@@ -105,6 +113,8 @@ def estimator_keys(
         out["verdict"] = verdict.as_dict()
     if southwell is not None:
         out["southwell"] = southwell.as_dict()
+    if lean is not None:
+        out["lean"] = lean.record()
     return out
 
 

@@ -8,6 +8,7 @@ means the same everywhere.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 
@@ -20,8 +21,8 @@ from estimation.beamstate import infer_states, onset_mode
 from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
 from estimation.section import Section
 from estimation.section import sensor_section as section_of
-from robot.indentation import Guards, Prober, TrialPlan
-from robot.probing import ProbeGeometry, ProbeRoutine, ProbeSettings
+from robot.indentation import STATE_TIMEOUT, Guards, Prober, TrialPlan
+from robot.probing import ProbeGeometry, ProbeRoutine, ProbeSettings, probe_budget
 from robot.rig import RigSettings
 from sensor.strain import StrainChain, grating_intervals
 from wire.dynamixel import TICKS_PER_REV
@@ -32,6 +33,11 @@ FloatArray = NDArray[np.float64]
 def sensor_section(stack: StackConfig) -> Section:
     """The sensor's composite section (EI, EA, fiber offset) from the robot configuration."""
     return section_of(stack.sensor)
+
+
+PROBE_SEARCH = 6e-3  # m the first touch looks past the approach window (samples 1-5 mm off)
+BUDGET_SHARE = 0.8  # probing's budget never exceeds this share of the state timeout
+SETTLE_ALLOWANCE = 0.4  # s per touch at rest for the strain zero (10 ticks at 25 Hz or more)
 
 
 def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Guards:
@@ -102,7 +108,18 @@ def prober_for(
             max_miss=campaign.miss_tolerance_mm * MM,
             standoff=plan.standoff,
             replan=probing is True,
+            search=PROBE_SEARCH,
         )
+        budget = probe_budget(
+            settings.offsets,
+            plan.approach_window,
+            settings.speed,
+            settings.fast_speed,
+            stack.drive.max_roll_speed,
+            SETTLE_ALLOWANCE,
+            settings.search,
+        )
+        settings = dataclasses.replace(settings, budget=min(budget, BUDGET_SHARE * STATE_TIMEOUT))
         return ProbeRoutine(geometry, settings, plan)
 
     return build

@@ -59,7 +59,11 @@ def test_a_rigid_reference_calibrates_the_compliance_before_the_other_trials(
         assert header["compliance_calibrated"] is True
         assert o.joint is not None
         assert o.joint.covers(o.spec.modulus)
-        assert o.status == "ok"
+        assert o.verdict is not None
+        # the straight tube probes but cannot measure a normal (issue 25): that is the only
+        # reason it is not ok
+        assert len(o.verdict.reasons) == 1
+        assert o.verdict.reasons[0].startswith("orientation unverified")
     report = replay(Path(str(ref.log_path)))
     assert report["identical"] is True
     assert report["replayed_calibration"]["compliance"] == ref.calibration.compliance

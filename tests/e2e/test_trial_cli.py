@@ -89,10 +89,12 @@ def run_on(
     )
 
 
-def session_on_ptys(tmp_path: Path, trials: str) -> tuple[list[BenchOutcome], list[bool], int]:
+def session_on_ptys(
+    tmp_path: Path, trials: str, extra: str = ""
+) -> tuple[list[BenchOutcome], list[bool], int]:
     """Run a bench file's trials through ``run_session`` on the emulators' ptys; return the
     outcomes, each servo's torque and the stage encoder after the session closed the bus."""
-    loaded = load_bench(bench_file(tmp_path, trials))
+    loaded = load_bench(bench_file(tmp_path, trials, extra))
     clock = VirtualClock()
     with simulated(loaded, clock) as sim:
         outcomes = run_on(sim, loaded, clock, tmp_path / "logs")
@@ -190,14 +192,28 @@ def test_a_rehearsal_on_the_twin_calibrates_on_the_reference_then_estimates(
 
 def test_a_fault_stops_the_session_and_skips_the_rest(tmp_path: Path) -> None:
     trials = "  - {target: up, sample: S8}\n" + ONE  # nothing above the sensor: no contact
-    outcomes, torque, _ = session_on_ptys(tmp_path, trials)
+    # without probing the approach's window is the plan's: no contact there is a guard's fault
+    outcomes, torque, _ = session_on_ptys(tmp_path, trials, "campaign: {probe: false}\n")
     first, second = outcomes
     assert first.state == "fault"
-    # robot trials probe the surface first (campaign.probe null): its first touch finds none
-    assert first.reason.startswith("probing: no surface within")
+    assert first.reason.startswith("no contact within")
     assert second.state == SKIPPED
     assert second.log_path is None
     assert torque == [False, False, False]
+    assert read_log(Path(str(first.log_path))).complete
+
+
+def test_a_sample_probing_cannot_find_ends_unreachable_and_the_session_goes_on(
+    tmp_path: Path,
+) -> None:
+    """Robot trials probe first (campaign.probe null): a first touch that finds no surface is a
+    geometric answer (issue 25), not a fault: the trial ends unreachable and the next runs."""
+    trials = "  - {target: up, sample: S8}\n" + ONE
+    outcomes, _, _ = session_on_ptys(tmp_path, trials)
+    first, second = outcomes
+    assert first.state == "unreachable"
+    assert first.reason.startswith("unreachable: probing: no surface within")
+    assert second.state != SKIPPED
     assert read_log(Path(str(first.log_path))).complete
 
 

@@ -59,3 +59,17 @@ def test_a_bow_during_a_roll_holds_the_roll_and_backs_off() -> None:
     assert cmd.advance <= behind - routine.settings.clearance  # backing off along the ray
     cmd = free_ticks(routine, mid, cmd.advance, 4)
     assert cmd.roll == target  # free again: the roll goes on
+
+
+def test_a_pattern_past_its_budget_is_a_geometric_answer() -> None:
+    """Moving between touches with the surface never reached: once the budget (from the drive's
+    limits) is spent, the routine answers with the reason instead of a command."""
+    routine, target = moving_routine()
+    budget = routine.settings.budget
+    assert math.isfinite(budget)
+    assert 0 < budget < 60.0
+    first = routine.step(obs(target / 2, CONTACT - 5e-3, 0.0, t=1.0))
+    assert isinstance(first, Command)
+    late = routine.step(obs(target / 2, CONTACT - 5e-3, 0.0, t=1.0 + budget + 0.1))
+    assert isinstance(late, str)
+    assert "budget" in late

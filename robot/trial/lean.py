@@ -1,0 +1,71 @@
+"""The load's lean measured on a trial's record (``estimation.misalignment``), trial and replay.
+
+The rows before buckling (states approach, contact, indenting) with their exposed lengths go to
+:func:`estimation.misalignment.measure_lean`; the rows after (``buckled``) are the elastica's,
+which the lateral load's linear shape does not describe.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from config.schema import SensorConfig
+from estimation.misalignment import Lean, measure_lean
+from estimation.section import Section
+from sensor.strain import grating_intervals
+
+PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
+
+
+def rows_in(
+    rows: Iterable[tuple[str, float, Sequence[float]]], states: frozenset[str], gratings: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(advance (N,), strains (N, G)) of the (state, advance, strains) rows in ``states`` with
+    all ``gratings``, in order."""
+    adv: list[float] = []
+    eps: list[Sequence[float]] = []
+    for state, advance, strains in rows:
+        if state in states and len(strains) == gratings:
+            adv.append(advance)
+            eps.append(strains)
+    x = np.asarray(adv, dtype=np.float64)
+    return x, np.asarray(eps, dtype=np.float64).reshape(-1, gratings)
+
+
+def grating_spans_from_tip(sensor: SensorConfig) -> NDArray[np.float64]:
+    """(G, 2): each used grating's (d0, d1), metres from the sensor tip (the arcs of
+    ``sensor.strain.grating_intervals`` at L = 0, s = -d, turned round)."""
+    arcs = grating_intervals(sensor, 0.0)
+    return np.stack([-arcs[:, 1], -arcs[:, 0]], axis=1)
+
+
+def lean_of_rows(
+    rows: Iterable[tuple[str, float, Sequence[float]]],
+    sensor: SensorConfig,
+    section: Section,
+    *,
+    kind: str,
+    exposed_length: float,
+    flush_translation: float,
+) -> Lean:
+    """The lean from (state, advance, strains) rows: on the robot L = advance - flush
+    translation, on the bench ``exposed_length``."""
+    gratings = len(sensor.used_gratings)
+    x, strains = rows_in(rows, PRE_BUCKLING, gratings)
+    if not x.size:
+        return Lean(False, "no rows before buckling")
+    lengths = np.asarray(
+        x - flush_translation if kind == "robot" else np.full(x.size, exposed_length),
+        dtype=np.float64,
+    )
+    return measure_lean(
+        strains,
+        lengths,
+        grating_spans_from_tip(sensor),
+        section.EA,
+        section.EI,
+        section.fiber_offset,
+    )
