@@ -31,7 +31,11 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from estimation.detect_buckling import BucklingDetector
+from robot.guards import STATE_TIMEOUT, Guards, Observation, limit_violation
 from robot.probe_result import ProbeResult
+
+# the guards' names, re-exported: the machine's interface is read from here
+__all__ = ["STATE_TIMEOUT", "Guards", "Observation", "limit_violation"]
 
 
 class State(enum.Enum):
@@ -52,7 +56,6 @@ class State(enum.Enum):
 
 TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})
 PLANNED_ENDS = frozenset({State.DONE, State.UNREACHABLE})  # torque stays on: nothing went wrong
-STATE_TIMEOUT = 60.0  # s in any one state (a guard: a state that never ends is a fault)
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 
 
@@ -71,33 +74,6 @@ class TrialPlan:
     indent_speed: float = 0.5e-3
     roll_tolerance: float = 2e-3
     position_tolerance: float = 5e-6
-
-
-@dataclass(frozen=True)
-class Guards:
-    """Limits that stop a trial. Exceeding any of them is a FAULT with the guard named."""
-
-    max_travel_past_contact: float = 2.5e-3  # m; the beam or the tissue is at risk beyond
-    strain_limit: float = 5e-3  # fiber strain (dimensionless); protects the fiber
-    stream_timeout: float = 0.1  # s without a fresh FBG frame
-    state_timeout: float = STATE_TIMEOUT  # s in any one state
-    early_contact_margin: float = 0.5e-3  # contact this much before the plan is "unexpected"
-    bus_grace: float = 0.5  # s of lost servo replies tolerated while retracting (goals still go)
-    max_twist: float | None = None  # rad, inner vs outer roller gear; None: not watched
-
-
-@dataclass(frozen=True)
-class Observation:
-    t: float  # s
-    advance: float  # m, stage position from the translation servo's encoder
-    roll: float  # rad, outer roll from its encoder
-    strains: tuple[float, ...]  # grating-average strains of the used gratings
-    contact: bool  # the contact event (force scale / camera / FBG), as the rig reports it
-    stream_age: float = 0.0  # s since the last good FBG frame
-    servo_fault: str | None = None  # a fault the servo bus reported, if any
-    bus_lost: bool = False  # servo_fault is a transport failure (no or garbled replies)
-    abort: bool = False  # the operator pressed stop
-    twist: float = 0.0  # rad, inner roller gear's roll minus the outer's (the sensor's twist)
 
 
 @dataclass(frozen=True)
@@ -124,28 +100,6 @@ class Transition:
     reason: str
     advance: float
     strains: tuple[float, ...]
-
-
-def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -> str | None:
-    """Why the fiber-strain or travel-past-contact guard trips on ``obs``, or None.
-
-    One function for the state machine and for teleoperation (``robot.teleop``), so a jog is
-    held to exactly the limits of a scripted trial. ``x_contact`` is the stage position at
-    contact (m), None while the sensor is free.
-    """
-    peak = max((abs(s) for s in obs.strains), default=0.0)
-    if peak > guards.strain_limit:
-        return f"fiber strain {peak * 1e6:.0f} ue over the limit {guards.strain_limit * 1e6:.0f} ue"
-    if guards.max_twist is not None and abs(obs.twist) > guards.max_twist:
-        return (
-            f"sensor twist {math.degrees(obs.twist):.2f} deg (inner vs outer roller gear) over "
-            f"the {math.degrees(guards.max_twist):.2f} deg bound"
-        )
-    if x_contact is not None:
-        past = obs.advance - x_contact
-        if past > guards.max_travel_past_contact:
-            return f"travel past contact {past * 1e3:.2f} mm over the limit"
-    return None
 
 
 @dataclass

@@ -40,6 +40,7 @@ from sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_
 from sim.equilibrium import ContactEffects, TissueLaw
 from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
 from sim.oblique import ObliqueContact
+from sim.readout import GratingReadout
 from sim.viscoelastic import StandardLinearSolid
 from wire.frame import Status
 
@@ -156,22 +157,9 @@ class World:
         self.joints = joints
         self.rng = rng
         self.has_force = has_force
-        k_tube = fidelity.tube_tip_stiffness_n_per_mm
-        self.effects = ContactEffects(
-            tube_stiffness=None if k_tube is None else k_tube * 1e3,
-            imperfection=fidelity.imperfection_w0_over_l,
-        )
-        sd = fidelity.contact_uncertainty_mm * 1e-3
-        self.contact_offset = float(rng.normal(0.0, sd)) if sd > 0 else 0.0
+        self.effects, self.contact_offset = _contact_effects(fidelity, rng)
         self._centres = tuple(sensor.grating_centres_from_tip())
-        self._base = tuple(fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in sensor.used_gratings)
-        self._noise = fidelity.fbg_noise_pm * 1e-12
-        ref_nm = fbg.reference_wavelength_nm
-        self._reference = None if ref_nm is None else ref_nm * 1e-9
-        # peak noises, then the reference's, drawn in one call (the same stream as separate ones)
-        self._draws = (len(self._base) + (ref_nm is not None)) if self._noise > 0 else 0
-        self._strain_coefficient = fbg.strain_coefficient
-        self._temperature_coefficient = fbg.temperature_coefficient
+        self.readout = GratingReadout(sensor, fbg, fidelity)
         self._tip_radius = sensor.tip_radius
         self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
@@ -179,8 +167,8 @@ class World:
         self.friction = friction
         self.poisson = poisson
         self.weight = weight
-        half = 0.5 * sensor.grating_length
-        self._from_tip = np.asarray(self._centres)[:, None] + np.array([-half, half])
+        # each grating's ends, from the tip (m): where gravity's sag is averaged
+        self._from_tip = _grating_ends(self._centres, sensor.grating_length)
         self._tables: dict[float, ContactTable] = {}
         self.relaxation = relaxation
         self._histories: dict[float, ViscoelasticContact] = {}
@@ -374,38 +362,37 @@ class World:
     def sample(self, t: float) -> BoardSample:
         st = self.state(t)
         drift = self.fidelity.temperature_drift_degc_per_s * t
-        noise = self.rng.normal(0.0, self._noise, size=self._draws).tolist() if self._draws else []
-        reference = None
-        if self._reference is not None:
-            reference = self._reference
-            reference += self._temperature_coefficient * drift
-            if noise:
-                reference += noise[-1]
+        wavelengths, reference = self.readout.read(st.strains, drift, self.rng)
         flags = _CONTACT_FLAG if st.contact_event else 0
         force = None
         if self.has_force:
             force = st.P
             flags |= _FORCE_FLAG
         return BoardSample(
-            wavelengths=self._peaks(st.strains, drift, noise),
+            wavelengths=wavelengths,
             encoder=st.encoder,
             reference=reference,
             force=force,
             flags=flags,
         )
 
-    def _peaks(
-        self, strains: tuple[float, ...], drift: float, noise: list[float]
-    ) -> tuple[float, ...]:
-        """Peak wavelengths (m): base + S_eps eps (+ S_T dT) (+ noise). Plain floats, with the
-        same IEEE operations in the same order as the array expression they replace, so the
-        same bits."""
-        k = self._strain_coefficient
-        shift = [k * x for x in strains]
-        if drift:
-            offset = self._temperature_coefficient * drift
-            shift = [x + offset for x in shift]
-        wl = [b + x for b, x in zip(self._base, shift, strict=True)]
-        if noise:
-            wl = [w + n for w, n in zip(wl, noise[: len(wl)], strict=True)]
-        return tuple(wl)
+
+def _contact_effects(
+    fidelity: FidelityConfig, rng: np.random.Generator
+) -> tuple[ContactEffects, float]:
+    """What the scene's fidelity adds at the contact (a compliant tube tip, the beam's bow) and
+    this trial's contact-event error (m, drawn once)."""
+    k_tube = fidelity.tube_tip_stiffness_n_per_mm
+    effects = ContactEffects(
+        tube_stiffness=None if k_tube is None else k_tube * 1e3,
+        imperfection=fidelity.imperfection_w0_over_l,
+    )
+    sd = fidelity.contact_uncertainty_mm * 1e-3
+    return effects, float(rng.normal(0.0, sd)) if sd > 0 else 0.0
+
+
+def _grating_ends(centres: tuple[float, ...], grating_length: float) -> Vector:
+    """(n, 2) distances from the tip (m) of each grating's two ends."""
+    half = 0.5 * grating_length
+    ends: Vector = np.asarray(centres)[:, None] + np.array([-half, half])
+    return ends

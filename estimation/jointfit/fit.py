@@ -71,14 +71,9 @@ def joint_fit(
     check_options(confidence, search, f_scale, encoder_resolution)
     provisional = belief.provisional()
     try:
-        if record.n < min_points:
-            raise FitFailed(f"too few points: {record.n} samples, the fit needs {min_points}")
         # 1. scan x0 (E, P0 in closed form); 2. refine robustly; 3. the noise model
-        start = scan(provisional, record, contact_guess, search, load_offset)
-        fit = refine(
-            provisional, record, start, encoder_resolution, f_scale=f_scale, max_nfev=max_nfev
-        )
-        require_contact(fit, min_contact_points)
+        located = (contact_guess, search, load_offset, min_points, min_contact_points)
+        start, fit = _located(provisional, record, located, encoder_resolution, f_scale, max_nfev)
         noise = frozen_noise(fit, f_scale, confidence)
         require_significance(fit, noise)
         # 4. profile every hypothesis of the belief in every form; the estimate at the best one
@@ -86,6 +81,26 @@ def joint_fit(
         return _profiled(belief, refit, noise, confidence, misalignment, min_contact_points)
     except FitFailed as failure:
         return failure.result(record.n, confidence, provisional.law.name)
+
+
+def _located(
+    provisional: Hypothesis,
+    record: Record,
+    located: tuple[float | None, float, bool, int, int],
+    encoder_resolution: float,
+    f_scale: float,
+    max_nfev: int,
+) -> tuple[Start, Refined]:
+    """Steps 1-2 of :func:`joint_fit` under the provisional hypothesis: the contact scanned over
+    the record, then refined robustly; ``located`` is (contact_guess, search, load_offset,
+    min_points, min_contact_points). Raises FitFailed where the record cannot carry a fit."""
+    contact_guess, search, load_offset, min_points, min_contact_points = located
+    if record.n < min_points:
+        raise FitFailed(f"too few points: {record.n} samples, the fit needs {min_points}")
+    start = scan(provisional, record, contact_guess, search, load_offset)
+    fit = refine(provisional, record, start, encoder_resolution, f_scale=f_scale, max_nfev=max_nfev)
+    require_contact(fit, min_contact_points)
+    return start, fit
 
 
 def _profiled(

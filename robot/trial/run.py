@@ -112,25 +112,18 @@ def run_trial(
     machine = IndentationMachine(
         plan, guards, detector, on_transition=record_transition, prober=prober
     )
-    probe_logged = False
     t0 = clock.now()
-    ticks = 0
-    recovered = False
+    ticks, recovered, probe_logged = 0, False, False
     try:
         while not machine.finished:
-            if ticks >= max_ticks:
-                machine.abort(clock.now(), f"tick budget of {max_ticks} exhausted")
-                if ticks >= max_ticks + 100_000:
-                    break
+            if _out_of_ticks(machine, clock.now(), ticks, max_ticks):
+                break
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
             record.append((machine.state.value, obs.advance, tuple(obs.strains)))
             if log is not None:
-                log.write(_sample_record(obs, machine.state, cmd))
+                probe_logged = _write_tick(log, obs, machine, cmd, probe_logged)
             if on_tick is not None:
                 on_tick(obs, machine.state)
-            if machine.probe is not None and not probe_logged and log is not None:
-                log.write({"kind": "probe", **machine.probe.as_dict()})
-                probe_logged = True
             ticks += 1
             if not machine.finished:
                 clock.sleep(rig.tick)
@@ -149,6 +142,27 @@ def run_trial(
         record=record,
         probe=machine.probe,
     )
+
+
+def _out_of_ticks(machine: IndentationMachine, t: float, ticks: int, max_ticks: int) -> bool:
+    """Past ``max_ticks`` the trial is aborted (it retracts); True once even the retraction has
+    had 100,000 ticks more: the loop stops."""
+    if ticks >= max_ticks:
+        machine.abort(t, f"tick budget of {max_ticks} exhausted")
+        return ticks >= max_ticks + 100_000
+    return False
+
+
+def _write_tick(
+    log: TrialLogWriter, obs: Observation, machine: IndentationMachine, cmd: Command, probed: bool
+) -> bool:
+    """The tick's sample record, then what probing found once it is found; returns whether the
+    probe record is written."""
+    log.write(_sample_record(obs, machine.state, cmd))
+    if machine.probe is not None and not probed:
+        log.write({"kind": "probe", **machine.probe.as_dict()})
+        return True
+    return probed
 
 
 def _tick(
