@@ -38,7 +38,7 @@ from typing import Literal
 
 import numpy as np
 
-from estimation.corrections import CHI_MAX, ContactLaw
+from estimation.corrections import CHI_MAX, ContactLaw, LayerLaw
 
 E_STEP = 0.02
 CHI_STEP = 0.02
@@ -88,6 +88,7 @@ class Belief:
             clamp (tube tip or stage).
         large_indentation: Sneddon's sphere (else Hertz).
         layer_ratio_from: the thin-layer ratio of the laws (``ContactLaw.layer_ratio_from``).
+        layer_law: the laws' layer law (``ContactLaw.layer_law``): exact, or the series.
     """
 
     tip_radius: float
@@ -97,6 +98,7 @@ class Belief:
     compliance: Range = (0.0, 0.0)
     large_indentation: bool = True
     layer_ratio_from: Literal["published", "sphere"] = "published"
+    layer_law: LayerLaw = "exact"
 
     def __post_init__(self) -> None:
         _checked_range("poisson", self.poisson, 0.0, 0.5)
@@ -120,6 +122,7 @@ class Belief:
             (compliance, compliance),
             law.large_indentation,
             law.layer_ratio_from,
+            law.layer_law,
         )
 
     @property
@@ -166,7 +169,13 @@ class Belief:
     ) -> Hypothesis:
         h = None if inverse_thickness <= 0.0 else 1.0 / inverse_thickness
         law = ContactLaw(
-            self.tip_radius, poisson, h, bonded, self.large_indentation, self.layer_ratio_from
+            self.tip_radius,
+            poisson,
+            h,
+            bonded,
+            self.large_indentation,
+            self.layer_ratio_from,
+            self.layer_law,
         )
         return Hypothesis(law, compliance)
 

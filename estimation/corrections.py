@@ -35,13 +35,17 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from estimation.hertz import MAX_DEPTH_RATIO as MAX_DEPTH_RATIO_HERTZ
 from estimation.hertz import hertz_validity
 from estimation.layer import dimitriadis_bracket, layer_coefficients
+from estimation.layer_table import DEPTH_RATIO_MAX, LayerFactor, layer_factor
 
 FloatArray = NDArray[np.float64]
 
 CHI_MAX = 1.0
 """Layer ratio up to which the Dimitriadis series is trusted (its small-chi expansion)."""
+
+LayerLaw = Literal["exact", "dimitriadis"]
 
 MAX_MISALIGNMENT = math.radians(5.0)
 """Angle between the sensor axis and the surface normal above which a warning is given: the
@@ -162,6 +166,10 @@ class ContactLaw:
             ``"sphere"``: chi = a/h with Sneddon's contact radius a = R tanh(y). The series was
             derived for the paraboloid, so with the sphere both are defensible; the joint fit
             uses the published one and the spread between the two as a model-form uncertainty.
+            Only for ``layer_law="dimitriadis"``: the exact law has no such choice.
+        layer_law: ``"exact"``: the layer's exact linear-elastic law for the sphere (or the
+            paraboloid) at depth (``estimation.layer_table``), trusted to chi = 3 and
+            delta/R = 1; ``"dimitriadis"``: the published series, kept as a reference.
     """
 
     tip_radius: float
@@ -170,6 +178,7 @@ class ContactLaw:
     bonded: bool = True
     large_indentation: bool = True
     layer_ratio_from: Literal["published", "sphere"] = "published"
+    layer_law: LayerLaw = "exact"
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tip_radius) and self.tip_radius > 0):
@@ -183,6 +192,8 @@ class ContactLaw:
             raise ValueError(
                 f"layer_ratio_from must be 'published' or 'sphere', got {self.layer_ratio_from!r}"
             )
+        if self.layer_law not in ("exact", "dimitriadis"):
+            raise ValueError(f"layer_law must be 'exact' or 'dimitriadis', got {self.layer_law!r}")
 
     @property
     def name(self) -> str:
@@ -190,7 +201,18 @@ class ContactLaw:
         if self.thickness is None:
             return base
         kind = "bonded" if self.bonded else "non-bonded"
+        if self.layer_law == "exact":
+            return f"{base} on an exact {kind} layer (h = {self.thickness * 1e3:g} mm)"
         return f"{base} x Dimitriadis {kind} (h = {self.thickness * 1e3:g} mm)"
+
+    @property
+    def exact_layer(self) -> LayerFactor | None:
+        """The exact law's layer factor against the half-space law (None: no layer, or the
+        Dimitriadis series)."""
+        if self.thickness is None or self.layer_law != "exact":
+            return None
+        ratio = self.thickness / self.tip_radius
+        return layer_factor(self.poisson, self.bonded, ratio, self.large_indentation)
 
     def shape(self, delta: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """f(delta) = F/E (N/Pa) and df/ddelta, for depths ``delta`` (m); 0 where delta <= 0.
@@ -206,7 +228,8 @@ class ContactLaw:
         half = _half_space(R, dp, self.large_indentation)
         root, a, f0 = half.root, half.a, half.f0
         da = np.where(dp > 0, 0.5 * R / np.where(root > 0, root, 1.0), 0.0)  # d sqrt(R d)/dd
-        if self.layer_ratio_from == "sphere" and half.y is not None and half.t is not None:
+        sphere_ratio = self.layer_ratio_from == "sphere" and self.layer_law == "dimitriadis"
+        if sphere_ratio and half.y is not None and half.t is not None:
             y, t = half.y, half.t
             sech2 = 1.0 - t * t
             da = sech2 / (t + y * sech2 + (y == 0))
@@ -215,6 +238,11 @@ class ContactLaw:
         scale = 1.0 / (1.0 - self.poisson**2)
         if self.thickness is None:
             return np.asarray(scale * f0), np.asarray(scale * df0)
+        exact = self.exact_layer
+        if exact is not None:
+            g, dg = exact.at(root / self.thickness)
+            dchi = da / self.thickness
+            return np.asarray(scale * f0 * g), np.asarray(scale * (df0 * g + f0 * dg * dchi))
         chi = root / self.thickness
         b, db = dimitriadis_bracket(chi, layer_coefficients(self.poisson, self.bonded))
         dchi = da / self.thickness
@@ -267,6 +295,10 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
         if law.thickness is None:
             out.append(np.asarray(scale * f0))
             continue
+        exact = law.exact_layer
+        if exact is not None:
+            out.append(np.asarray(scale * f0 * exact.at(half.root / law.thickness)[0]))
+            continue
         radius = half.a if law.layer_ratio_from == "sphere" else half.root
         k = layer_coefficients(law.poisson, law.bonded)
         b, _ = dimitriadis_bracket(radius / law.thickness, k)
@@ -274,18 +306,81 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
     return out
 
 
+LAYER_STRAIN_MAX = 0.2
+"""Trusted compression of a layer, delta/h: past it a thin layer's finite strain (not in any
+linear law) moves the force by several % (docs/estimation.md)."""
+
+
 def validity_warnings(
     law: ContactLaw, delta_max: float, misalignment: float | None = None
 ) -> tuple[str, ...]:
     """Warnings (one sentence each) on using ``law`` up to depth ``delta_max`` (m).
 
-    - Hertz's small-strain range delta/R and the half-space condition a/h
-      (``estimation.hertz.hertz_validity``), said as corrected when the law corrects them;
-    - chi beyond the Dimitriadis series' range (CHI_MAX);
+    - the law's trusted domain: for the exact layer law (:func:`exact_domain_warnings`), its
+      tables' reach in chi and delta/R and the layer's compression; for the Dimitriadis series,
+      Hertz's small-strain range and the half-space condition (``estimation.hertz``), said as
+      corrected when the law corrects them, and chi beyond the series' range (CHI_MAX);
     - ``misalignment`` (rad, e.g. the inverse kinematics' residual angle) above MAX_MISALIGNMENT.
     """
     if not (math.isfinite(delta_max) and delta_max >= 0):
         raise ValueError(f"delta_max must be finite and >= 0 m, got {delta_max!r}")
+    if law.layer_law == "exact":
+        out = exact_domain_warnings(law, delta_max)
+    else:
+        out = _series_warnings(law, delta_max)
+    if misalignment is not None:
+        if not math.isfinite(misalignment):
+            raise ValueError(f"misalignment must be finite (rad), got {misalignment!r}")
+        if abs(misalignment) > MAX_MISALIGNMENT:
+            out.append(
+                f"sensor {math.degrees(abs(misalignment)):.1f} deg off the surface normal "
+                f"(> {math.degrees(MAX_MISALIGNMENT):g} deg): the indentation is not normal"
+            )
+    return tuple(out)
+
+
+def exact_domain_warnings(law: ContactLaw, delta_max: float) -> list[str]:
+    """Where ``law`` (the exact layer law) is used past its trusted domain at depth
+    ``delta_max`` (m): the sphere's depth (DEPTH_RATIO_MAX), the layer ratio its tables reach
+    (``estimation.layer_table.CHI_MAX`` or less), the layer's compression (LAYER_STRAIN_MAX). Each is a reason
+    for ``suspect``; the half-space depth is said as corrected (Sneddon's sphere is exact)."""
+    out: list[str] = []
+    depth_ratio = delta_max / law.tip_radius
+    if depth_ratio > DEPTH_RATIO_MAX:
+        out.append(
+            f"indentation beyond the exact law's trusted depth: delta/R up to {depth_ratio:.3g} "
+            f"> {DEPTH_RATIO_MAX:g} (the law is extrapolated)"
+        )
+    elif depth_ratio > MAX_DEPTH_RATIO_HERTZ:
+        note = (
+            "corrected with Sneddon's sphere (linear elasticity still assumed)"
+            if law.large_indentation
+            else "the paraboloid departs from the sphere"
+        )
+        out.append(
+            f"indentation beyond Hertz's small-strain range: delta/R up to {depth_ratio:.3g}; "
+            f"{note}"
+        )
+    exact = law.exact_layer
+    if exact is None or law.thickness is None:
+        return out
+    chi = float(law.layer_ratio(delta_max))
+    if chi > exact.reach:
+        out.append(
+            f"layer ratio sqrt(R delta)/h = {chi:.3g} beyond the exact layer law's trusted "
+            f"domain (chi <= {exact.reach:.3g}): the thickness correction is extrapolated"
+        )
+    strain = delta_max / law.thickness
+    if strain > LAYER_STRAIN_MAX:
+        out.append(
+            f"the layer is compressed by delta/h = {strain:.3g} > {LAYER_STRAIN_MAX:g}: "
+            f"finite strain, outside every linear law, moves the force by several %"
+        )
+    return out
+
+
+def _series_warnings(law: ContactLaw, delta_max: float) -> list[str]:
+    """The Dimitriadis series' flags: Hertz's limits said as corrected, chi past CHI_MAX."""
     out: list[str] = []
     hv = hertz_validity(delta_max, law.tip_radius, law.thickness)
     for warning in hv.warnings:
@@ -302,12 +397,4 @@ def validity_warnings(
             f"layer ratio sqrt(R delta)/h = {chi:.3g} beyond the Dimitriadis series' range "
             f"(chi <= {CHI_MAX:g}): the thickness correction is extrapolated"
         )
-    if misalignment is not None:
-        if not math.isfinite(misalignment):
-            raise ValueError(f"misalignment must be finite (rad), got {misalignment!r}")
-        if abs(misalignment) > MAX_MISALIGNMENT:
-            out.append(
-                f"sensor {math.degrees(abs(misalignment)):.1f} deg off the surface normal "
-                f"(> {math.degrees(MAX_MISALIGNMENT):g} deg): the indentation is not normal"
-            )
-    return tuple(out)
+    return out

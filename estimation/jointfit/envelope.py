@@ -34,9 +34,9 @@ FloatArray = NDArray[np.float64]
 
 
 def other_forms(law: ContactLaw) -> tuple[ContactLaw, ...]:
-    """The equally defensible variants of ``law`` (the other thin-layer ratio with Sneddon's
-    sphere; none when the choice does not arise)."""
-    if law.thickness is None or not law.large_indentation:
+    """The equally defensible variants of ``law`` (the other thin-layer ratio of the Dimitriadis
+    series with Sneddon's sphere; none when the choice does not arise, as with the exact law)."""
+    if law.thickness is None or not law.large_indentation or law.layer_law == "exact":
         return ()
     if law.layer_ratio_from == "published":
         return (dataclasses.replace(law, layer_ratio_from="sphere"),)

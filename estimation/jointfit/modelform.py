@@ -52,8 +52,13 @@ def model_form(law: ContactLaw, max_depth: float) -> ModelForm:
     """The model-form uncertainty of ``law`` at depth ``max_depth`` (m, >= 0)."""
     if not (math.isfinite(max_depth) and max_depth >= 0.0):
         raise ValueError(f"max_depth must be finite and >= 0 m, got {max_depth!r}")
+    strain = max_depth / law.tip_radius
+    if law.layer_law == "exact":
+        if law.thickness is not None:
+            strain = max(strain, max_depth / law.thickness)
+        return ModelForm(0.0, FINITE_STRAIN * strain)
     chi = float(law.layer_ratio(max_depth))
-    return ModelForm(LAYER_SERIES * chi * chi, FINITE_STRAIN * max_depth / law.tip_radius)
+    return ModelForm(LAYER_SERIES * chi * chi, FINITE_STRAIN * strain)
 
 
 def widened(modulus: float, ci_low: float, ci_high: float, eps: float) -> tuple[float, float]:

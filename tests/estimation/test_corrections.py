@@ -182,21 +182,40 @@ def test_the_simulator_uses_the_same_constants() -> None:
         assert tissue.layer_coefficients() == layer_coefficients(0.45, bonded)
     # the sim's composition (chi = a/h with Sneddon's a) is the estimator's alternative one
     tissue = TissueModel(1.0, 0.45, 10e-3, True, R, True, True)
-    law = ContactLaw(R, 0.45, 10e-3, True, True, "sphere")
+    law = ContactLaw(R, 0.45, 10e-3, True, True, "sphere", layer_law="dimitriadis")
     np.testing.assert_allclose(law.shape(DEPTHS)[0], tissue.force(DEPTHS), rtol=1e-12)
     published = ContactLaw(R, 0.45, 10e-3)
     assert not np.allclose(published.shape(DEPTHS)[0], tissue.force(DEPTHS), rtol=1e-3)
 
 
-def test_validity_warnings() -> None:
-    law = ContactLaw(R, 0.45, 10e-3)
+def test_validity_warnings_of_the_series() -> None:
+    law = ContactLaw(R, 0.45, 10e-3, layer_law="dimitriadis")
     assert validity_warnings(law, 1e-5) == ()
     deep = validity_warnings(law, 1e-3, misalignment=math.radians(8))
     assert any("Sneddon" in w for w in deep)
     assert any("Dimitriadis thin-layer correction applied" in w for w in deep)
     assert any("8.0 deg off the surface normal" in w for w in deep)
-    thin = validity_warnings(ContactLaw(R, 0.45, 1e-3), 1e-3)
+    thin = validity_warnings(ContactLaw(R, 0.45, 1e-3, layer_law="dimitriadis"), 1e-3)
     assert any("beyond the Dimitriadis series' range" in w for w in thin)
+
+
+def test_validity_warnings_of_the_exact_law_name_its_trusted_domain() -> None:
+    law = ContactLaw(R, 0.45, 10e-3)
+    assert validity_warnings(law, 1e-5) == ()
+    deep = validity_warnings(law, 1e-3, misalignment=math.radians(8))
+    assert len(deep) == 2  # the sphere's depth (corrected) and the misalignment
+    assert any("corrected with Sneddon's sphere" in w for w in deep)
+    assert any("8.0 deg off the surface normal" in w for w in deep)
+    # chi = sqrt(3.5 * 1)/1 = 1.87: inside the exact law's domain, but the layer is compressed
+    thin = validity_warnings(ContactLaw(R, 0.45, 1e-3), 1e-3)
+    assert not any("layer ratio" in w for w in thin)
+    assert any("compressed by delta/h = 1" in w for w in thin)
+    very_thin = validity_warnings(ContactLaw(R, 0.45, 0.3e-3), 0.2e-3)  # chi = 2.8
+    assert not any("layer ratio" in w for w in very_thin)
+    beyond = validity_warnings(ContactLaw(R, 0.45, 0.3e-3), 0.4e-3)  # chi = 3.9
+    assert any("beyond the exact layer law's trusted domain" in w for w in beyond)
+    past = validity_warnings(ContactLaw(R, 0.45, None), 1.2 * R)
+    assert any("beyond the exact law's trusted depth" in w for w in past)
     hertz = validity_warnings(ContactLaw(R, 0.45, None, large_indentation=False), 1e-3)
     assert any("small-strain" in w and "corrected" not in w for w in hertz)
 

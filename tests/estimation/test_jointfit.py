@@ -127,7 +127,9 @@ def test_a_zero_error_on_the_load_is_fitted_not_absorbed_by_the_modulus() -> Non
 def test_interval_holds_the_modulus_whichever_layer_ratio_the_sample_follows() -> None:
     # the sample follows chi = a/h, the estimate uses the published sqrt(R delta)/h; with little
     # noise the gap between the two is larger than the noise interval
-    sphere = ContactLaw(3.5e-3, 0.45, 5e-3, bonded=True, layer_ratio_from="sphere")
+    sphere = ContactLaw(
+        3.5e-3, 0.45, 5e-3, bonded=True, layer_ratio_from="sphere", layer_law="dimitriadis"
+    )
     rng = np.random.default_rng(8)
     u, P, e = curve(400e3, 0.0, rng, law=sphere)
     P = sphere.force(400e3, np.clip(u - e, 0.0, None)) + rng.normal(0.0, 1e-4, u.size)
@@ -146,9 +148,13 @@ def test_interval_holds_the_modulus_whichever_layer_ratio_the_sample_follows() -
 
 
 def test_model_form_spread_widens_the_interval_on_thin_layers_only() -> None:
+    # the Dimitriadis series' two layer ratios; the exact law has one form and no spread
     rng = np.random.default_rng(4)
-    u, P, e = curve(400e3, 0.0, rng)
-    thin = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0)
+    series = dataclasses.replace(LAW, layer_law="dimitriadis")
+    u, P, e = curve(400e3, 0.0, rng, law=series)
+    thin = joint_fit(u, P, e, series, sigma_force=SIGMA_P, contact_guess=0.0)
+    exact = joint_fit(u, P, e, LAW, sigma_force=SIGMA_P, contact_guess=0.0)
+    assert exact.model_spread == 0.0
     half = ContactLaw(3.5e-3, 0.45, None)
     u2, P2, e2 = curve(400e3, 0.0, rng, law=half)
     thick = joint_fit(u2, P2, e2, half, sigma_force=SIGMA_P, contact_guess=0.0)
