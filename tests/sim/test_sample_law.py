@@ -138,7 +138,9 @@ def test_description_names_the_table() -> None:
     assert describe(SAMPLE, FidelityConfig(tissue_model="closed-form"), R)["level"] == "closed-form"
 
 
-SCENES = sorted(Path(resolve("scenes/bench.yaml")).parent.glob("*.yaml"))
+SCENES = sorted(Path(resolve("scenes/bench.yaml")).parent.glob("*.yaml")) + sorted(
+    Path(resolve("scenes/bench.yaml")).parent.glob("layers/*.yaml")
+)
 
 
 @pytest.mark.parametrize("path", SCENES, ids=lambda p: p.name)
