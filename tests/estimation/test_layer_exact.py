@@ -70,12 +70,12 @@ def test_the_half_space_law_is_hertz_and_sneddon_exactly() -> None:
 def test_nystrom_converges(rho: float) -> None:
     kernel = kernel_transform(0.49, True)
     alpha = np.array([0.3, 0.6]) if math.isfinite(rho) else np.array([0.3, 1.5, 3.0, 6.0])
-    coarse = solve_contact(alpha, rho, kernel, nodes=3)
+    coarse = solve_contact(alpha[:2], rho, kernel, nodes=3)
     fine = solve_contact(alpha, rho, kernel, nodes=32)
     finer = solve_contact(alpha, rho, kernel, nodes=64)
     # what is left between 32 and 64 nodes is the kernel's interpolation (~1e-7 to 3e-6)
     np.testing.assert_allclose(fine.force, finer.force, rtol=1e-5)
-    assert np.max(np.abs(coarse.force / finer.force - 1)) > np.max(
+    assert np.max(np.abs(coarse.force / finer.force[:2] - 1)) > np.max(
         np.abs(fine.force / finer.force - 1)
     )
 
