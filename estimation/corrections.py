@@ -342,8 +342,9 @@ def validity_warnings(
 def exact_domain_warnings(law: ContactLaw, delta_max: float) -> list[str]:
     """Where ``law`` (the exact layer law) is used past its trusted domain at depth
     ``delta_max`` (m): the sphere's depth (DEPTH_RATIO_MAX), the layer ratio its tables reach
-    (``estimation.layer_table.CHI_MAX`` or less), the layer's compression (LAYER_STRAIN_MAX). Each is a reason
-    for ``suspect``; the half-space depth is said as corrected (Sneddon's sphere is exact)."""
+    (``estimation.layer_table.CHI_MAX`` or less), the layer's compression (LAYER_STRAIN_MAX).
+    Each is a reason for ``suspect``; the half-space depth is said as corrected (Sneddon's
+    sphere is exact)."""
     out: list[str] = []
     depth_ratio = delta_max / law.tip_radius
     if depth_ratio > DEPTH_RATIO_MAX:

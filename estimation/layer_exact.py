@@ -54,7 +54,7 @@ linear interpolation errs by < 1e-6 there (M'' is of order 0.1)."""
 NODES = 32
 
 
-class LayerSolveFailed(ValueError):
+class LayerSolveError(ValueError):
     """The layer's contact equation has no admissible solution at the asked contact radius (an
     edge condition with no positive pressure, or a non-finite result)."""
 
@@ -118,13 +118,13 @@ def solve_contact(
     ``rho`` = R/h (``math.inf``: Hertz's paraboloid). All radii are solved as one batch.
 
     Raises:
-        LayerSolveFailed: alpha outside (0, min(rho, KERNEL_X_MAX/2)), or a radius with no
+        LayerSolveError: alpha outside (0, min(rho, KERNEL_X_MAX/2)), or a radius with no
             admissible solution (g1(a) <= 0 or a non-finite load).
     """
     a = np.atleast_1d(np.asarray(alpha, dtype=np.float64))
     top = min(rho, 0.5 * KERNEL_X_MAX)
     if not np.all(np.isfinite(a) & (a > 0.0) & (a < top)):
-        raise LayerSolveFailed(f"contact radius a/h must be in (0, {top:.4g}), got {a.min():.4g}")
+        raise LayerSolveError(f"contact radius a/h must be in (0, {top:.4g}), got {a.min():.4g}")
     g, w = np.polynomial.legendre.leggauss(nodes)
     tau = a[:, None] * (0.5 * (g + 1.0))
     wt = a[:, None] * (0.5 * w)
@@ -139,9 +139,9 @@ def solve_contact(
     g1a = 1.0 - np.sum(edge * wt * g1, axis=1)
     g2a = _profile(a, rho) - np.sum(edge * wt * g2, axis=1)
     if not np.all(np.isfinite(g1a) & (g1a > 0.0)):
-        raise LayerSolveFailed("the layer's contact equation has no positive edge solution")
+        raise LayerSolveError("the layer's contact equation has no positive edge solution")
     depth = g2a / g1a
     force = 2.0 * (depth * np.sum(wt * g1, axis=1) - np.sum(wt * g2, axis=1))
     if not np.all(np.isfinite(force) & (force > 0.0)):
-        raise LayerSolveFailed("the layer's contact load is not finite and positive")
+        raise LayerSolveError("the layer's contact load is not finite and positive")
     return LayerContact(a, np.asarray(depth), np.asarray(force))

@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from estimation.belief import Belief, Hypothesis
 from estimation.corrections import ContactLaw
+from estimation.jointfit.beliefcheck import contradictions
 from estimation.jointfit.envelope import Found, envelope, profile_hypotheses
 from estimation.jointfit.noise import Noise, frozen_noise, profile_span, require_significance
 from estimation.jointfit.record import Record, check_options, checked_record
@@ -125,7 +126,7 @@ def _profiled(
     if best != fit.hypothesis:
         fit = refit.at_best(best, found)
         require_contact(fit, min_contact_points)
-    return envelope(
+    result = envelope(
         fit,
         noise,
         found,
@@ -135,6 +136,17 @@ def _profiled(
         belief.open_keys,
         len(hypotheses),
     )
+    # 5. can the record contradict what the belief states as a point?
+    compliance = fit.hypothesis.compliance
+    base = (record.depth_base_at(compliance), weights_at(compliance))
+    start = refit.start
+    window = (max(start.lo, fit.contact - 3.0 * span), min(start.hi, fit.contact + 3.0 * span))
+    found_against = contradictions(
+        belief, fit.hypothesis.law, base, record.force, window, start.load_offset, noise.scale2
+    )
+    if not found_against:
+        return result
+    return dataclasses.replace(result, warnings=result.warnings + found_against)
 
 
 @dataclass(frozen=True)

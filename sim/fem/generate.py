@@ -3,7 +3,8 @@
 The shipped problems are the scenes' samples: the paper's phantoms (tip R = 3.5 mm, 10 mm layers
 in a 40 mm radius dish, nu = 0.45, bonded, frictionless and full stick; linear and neo-Hookean), the
 soft-tissue designs (R = 6 mm, 20 mm layers), the half-space stand-in (a block 200 R deep and
-wide, nu = 0.45, for any tip: ``sim.sample_law``) and the layers of ``config/scenes/layers/``. tests/sim/test_sample_law.py checks that every
+wide, nu = 0.45, for any tip: ``sim.sample_law``) and the layers of ``config/scenes/layers/``.
+tests/sim/test_sample_law.py checks that every
 sample of the shipped scenes finds its table here. Each table is solved afresh, written to
 ``sim/fem/tables/<key>.npz``, and its key, build time and status printed; tables that no shipped
 problem names any more are removed. Options: ``--only NAME`` (repeatable), ``--list``.
@@ -35,15 +36,14 @@ SHIPPED: dict[str, LayerProblem] = {
         thickness_ratio=200.0, radius_ratio=200.0, poisson=0.45, contact="stick"
     ),
 }
-_LAYERS = {"tip_radius": 3.5e-3, "radius": 40e-3, "contact": "frictionless"}
 for _h in (1.5e-3, 3e-3, 5e-3):
     for _nu, _base in ((0.45, "bonded"), (0.45, "sliding"), (0.49, "bonded"), (0.49, "sliding")):
         SHIPPED[f"layers-{_h * 1e3:g}mm-{_base}-nu{_nu:g}"] = LayerProblem.from_dimensions(
-            **_LAYERS, thickness=_h, poisson=_nu, base=_base
+            3.5e-3, _h, 40e-3, poisson=_nu, base=_base, contact="frictionless"
         )
 for _h in (20e-3, 30e-3):
     SHIPPED[f"layers-deep-{_h * 1e3:g}mm"] = LayerProblem.from_dimensions(
-        **_LAYERS, thickness=_h, poisson=0.45
+        3.5e-3, _h, 40e-3, poisson=0.45, contact="frictionless"
     )
 """The problems whose tables ship in ``sim/fem/tables``, by name: the paper's and the soft
 designs' phantoms, the half-space stand-in, and the thin and deep layers of
