@@ -151,10 +151,10 @@ def assess(
 
 
 def _contact_ratio(R: FloatArray, delta_soft: FloatArray, c: DesignConstraints) -> FloatArray:
-    """(N,) a/h at E_min with Hertz's a = sqrt(R delta); NaN for a half-space."""
+    """(N,) the layer's compression delta/h at E_min; NaN for a half-space."""
     if c.thickness is None:
         return np.full_like(R, math.nan)
-    return np.asarray(np.sqrt(R * delta_soft) / c.thickness)
+    return np.asarray(delta_soft / c.thickness + 0.0 * R)
 
 
 def _detection_strain(
@@ -222,10 +222,10 @@ def _checks(
         return np.full_like(depth_ratio, value)
 
     checks: dict[str, tuple[FloatArray, FloatArray, bool]] = {
-        "hertz_depth": (depth_ratio, limit(c.max_depth_ratio), True)
+        "depth": (depth_ratio, limit(c.max_depth_ratio), True)
     }
     if c.thickness is not None:
-        checks["thickness"] = (contact_ratio, limit(c.max_contact_ratio), True)
+        checks["thickness"] = (contact_ratio, limit(c.max_layer_strain), True)
     checks["resolution"] = (delta_stiff, limit(c.resolution_multiple * c.encoder_resolution), False)
     checks["detection"] = (detection, floor, False)
     checks["delta_bias"] = (bias, c.max_bias_fraction * delta_stiff, True)

@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 from estimation.design.space import SensorDesign
 
 CHECKS: dict[str, str] = {
-    "hertz_depth": "Hertz small strain at E_min: delta/R <= max_depth_ratio",
-    "thickness": "half-space at E_min: contact radius / thickness <= max_contact_ratio",
+    "depth": "the estimator's trusted sphere depth at E_min: delta/R <= max_depth_ratio",
+    "thickness": "the layer's trusted compression at E_min: delta/h <= max_layer_strain",
     "resolution": "measurable at E_max: delta >= resolution_multiple x encoder resolution",
     "detection": "buckling detectable: grating strain norm at e_det >= pre-load norm + noise",
     "delta_bias": "stage travel that is not indentation <= max_bias_fraction x delta at E_max",

@@ -43,7 +43,7 @@ def _depth_window(rng: tuple[float, float], space: DesignSpace, c: DesignConstra
     for R in space.tip_radii:
         ceiling = c.max_depth_ratio * R
         if c.thickness is not None:
-            ceiling = min(ceiling, (c.max_contact_ratio * c.thickness) ** 2 / R)
+            ceiling = min(ceiling, c.max_layer_strain * c.thickness)
         if ceiling / floor > best_ratio:
             best_ratio, best_r, best_ceiling = ceiling / floor, R, ceiling
     if best_ratio >= need:
@@ -52,8 +52,9 @@ def _depth_window(rng: tuple[float, float], space: DesignSpace, c: DesignConstra
     return (
         f"the modulus range is too wide for any sensor{where}: one sensor's indentation at "
         f"buckling scales as E**(-2/3), so E_max/E_min = {rng[1] / rng[0]:.3g} needs a depth "
-        f"ratio of {need:.3g}, but Hertz validity (delta/R <= {c.max_depth_ratio:g}"
-        + ("" if c.thickness is None else f", a/h <= {c.max_contact_ratio:g}")
+        f"ratio of {need:.3g}, but the estimator's trusted domain (delta/R <= "
+        f"{c.max_depth_ratio:g}"
+        + ("" if c.thickness is None else f", delta/h <= {c.max_layer_strain:g}")
         + f") caps delta at {best_ceiling * 1e3:.3g} mm (best tip R = {best_r * 1e3:g} mm) and "
         f"the encoder needs delta >= {c.resolution_multiple:g} x "
         f"{c.encoder_resolution * 1e6:.3g} um = {floor * 1e3:.3g} mm: a ratio of "

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from estimation.hertz import MAX_CONTACT_RATIO, MAX_DEPTH_RATIO
+from estimation.corrections import LAYER_STRAIN_MAX
 from estimation.section import Section, composite_section, euler_load
 
 FloatArray = NDArray[np.float64]
@@ -81,7 +81,12 @@ class DesignConstraints:
         thickness: tissue layer thickness h (m); None for a half-space (no a/h check).
         encoder_resolution: stage travel per encoder count (m): lead / 4096 for the lead screw.
         resolution_multiple: the smallest indentation, in encoder counts.
-        max_depth_ratio, max_contact_ratio: Hertz validity limits (``estimation.hertz``).
+        max_depth_ratio: the deepest sphere indentation delta/R the estimate should rely on:
+            DESIGN_DEPTH_RATIO, where the exact law's finite-strain bound reaches 5 %
+            (``estimation.jointfit.modelform``; the law's tables reach delta/R = 1).
+        max_layer_strain: the layer's trusted compression delta/h (the exact layer law's
+            domain, ``estimation.corrections.LAYER_STRAIN_MAX``; it also keeps chi =
+            sqrt(R delta)/h within the law's 3 for any R < 45 h).
         strain_limit: the fiber's strain limit (dimensionless).
         strain_noise: FBG strain noise per grating, 1 sigma (dimensionless): sigma_pm / k'_eps.
         noise_sigmas: detection floor above the pre-load, in units of ``strain_noise``.
@@ -104,8 +109,8 @@ class DesignConstraints:
     thickness: float | None = 20 * MM
     encoder_resolution: float = 20 * MM / 4096
     resolution_multiple: float = 20.0
-    max_depth_ratio: float = MAX_DEPTH_RATIO
-    max_contact_ratio: float = MAX_CONTACT_RATIO
+    max_depth_ratio: float = 0.5
+    max_layer_strain: float = LAYER_STRAIN_MAX
     strain_limit: float = 5e-3
     strain_noise: float = 1.0 / 0.424 * 1e-6
     noise_sigmas: float = 6.0
@@ -128,7 +133,7 @@ class DesignConstraints:
             "encoder_resolution",
             "resolution_multiple",
             "max_depth_ratio",
-            "max_contact_ratio",
+            "max_layer_strain",
             "strain_limit",
             "detection_fraction",
             "max_bias_fraction",

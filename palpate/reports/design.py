@@ -43,7 +43,7 @@ def design_dict(result: DesignResult, unit_name: str) -> dict[str, Any] | None:
         "delta_at_min_modulus_mm": ev.delta_soft * 1e3,
         "delta_at_max_modulus_mm": ev.delta_stiff * 1e3,
         "depth_ratio_at_min_modulus": ev.depth_ratio,
-        "contact_ratio_at_min_modulus": None if math.isnan(ev.contact_ratio) else ev.contact_ratio,
+        "layer_strain_at_min_modulus": None if math.isnan(ev.contact_ratio) else ev.contact_ratio,
         "delta_bias_um": ev.delta_bias * 1e6,
         "detector_threshold_ue": None if ev.threshold is None else ev.threshold * 1e6,
         "peak_fiber_strain_ue": ev.peak_strain * 1e6,
@@ -139,7 +139,7 @@ def _design_rows(
         ("P_cr", f"{ev.critical_load * 1e3:.3g} mN"),
         (
             f"delta at {lo / unit:g} {unit_name}",
-            f"{ev.delta_soft * 1e3:.3f} mm (delta/R {ev.depth_ratio:.3f}, a/h "
+            f"{ev.delta_soft * 1e3:.3f} mm (delta/R {ev.depth_ratio:.3f}, delta/h "
             f"{ev.contact_ratio:.3f})",
         ),
         (

@@ -19,19 +19,19 @@ def test_design_for_soft_tissue_and_its_simulated_check(capsys: pytest.CaptureFi
     assert out["success"] is True
     d = out["design"]
     assert d["modulus_range_kpa"] == [1.0, 10.0]
-    assert d["depth_ratio_at_min_modulus"] <= 0.1
-    assert d["contact_ratio_at_min_modulus"] <= 0.1
+    assert d["depth_ratio_at_min_modulus"] <= 0.5
+    assert d["layer_strain_at_min_modulus"] <= 0.2
     assert d["delta_at_max_modulus_mm"] * 1e-3 >= 20 * out["encoder_resolution_um"] * 1e-6
     assert all(c["ok"] for c in d["checks"])
-    assert d["critical_load_mn"] < 10  # the paper's sensor buckles at 1353 mN
+    assert d["critical_load_mn"] < 100  # the paper's sensor buckles at 1353 mN
     trials = out["campaign"]["trials"]
     assert [t["actual_kpa"] for t in trials] == pytest.approx([1.0, 10**0.5, 10.0])
     assert {t["exposed_length_mm"] for t in trials} == {round(d["exposed_length_mm"], 1)}
-    # the soft sensor reaches DONE on every phantom, and the paper's estimate lands close:
-    # the remaining error is the layer (a/h ~ 0.09) and large-indentation bias of the tissue
+    # the soft sensor reaches DONE on every phantom; the paper's Hertz estimate errs by the
+    # layer and the depth the exact law now allows (delta/R up to 0.5), within a few tens of %
     assert all(t["state"] == "done" for t in trials)
-    assert all(abs(t["relative_error_paper"]) < 0.25 for t in trials)
-    assert out["campaign"]["paper"]["median_abs_relative_error"] < 0.2
+    assert all(abs(t["relative_error_paper"]) < 0.5 for t in trials)
+    assert out["campaign"]["paper"]["median_abs_relative_error"] < 0.35
 
 
 def test_text_output_without_the_campaign(capsys: pytest.CaptureFixture[str]) -> None:
@@ -45,7 +45,7 @@ def test_text_output_without_the_campaign(capsys: pytest.CaptureFixture[str]) ->
 
 
 def test_an_impossible_range_exits_2_and_says_why(capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["design", "--modulus-range", "1:100", "--json", *QUICK])
+    code = main(["design", "--modulus-range", "1:1000", "--json", *QUICK])
     out = json.loads(capsys.readouterr().out)
     assert code == 2
     assert out["success"] is False
