@@ -45,7 +45,7 @@ def test_joint_fit_is_close_with_an_interval_and_flags(outcomes: list[TrialOutco
         assert o.joint.ci_low is not None
         assert o.joint.ci_high is not None
         assert o.joint.ci_low < joint < o.joint.ci_high
-        assert any("Dimitriadis" in w for w in o.joint.warnings)
+        assert "exact bonded layer" in (o.joint.law or "")
 
 
 def test_results_and_logs_carry_both_estimates(outcomes: list[TrialOutcome]) -> None:
