@@ -353,11 +353,9 @@ def exact_domain_warnings(law: ContactLaw, delta_max: float) -> list[str]:
             f"> {DEPTH_RATIO_MAX:g} (the law is extrapolated)"
         )
     elif depth_ratio > MAX_DEPTH_RATIO_HERTZ:
-        note = (
-            "corrected with Sneddon's sphere (linear elasticity still assumed)"
-            if law.large_indentation
-            else "the paraboloid departs from the sphere"
-        )
+        note = "the paraboloid departs from the sphere"
+        if law.large_indentation:
+            note = "corrected with Sneddon's sphere (linear elasticity still assumed)"
         out.append(
             f"indentation beyond Hertz's small-strain range: delta/R up to {depth_ratio:.3g}; "
             f"{note}"
