@@ -64,10 +64,12 @@ class SampleConfig:
 
     Truth: ``modulus_kpa``, ``poisson``, ``thickness_mm`` (null = half-space) on a rigid base,
     ``bonded`` to it or sliding, ``material`` (linear elastic or neo-Hookean),
-    ``lateral_radius_mm`` (the sample's finite lateral size), a standard-linear-solid relaxation
-    (``relaxation_time_s``, null = elastic, and ``relaxed_ratio`` = E_inf / E_0, used where the
-    scene's fidelity switches viscoelasticity on; ``modulus_kpa`` is then the relaxed modulus
-    E_inf), the Coulomb ``friction`` between tip and surface (0.5 by default, silicone or gel on
+    ``lateral_radius_mm`` (the sample's finite lateral size), a relaxation (``relaxation``:
+    ``sls``, a standard linear solid, or ``power-law``, ``G = r + (1 - r)(1 + t/tau)^-beta`` with
+    ``relaxation_exponent`` beta; ``relaxation_time_s`` tau, null = elastic, and
+    ``relaxed_ratio`` r = E_inf / E_0, used where the scene's fidelity switches viscoelasticity
+    on; ``modulus_kpa`` is then the relaxed modulus E_inf: ``sim.viscoelastic``), the Coulomb
+    ``friction`` between tip and surface (0.5 by default, silicone or gel on
     a printed sphere: an oblique contact slips where tan(misalignment) exceeds it; the normal
     force law takes the nearer of the FE's frictionless and full-stick limits:
     ``sim.sample_law.contact_condition``), and ``rigid`` (a rigid reference for calibrating the
@@ -94,6 +96,8 @@ class SampleConfig:
     lateral_radius_mm: float = field(default=40.0, metadata=limits(gt=0, le=1000))
     relaxation_time_s: float | None = field(default=None, metadata=limits(gt=0, le=1e4))
     relaxed_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1))
+    relaxation: Literal["sls", "power-law"] = "sls"
+    relaxation_exponent: float = field(default=0.5, metadata=limits(gt=0, le=3))
     friction: float = field(default=0.5, metadata=limits(ge=0, le=5))
     rigid: bool = False
     tilt_deg: float = field(default=0.0, metadata=limits(ge=0, le=80))

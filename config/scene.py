@@ -81,7 +81,14 @@ class CampaignConfig:
     standoff_mm: float = field(default=1.0, metadata=limits(gt=0, le=50))
     approach_speed_mm_per_s: float = field(default=2.0, metadata=limits(gt=0, le=100))
     indent_speed_mm_per_s: float = field(default=0.5, metadata=limits(gt=0, le=100))
+    # Each trial at each of these speeds instead (a viscoelastic scene's speed sweep); empty:
+    # indent_speed_mm_per_s alone.
+    indent_speeds_mm_per_s: tuple[float, ...] = field(default=(), metadata=limits(gt=0, le=100))
     post_buckling_mm: float = field(default=0.3, metadata=limits(ge=0, le=20))
+    # Stand still this long after the post-buckling travel: a creep test the gratings record, from
+    # which the estimator reads the relaxed and instantaneous moduli (estimation.relaxation);
+    # 0: no hold (an elastic sample needs none). docs/viscoelastic.md has the length's table.
+    hold_s: float = field(default=0.0, metadata=limits(ge=0, le=50))
     max_travel_past_contact_mm: float = field(default=2.5, metadata=limits(gt=0, le=50))
     contact: Literal["event", "fbg"] = "event"
     detector: Literal["paper", "cusum"] = "paper"
@@ -99,6 +106,10 @@ class CampaignConfig:
     # x axis): what fixes the normal's tilt along the tube's bend, so the roll span per tube.
     probe_sagitta_mm: float = field(default=3.0, metadata=limits(gt=0, le=50))
     probe_touch_ue: float = field(default=25.0, metadata=limits(gt=0, le=1000))  # light touch
+
+    def speeds_mm_per_s(self) -> tuple[float, ...]:
+        """The indentation speeds the campaign runs each trial at (mm/s)."""
+        return self.indent_speeds_mm_per_s or (self.indent_speed_mm_per_s,)
 
     def probing(self) -> bool | Literal["measure"]:
         """Whether trials probe: ``probe`` itself, or for null, robot campaigns only."""

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline  # type: ignore[import-untyped,unused-ignore]
 
 from estimation.layer_exact import kernel_transform, solve_contact
+from estimation.sneddon import sneddon_bracket, sneddon_y
 
 FloatArray = NDArray[np.float64]
 
@@ -54,15 +55,11 @@ FACTOR_POINTS = 257
 
 def _sneddon_radius(depth_ratio: FloatArray) -> FloatArray:
     """a/R of Sneddon's sphere on a half-space at delta/R: tanh y with y tanh y = delta/R."""
-    from estimation.corrections import sneddon_y  # corrections imports this module
-
     return np.asarray(np.tanh(sneddon_y(depth_ratio)))
 
 
 def _sneddon_force(depth_ratio: FloatArray) -> FloatArray:
     """F / (E* R^2) of Sneddon's sphere on a half-space at delta/R."""
-    from estimation.corrections import sneddon_bracket, sneddon_y
-
     y = sneddon_y(depth_ratio)
     return np.asarray(sneddon_bracket(y, np.tanh(y)))
 

@@ -14,7 +14,9 @@ A number is only as good as what it assumed. The verdict reads the joint fit
   (the model misses part of the curve), a validity flag the law does not correct (thin-layer
   series extrapolated, misalignment past 5 deg), the misalignment beyond the campaign's
   tolerance, an uncalibrated compliance (the interval was widened over its plausible range),
-  or a trial that did not end ``done``.
+  or a trial that did not end ``done``, or a hold that shows the tissue relaxing (the elastic
+  number then depends on the indentation speed; the relaxation fit's own verdict,
+  :func:`relaxed_verdict`, judges the relaxed modulus).
 - ``ok``: none of these.
 
 Tables count trials per verdict, take medians over ``ok`` only, and the interval's coverage over
@@ -33,6 +35,7 @@ from estimation.corrections import ContactLaw
 from estimation.jointfit import JointFit
 from estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
 from estimation.misalignment import Lean
+from estimation.relaxation import RelaxationFit
 
 Status = Literal["ok", "suspect", "none"]
 STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")
@@ -86,6 +89,7 @@ class TrialFacts:
             by the operator (no probing); False when probing could not measure a normal.
         lean: the load's lean measured from the strains (``estimation.misalignment``).
         misalignment_sigma: the measured normal's 1-sigma angle (rad), None if not measured.
+        relaxation: the relaxation fit of a trial that held (``estimation.relaxation``).
     """
 
     state: str = "done"
@@ -98,6 +102,7 @@ class TrialFacts:
     orientation_verified: bool = True
     lean: Lean | None = None
     misalignment_sigma: float | None = None
+    relaxation: RelaxationFit | None = None
 
 
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
@@ -112,6 +117,19 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
     imprecise = _imprecise(fit)
     if imprecise is not None:
         reasons.append(imprecise)
+    reasons += _trial_reasons(facts)
+    if facts.relaxation is not None and facts.relaxation.relaxes:
+        reasons.append(
+            f"{facts.relaxation.summary()}: the elastic estimate is an apparent modulus at this "
+            "indentation speed, between the two; the relaxed modulus is the tissue's long-time one"
+        )
+    return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+
+
+def _trial_reasons(facts: TrialFacts) -> list[str]:
+    """Why any number of this trial is suspect, whatever the model: the rig's compliance, the
+    misalignment and orientation, how the trial ended."""
+    reasons: list[str] = []
     if not facts.compliance_calibrated:
         reasons.append(
             "the rig's compliance is not calibrated: the interval spans its plausible range "
@@ -126,7 +144,7 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
     reasons.extend(_orientation(facts))
     if facts.state != "done":
         reasons.append(f"the trial ended in {facts.state}: {facts.reason}")
-    return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+    return reasons
 
 
 def _orientation(facts: TrialFacts) -> list[str]:
@@ -226,3 +244,29 @@ def _depth_to_buckle(fit: JointFit | None, facts: TrialFacts, tip_radius: float)
         return math.inf
     compliance = float(best.get("compliance", 0.0))  # type: ignore[arg-type]
     return float(depth[k]) + compliance * p_cr
+
+
+def relaxed_verdict(
+    fit: RelaxationFit | None, elastic: Verdict, facts: TrialFacts
+) -> Verdict | None:
+    """The verdict on the relaxed modulus of a trial that held (None without a hold): ``none``
+    without a fit or without a number from the trial; ``suspect`` where the relaxation is not
+    complete within the record (the modulus is extrapolated), the interval is wider than
+    ``IMPRECISE``, or the trial has a reason of its own (a
+    misalignment, an unverified orientation, a trial that did not end ``done``: they concern the
+    relaxed number as much; the elastic fit's own misfit, which relaxation causes, does not);
+    else ``ok``. An elastic record (no relaxation) says so, and its
+    relaxed modulus is the elastic one."""
+    if fit is None:
+        return None
+    if not fit.success or fit.relaxed is None or not elastic.has_number:
+        why = fit.message if not fit.success else "no elastic estimate to start from"
+        return Verdict("none", (f"no relaxed modulus: {why}",))
+    reasons = _trial_reasons(facts) + list(fit.warnings)
+    lo, hi, e = fit.relaxed_low, fit.relaxed_high, fit.relaxed
+    if lo is not None and hi is not None and e > 0 and max(e - lo, hi - e) / e > IMPRECISE:
+        reasons.append(
+            f"imprecise: the relaxed modulus's interval spans -{100 * (e - lo) / e:.0f} % / "
+            f"+{100 * (hi - e) / e:.0f} %, beyond +-{100 * IMPRECISE:.0f} %"
+        )
+    return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")

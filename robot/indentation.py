@@ -8,7 +8,11 @@ touches hardware, so the same machine runs on the bench, on the emulators and in
 States and the normal path::
 
     IDLE -> HOMING -> POSITIONING -> APPROACH -> CONTACT -> INDENTING -> BUCKLED
-         -> RETRACTING -> DONE
+         [-> HOLDING] -> RETRACTING -> DONE
+
+With ``TrialPlan.hold_time`` > 0 the stage then stands still that long: the buckled beam is
+nearly a constant-force spring, so the hold is a creep test the gratings record
+(``estimation.relaxation``); a contact phase, every guard applies.
 
 With a ``prober`` (``robot.probing``) the first arrival at the stand-off goes to PROBING
 instead: light touches around the plan, a fitted surface, and the pose orthogonal to it, which
@@ -47,6 +51,7 @@ class State(enum.Enum):
     CONTACT = "contact"
     INDENTING = "indenting"
     BUCKLED = "buckled"
+    HOLDING = "holding"
     RETRACTING = "retracting"
     DONE = "done"
     FAULT = "fault"
@@ -74,6 +79,7 @@ class TrialPlan:
     indent_speed: float = 0.5e-3
     roll_tolerance: float = 2e-3
     position_tolerance: float = 5e-6
+    hold_time: float = 0.0  # s at rest after the post-buckling travel (a creep test); 0: none
 
 
 @dataclass(frozen=True)
@@ -132,6 +138,11 @@ class IndentationMachine:
     _last_command: Command | None = None
     _first_touch: float | None = None  # advance at the first contact event, planned or not
     _lost_since: float | None = None  # time the servo replies were lost while retracting
+
+    def __post_init__(self) -> None:
+        hold, timeout = self.plan.hold_time, self.guards.state_timeout
+        if not (math.isfinite(hold) and 0.0 <= hold < timeout):
+            raise ValueError(f"hold_time must be >= 0 s and below {timeout:g} s, got {hold!r}")
 
     # -- public -------------------------------------------------------------------------------
     @property
@@ -195,6 +206,7 @@ class IndentationMachine:
             State.CONTACT,
             State.INDENTING,
             State.BUCKLED,
+            State.HOLDING,
         )
         if in_contact_phase and obs.stream_age > self.guards.stream_timeout:
             self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
@@ -330,12 +342,23 @@ class IndentationMachine:
         assert self.marks.x_buckling is not None
         goal = self.marks.x_buckling + self.plan.post_buckling_travel
         if obs.advance >= goal - self.plan.position_tolerance:
-            self.marks.reason = self.marks.reason or "completed"
-            self._go(
-                State.RETRACTING, obs.t, "post-buckling record complete", obs.advance, obs.strains
-            )
-            return Command(self._retract_goal(), self.plan.roll, self.plan.fast_speed)
+            if self.plan.hold_time <= 0:
+                return self._complete(obs, "post-buckling record complete")
+            why = "post-buckling record complete: holding"
+            self._go(State.HOLDING, obs.t, why, obs.advance, obs.strains)
         return Command(goal, self.plan.roll, self.plan.indent_speed)
+
+    def _holding(self, obs: Observation) -> Command:
+        assert self.marks.x_buckling is not None
+        if obs.t - self._entered >= self.plan.hold_time - 1e-9:  # the clock sums its ticks
+            return self._complete(obs, f"hold of {self.plan.hold_time:g} s complete")
+        goal = self.marks.x_buckling + self.plan.post_buckling_travel
+        return Command(goal, self.plan.roll, self.plan.indent_speed)
+
+    def _complete(self, obs: Observation, why: str) -> Command:
+        self.marks.reason = self.marks.reason or "completed"
+        self._go(State.RETRACTING, obs.t, why, obs.advance, obs.strains)
+        return Command(self._retract_goal(), self.plan.roll, self.plan.fast_speed)
 
     def _retracting(self, obs: Observation) -> Command:
         p = self.plan
@@ -365,6 +388,7 @@ _HANDLERS: dict[State, Callable[[IndentationMachine, Observation], Command]] = {
     State.CONTACT: IndentationMachine._contact,
     State.INDENTING: IndentationMachine._indenting,
     State.BUCKLED: IndentationMachine._buckled,
+    State.HOLDING: IndentationMachine._holding,
     State.RETRACTING: IndentationMachine._retracting,
     State.DONE: IndentationMachine._terminal,
     State.FAULT: IndentationMachine._terminal,

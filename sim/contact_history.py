@@ -3,10 +3,11 @@
 A viscoelastic tissue's force depends on its history, so the equilibrium cannot be tabulated
 over the stage advance as :mod:`sim.contact_table` does for elastic samples: here it is solved
 at every board sample, one quasi-linear-viscoelastic state per trial (:mod:`sim.viscoelastic`).
-Over a step ``dt`` the standard linear solid's force is an affine map of the elastic law
-(:class:`StepLaw`)::
+Over a step ``dt`` the relaxation's force (a Prony series, whichever form) is an affine map of
+the elastic law (:class:`StepLaw`)::
 
-    F(delta) = a F_e(delta) + b,   a = r + (1 - r) gain,   b = (1 - r)(decay h - gain F_e,prev)
+    F(delta) = a F_e(delta) + b,   a = r + sum_k w_k gain_k,
+                                   b = sum_k w_k (decay_k h_k - gain_k F_e,prev)
 
 so the step's equilibrium is the ordinary one (:func:`sim.equilibrium.solve_contact`, its
 plain-float path) with that law, and the state moves on with the solved depth. Out of contact
@@ -20,7 +21,6 @@ tissue does not push on a tip that does not indent it). Cost: one scalar solve p
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +30,7 @@ from estimation.beam import Beam
 from sim.contact_table import GridPhysics, grating_strains
 from sim.equilibrium import TissueLaw, solve_contact
 from sim.equilibrium.law import FloatArray
-from sim.viscoelastic import StandardLinearSolid, ViscoelasticState, step
+from sim.viscoelastic import Relaxation, ViscoelasticState, step
 
 Row = tuple[float, float, float, float, tuple[float, ...]]  # delta, e, P, |R|, strains
 
@@ -61,21 +61,20 @@ class StepLaw:
         return self.elastic.inverse_at(max((force - self.b) / self.a, 0.0))
 
 
-def step_law(
-    sls: StandardLinearSolid, elastic: TissueLaw, state: ViscoelasticState, dt: float
-) -> StepLaw:
+def step_law(relax: Relaxation, elastic: TissueLaw, state: ViscoelasticState, dt: float) -> StepLaw:
     """The force law of the step ``dt`` (s) from ``state`` (see the module docstring)."""
-    decay, gain = sls.weights(dt)
-    r = sls.ratio
-    b = (1.0 - r) * (decay * state.memory - gain * state.elastic_force)
-    return StepLaw(elastic, r + (1.0 - r) * gain, min(b, 0.0))
+    p = relax.prony
+    decay, gain = p.step_weights(dt)
+    w = np.asarray(p.weights)
+    b = float(w @ (decay * state.memories(w.size) - gain * state.elastic_force))
+    return StepLaw(elastic, p.ratio + float(w @ gain), min(b, 0.0))
 
 
 class ViscoelasticContact:
     """One trial's viscoelastic contact: :meth:`at` a board sample in contact, :meth:`release`
     one out of contact; both step the state from the previous sample's time."""
 
-    def __init__(self, physics: GridPhysics, sls: StandardLinearSolid) -> None:
+    def __init__(self, physics: GridPhysics, sls: Relaxation) -> None:
         self.physics = physics
         self.sls = sls
         self.state = ViscoelasticState()
@@ -107,7 +106,7 @@ class ViscoelasticContact:
     def release(self, t: float) -> None:
         """Out of contact at time ``t``: the memory relaxes toward an unloaded tissue."""
         dt = self._dt(t)
-        if self.state.elastic_force != 0.0 or self.state.memory != 0.0:
+        if self.state.elastic_force != 0.0 or any(self.state.memory):
             _, _, self.state = step(self.sls, self.physics.tissue, self.state, 0.0, dt)
-            if math.isclose(self.state.memory, 0.0, abs_tol=1e-15):
+            if max(map(abs, self.state.memory), default=0.0) <= 1e-15:
                 self.state = ViscoelasticState()

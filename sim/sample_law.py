@@ -38,7 +38,7 @@ from config.scene import FidelityConfig
 from sim.equilibrium import TissueLaw
 from sim.equilibrium.law import FloatArray
 from sim.fem import FeTissueLaw, LayerProblem, table_key
-from sim.viscoelastic import StandardLinearSolid
+from sim.viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
 
 HALF_SPACE_RATIO = 200.0
 """Depth and lateral radius / R of the block that stands in for a half-space on the FE level."""
@@ -85,11 +85,15 @@ def fe_problem(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float
     return LayerProblem.from_dimensions(tip_radius, thickness, sample.lateral_radius, **options)
 
 
-def relaxation(sample: SampleConfig, fidelity: FidelityConfig) -> StandardLinearSolid | None:
-    """The sample's standard linear solid when the scene switches viscoelasticity on and the
-    sample has a relaxation time; None: elastic."""
+def relaxation(sample: SampleConfig, fidelity: FidelityConfig) -> Relaxation | None:
+    """The sample's relaxation (``relaxation``: a standard linear solid or a power law) when the
+    scene switches viscoelasticity on and the sample has a relaxation time; None: elastic."""
     if not fidelity.viscoelastic or sample.relaxation_time_s is None or sample.rigid:
         return None
+    if sample.relaxation == "power-law":
+        return PowerLawSolid(
+            sample.relaxation_time_s, sample.relaxed_ratio, sample.relaxation_exponent
+        )
     return StandardLinearSolid(sample.relaxation_time_s, sample.relaxed_ratio)
 
 
@@ -136,11 +140,7 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
         )
     else:
         out["law"] = "Sneddon x Dimitriadis (sim.tissue: the estimator's own family)"
-    out["viscoelastic"] = (
-        None
-        if sls is None
-        else {"relaxation_time_s": sls.tau, "relaxed_ratio": sls.ratio, "modulus": "relaxed"}
-    )
+    out["viscoelastic"] = None if sls is None else {**sls.describe(), "modulus": "relaxed"}
     return out
 
 

@@ -41,7 +41,7 @@ from sim.equilibrium import ContactEffects, TissueLaw
 from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
 from sim.oblique import ObliqueContact
 from sim.readout import GratingReadout
-from sim.viscoelastic import StandardLinearSolid
+from sim.viscoelastic import Relaxation
 from wire.frame import Status
 
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)
@@ -139,7 +139,7 @@ class World:
         friction: float = 0.5,
         poisson: float = 0.45,
         weight: BeamWeight | None = None,
-        relaxation: StandardLinearSolid | None = None,
+        relaxation: Relaxation | None = None,
     ) -> None:
         """``encoder_step``: the stage advance per encoder count (m). The stage stops only on
         whole counts, so every sample in contact lies on that lattice; the contact table is

@@ -16,5 +16,6 @@ SECTIONS: dict[str, str] = {
     "estimation": "palpate.benchmarks.estimation",
     "tissue": "palpate.benchmarks.tissue",
     "tissue-fe": "palpate.benchmarks.tissue_fe",
+    "hold": "palpate.benchmarks.hold",
     "fuzz": "palpate.benchmarks.fuzz",
 }

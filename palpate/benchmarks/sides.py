@@ -70,7 +70,7 @@ BOUNDARIES = (
     Boundary("palpate.simulation.trial", "run_trial", "trial loop", CONTROL),
     Boundary("robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
     Boundary("robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
-    Boundary("robot.trial.estimate", "infer_states", "beam states", ESTIMATOR),
+    Boundary("robot.trial.states", "infer_states", "beam states", ESTIMATOR),
     Boundary("robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
     Boundary("palpate.simulation.result", "estimate_trial", "rest of the estimate", ESTIMATOR),
 )

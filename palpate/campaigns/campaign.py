@@ -30,8 +30,14 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
     references = reported_references(scene, seed)
 
     def add(sample_name: str, tube: str, orientation: str, length_mm: float, rep: int) -> None:
-        s = next(x for x in scene.samples if x.name == sample_name)
-        parts = [sample_name, tube, orientation, f"L{length_mm:g}"]
+        for speed in c.speeds_mm_per_s():
+            at(sample_name, tube, orientation, length_mm, rep, speed)
+
+    def at(name: str, tube: str, orientation: str, length_mm: float, rep: int, v: float) -> None:
+        s = next(x for x in scene.samples if x.name == name)
+        parts = [name, tube, orientation, f"L{length_mm:g}"]
+        if c.indent_speeds_mm_per_s:
+            parts.append(f"v{v:g}")
         if c.repeats > 1:
             parts.append(f"r{rep}")
         specs.append(
@@ -47,6 +53,7 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
                 exposed_length=length_mm * 1e-3,
                 seed=seed * 1_000_003 + len(specs),
                 reference=references[s.name],
+                indent_speed=v * 1e-3 if c.indent_speeds_mm_per_s else None,
             )
         )
 

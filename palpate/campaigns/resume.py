@@ -20,6 +20,7 @@ from config.schema import StackConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
 from estimation.misalignment import Lean
+from estimation.relaxation import RelaxationFit
 from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
 from palpate.campaigns.runs import set_aside
@@ -97,6 +98,8 @@ def _outcome(
         southwell=_optional(SouthwellFit, estimate.get("southwell")),
         calibration=_optional(ComplianceFit, estimate.get("calibration")),
         lean=Lean.from_record(estimate["lean"]) if isinstance(estimate.get("lean"), dict) else None,
+        relaxation=_relaxation(estimate.get("relaxation")),
+        relaxed_verdict=recorded_verdict(estimate, "relaxed_verdict"),
     )
 
 
@@ -177,3 +180,8 @@ def _paper(record: dict[str, Any]) -> StiffnessEstimate | None:
 
 def _joint(record: dict[str, Any]) -> JointFit:
     return _from_record(JointFit, record, "warnings")
+
+
+def _relaxation(record: Any) -> RelaxationFit | None:
+    """The relaxation fit of a trial that held (None for one that did not)."""
+    return _from_record(RelaxationFit, record, "warnings") if isinstance(record, dict) else None

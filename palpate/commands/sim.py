@@ -29,7 +29,7 @@ from palpate.campaigns.resume import resume_outcomes
 from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
 from palpate.cli import EXIT_FAULT, EXIT_OK
 from palpate.progress import progress_bar
-from palpate.reports.verdicts import Tally, by_sample, counts_column, summary_lines, tally
+from palpate.reports import verdicts
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
 from palpate.simulation.world import tissue_description
@@ -295,7 +295,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         "speedup": sim_time / wall if wall > 0 else None,
         "figures": figures,
     }
-    payload["verdicts"] = tally(outcomes).as_dict()
+    payload.update(verdicts.verdict_payload(outcomes))
     found = calibrate(
         (rig_key(o.spec.kind, o.spec.tube), o.calibration)
         for o in outcomes
@@ -333,13 +333,13 @@ def _print_report(
     sim_time = sum(o.sim_time for o in outcomes)
     paper = median_abs_relative_error(outcomes, "paper")
     failed = [o for o in outcomes if o.state != "done"]
-    _print_table(c.scene.name, rows, by_sample(outcomes))
+    _print_table(c.scene.name, rows, verdicts.by_sample(outcomes))
     samples = c.scene.campaign_samples()
     levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
     print(f"world tissue: {', '.join(levels)}{note}")
     print()
-    for line in summary_lines(outcomes):
+    for line in verdicts.summary_lines(outcomes):
         print(line)
     for line in config_lines(found):
         print(f"calibrated on the rigid reference: {line}")
@@ -369,7 +369,7 @@ def _kpa(d: dict[str, object]) -> dict[str, object]:
     return out
 
 
-def _print_table(name: str, rows: list, tallies: dict[str, Tally]) -> None:  # type: ignore[type-arg]
+def _print_table(name: str, rows: list, tallies: dict[str, verdicts.Tally]) -> None:  # type: ignore[type-arg]
     print(
         f"{name} campaign: estimated vs actual Young's modulus (kPa), joint fit (E and contact "
         "point fitted on the whole record; the paper's estimate is in --json) over the trials "
@@ -389,8 +389,8 @@ def _print_table(name: str, rows: list, tallies: dict[str, Tally]) -> None:  # t
 
         rel = "-" if s.relative_error is None else f"{100 * s.relative_error:+.1f}%"
         t = tallies[r.sample]
-        verdicts = counts_column(t)
+        counts = verdicts.counts_column(t)
         print(
-            f"{r.sample:>8} {r.trials:>6} {verdicts:>11} {k(s.mean):>10} {k(s.actual):>9} "
+            f"{r.sample:>8} {r.trials:>6} {counts:>11} {k(s.mean):>10} {k(s.actual):>9} "
             f"{k(s.rmse):>9} {k(s.iqr):>9} {rel:>8} {f'{t.covered}/{t.numbers}':>6}"
         )

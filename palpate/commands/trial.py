@@ -219,6 +219,16 @@ def _kpa(v: float | None) -> str:
     return "-" if v is None else f"{v:.2f}"
 
 
+def _relaxed(d: dict[str, Any]) -> list[str]:
+    """The relaxed modulus of a trial that held, for its line (none otherwise)."""
+    if d.get("relaxed_kpa") is None:
+        return []
+    lo, hi = d["relaxed_ci_kpa"]
+    return [
+        f"relaxed {_kpa(d['relaxed_kpa'])} [{_kpa(lo)}, {_kpa(hi)}] kPa: {d['relaxed_verdict']}"
+    ]
+
+
 def _row(d: dict[str, Any]) -> str:
     """One trial's line: the joint fit with its interval and verdict, the paper's estimate
     (Eqs. 13-14) beside it, the reference modulus and the joint fit's relative error."""
@@ -228,7 +238,7 @@ def _row(d: dict[str, Any]) -> str:
         lo, hi = d["joint_ci_kpa"]
         joint += f" [{_kpa(lo)}, {_kpa(hi)}]"
     verdict = d["verdict"] or "-"
-    why = "; ".join([d["reason"], *d["verdict_reasons"]])
+    why = "; ".join([d["reason"], *d["verdict_reasons"], *_relaxed(d)])
     cal = d.get("calibration")
     if cal is not None:
         c = cal.get("compliance")

@@ -24,6 +24,7 @@ from config.sample import UNKNOWN
 from config.schema import MM, StackConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
+from estimation.relaxation import RelaxationFit
 from estimation.section import Section
 from estimation.stiffness import StiffnessEstimate
 from estimation.verdict import Verdict
@@ -35,7 +36,7 @@ from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from robot.trial.inputs import belief_fields
 from robot.trial.log import TrialLogWriter
-from robot.trial.record import estimate_record, header_common
+from robot.trial.record import estimate_record, header_common, relaxed_row
 from robot.trial.run import end_record, run_trial
 from robot.trial.setup import (
     detector_for,
@@ -65,6 +66,8 @@ class BenchOutcome:
     joint: JointFit | None = None  # the joint fit: the headline estimate
     verdict: Verdict | None = None
     calibration: ComplianceFit | None = None  # on a rigid reference
+    relaxation: RelaxationFit | None = None  # a trial that held: relaxed and instantaneous moduli
+    relaxed_verdict: Verdict | None = None
 
     @property
     def status(self) -> str:
@@ -99,6 +102,7 @@ class BenchOutcome:
             "delta_mm": None if est is None else est.delta / MM,
             "force_n": None if est is None else est.force,
             "calibration": None if self.calibration is None else self.calibration.as_dict(),
+            **relaxed_row(self.relaxation, self.relaxed_verdict),
             "duration_s": self.duration,
             "log": self.log_path,
         }
@@ -255,6 +259,8 @@ def _outcome(
         estimate.joint,
         estimate.verdict,
         estimate.calibration,
+        estimate.relaxation,
+        estimate.relaxed_verdict,
     )
 
 

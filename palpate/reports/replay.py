@@ -136,15 +136,26 @@ def _replay_joint(
     if probe is not None:  # the estimator was told the misalignment probing measured
         raw = {**raw, **probe_inputs(probe)}
     inputs = EstimatorInputs.from_dict(raw)
-    rows = ((r["state"], r["advance"], r["strains"]) for r in log.of_kind("sample"))
-    fitted = fit_rows(rows, inputs, stack, section)
+    samples = list(log.of_kind("sample"))
+    rows = [(r["state"], r["advance"], r["strains"]) for r in samples]
+    fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples])
     end = log.end or {}
-    verdict = None
+    verdict, relaxed = None, None
     if not inputs.rigid:
         state, reason = str(end.get("state")), str(end.get("reason"))
-        verdict = verdict_for(fitted.joint, inputs, state, reason, section, fitted.lean)
+        verdict, relaxed = verdict_for(
+            fitted.joint, inputs, state, reason, section, fitted.lean, fitted.relaxation
+        )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
-    keys = estimator_keys(fitted.joint, verdict, fitted.southwell, fitted.calibration, lean)
+    keys = estimator_keys(
+        fitted.joint,
+        verdict,
+        fitted.southwell,
+        fitted.calibration,
+        lean,
+        fitted.relaxation,
+        relaxed,
+    )
     replayed = json.loads(json.dumps(keys))
     report.update({f"replayed_{k}" if k != "joint" else k: v for k, v in replayed.items()})
     report["recorded_joint"] = recorded.get("joint")

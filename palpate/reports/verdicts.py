@@ -6,7 +6,7 @@ silently counted as good, and its interval is still held to account."""
 from __future__ import annotations
 
 import statistics
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from estimation.verdict import STATUSES
@@ -61,32 +61,52 @@ def estimating(outcomes: Iterable[TrialOutcome]) -> list[TrialOutcome]:
     return [o for o in outcomes if o.calibration is None]
 
 
-def tally(outcomes: Iterable[TrialOutcome]) -> Tally:
-    """The :class:`Tally` of ``outcomes`` (rigid references are left out)."""
+Reading = Callable[[TrialOutcome], tuple[str, float | None, bool]]
+
+
+def joint_reading(o: TrialOutcome) -> tuple[str, float | None, bool]:
+    """The joint fit's (verdict, modulus Pa, whether its interval holds the truth)."""
+    jf = o.joint
+    return (
+        o.status,
+        None if jf is None else jf.modulus,
+        jf is not None and jf.covers(o.spec.modulus),
+    )
+
+
+def relaxed_reading(o: TrialOutcome) -> tuple[str, float | None, bool]:
+    """The relaxed modulus's (verdict, modulus Pa, whether its interval holds the truth)."""
+    fit, verdict = o.relaxation, o.relaxed_verdict
+    status = "none" if verdict is None else verdict.status
+    return (
+        status,
+        None if fit is None else fit.relaxed,
+        fit is not None and fit.covers(o.spec.modulus),
+    )
+
+
+def tally(outcomes: Iterable[TrialOutcome], reading: Reading = joint_reading) -> Tally:
+    """The :class:`Tally` of ``outcomes`` (rigid references are left out) by ``reading``: the
+    joint fit's estimate, or another of each trial's numbers (``relaxed_reading``)."""
     outs = estimating(outcomes)
-    counts: dict[str, int] = {s: sum(1 for o in outs if o.status == s) for s in STATUSES}
-    numbered = [o for o in outs if o.status != "none" and o.joint is not None]
-    errors = {id(o): _error(o) for o in numbered}
-    ok = [abs(errors[id(o)]) for o in numbered if o.status == "ok"]
-    every = [abs(e) for e in errors.values()]
-    covered = sum(1 for o in numbered if o.joint is not None and o.joint.covers(o.spec.modulus))
+    read = [(o, *reading(o)) for o in outs]
+    counts: dict[str, int] = {s: sum(1 for r in read if r[1] == s) for s in STATUSES}
+    numbered = [r for r in read if r[1] != "none" and r[2] is not None]
+    errors = [(abs(m / o.spec.modulus - 1), status) for o, status, m, _ in numbered if m]
+    ok = [e for e, status in errors if status == "ok"]
+    every = [e for e, _ in errors]
     seconds = [o.joint_seconds for o in outs if o.joint_seconds is not None]
     return Tally(
         trials=len(outs),
         counts=counts,
         numbers=len(numbered),
-        covered=covered,
+        covered=sum(1 for r in numbered if r[3]),
         median_ok=_median(ok),
         worst_ok=max(ok) if ok else None,
         median_all=_median(every),
         worst_all=max(every) if every else None,
         ms_per_trial=1e3 * statistics.median(seconds) if seconds else None,
     )
-
-
-def _error(o: TrialOutcome) -> float:
-    m = o.joint.modulus if o.joint is not None else None
-    return 0.0 if m is None else (m - o.spec.modulus) / o.spec.modulus
 
 
 def _median(values: Sequence[float]) -> float | None:
@@ -130,8 +150,62 @@ def _generic(reason: str) -> str:
     return head
 
 
+@dataclass(frozen=True)
+class RelaxedTally:
+    """The trials that held after buckling: how many, how many relax, and the :class:`Tally`
+    of their relaxed moduli (``relaxed_reading``)."""
+
+    held: int
+    relaxes: int
+    numbers: Tally
+
+    def as_dict(self) -> dict[str, object]:
+        out = self.numbers.as_dict()
+        del out["fit_ms_per_trial"], out["trials"]
+        return {"held": self.held, "relaxes": self.relaxes, **out}
+
+
+def relaxed_tally(outcomes: Iterable[TrialOutcome]) -> RelaxedTally:
+    """The :class:`RelaxedTally` of the trials among ``outcomes`` that held."""
+    held = [o for o in estimating(outcomes) if o.relaxation is not None]
+    relaxes = sum(1 for o in held if o.relaxation is not None and o.relaxation.relaxes)
+    return RelaxedTally(len(held), relaxes, tally(held, relaxed_reading))
+
+
+def verdict_payload(outcomes: Sequence[TrialOutcome]) -> dict[str, object]:
+    """``--json``'s ``verdicts`` (and ``relaxed`` when trials held)."""
+    out: dict[str, object] = {"verdicts": tally(outcomes).as_dict()}
+    held = relaxed_tally(outcomes)
+    if held.held:
+        out["relaxed"] = held.as_dict()
+    return out
+
+
+def relaxed_lines(outcomes: Sequence[TrialOutcome]) -> list[str]:
+    """The relaxed moduli's lines of ``palpate sim`` (none without a hold)."""
+    held = relaxed_tally(outcomes)
+    if not held.held:
+        return []
+    r = held.numbers
+    lines = [
+        f"held after buckling: {held.held} trials, {held.relaxes} relax; relaxed modulus "
+        f"verdicts: {counts_text(r)}"
+    ]
+    if r.numbers:
+        lines.append(
+            f"95 % interval of the relaxed modulus holds the truth in {r.covered}/{r.numbers}"
+        )
+    if r.median_ok is not None and r.worst_ok is not None:
+        lines.append(
+            f"relaxed modulus |relative error| over ok: median {100 * r.median_ok:.1f} %, "
+            f"worst {100 * r.worst_ok:.1f} %"
+        )
+    return lines
+
+
 def summary_lines(outcomes: Sequence[TrialOutcome]) -> list[str]:
-    """What ``palpate sim`` prints under its table: the verdicts, the coverage, the errors."""
+    """What ``palpate sim`` prints under its table: the verdicts, the coverage, the errors (and
+    the relaxed moduli of trials that held)."""
     t = tally(outcomes)
     lines = [f"verdicts: {counts_text(t)} (of {t.trials} trials estimating a modulus)"]
     if t.numbers:
@@ -145,4 +219,4 @@ def summary_lines(outcomes: Sequence[TrialOutcome]) -> list[str]:
             f"worst {100 * t.worst_ok:.1f} %"
         )
     lines += reason_lines(outcomes)
-    return lines
+    return lines + relaxed_lines(outcomes)

@@ -17,6 +17,7 @@ from config.schema import StackConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
 from estimation.misalignment import Lean
+from estimation.relaxation import RelaxationFit
 from estimation.southwell import SouthwellFit
 from estimation.stiffness import StiffnessEstimate
 from estimation.verdict import Verdict
@@ -25,6 +26,7 @@ from robot.indentation import TrialMarks
 from robot.probe_result import ProbeResult
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from robot.trial.inputs import belief_fields
+from robot.trial.record import relaxed_row
 from robot.trial.run import TrialResult
 from robot.trial.setup import sensor_section
 from wire.dynamixel import TICKS_PER_REV
@@ -49,6 +51,8 @@ class TrialOutcome:
     southwell: SouthwellFit | None = None  # the beam's bow, fitted from the record
     calibration: ComplianceFit | None = None  # on a rigid reference: the rig's compliance
     lean: Lean | None = None  # the load's lean from the strains (estimation.misalignment)
+    relaxation: RelaxationFit | None = None  # relaxed and instantaneous moduli (a trial that held)
+    relaxed_verdict: Verdict | None = None  # the verdict on the relaxed modulus
 
     misalignment: float = 0.0  # rad, what the estimator was told (probing's, or the IK's)
     true_misalignment: float | None = None  # rad, the world's at the indentation (sim truth)
@@ -109,6 +113,7 @@ class TrialOutcome:
             "true_misalignment_deg": _deg(self.true_misalignment),
             "probe": None if self.probe is None else self.probe.summary(),
             "strain_lean": None if self.lean is None else self.lean.as_dict(),
+            **relaxed_row(self.relaxation, self.relaxed_verdict),
             "probing_s": self.probing_time,
             "sim_time_s": self.sim_time,
             "log": self.log_path,
@@ -174,6 +179,8 @@ def outcome_of(
         southwell=estimate.southwell,
         calibration=estimate.calibration,
         lean=estimate.lean,
+        relaxation=estimate.relaxation,
+        relaxed_verdict=estimate.relaxed_verdict,
         misalignment=misalignment_of(result, geo),
         probe=result.probe,
         probing_time=result.probing_time,

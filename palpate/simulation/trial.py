@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
-from config.scene import FidelityConfig, SceneConfig
+from config.scene import CampaignConfig, FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
 from palpate.simulation.result import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
 from palpate.simulation.world import (
@@ -145,6 +145,13 @@ def _emulators(
         bus.close()  # no-op on the fast path (no pty)
 
 
+def trial_campaign(spec: TrialSpec, scene: SceneConfig) -> CampaignConfig:
+    """The scene's campaign at the trial's own indentation speed, when it has one."""
+    if spec.indent_speed is None:
+        return scene.campaign
+    return dataclasses.replace(scene.campaign, indent_speed_mm_per_s=spec.indent_speed * 1e3)
+
+
 def run_sim_trial(
     spec: TrialSpec,
     scene: SceneConfig,
@@ -156,7 +163,7 @@ def run_sim_trial(
     hook: EmulatorHook | None = None,
 ) -> TrialOutcome:
     """Run one simulated trial end to end and estimate the modulus from it."""
-    c = scene.campaign
+    c = trial_campaign(spec, scene)
     geo = trial_geometry(stack, spec, trial_sample(scene, spec))
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
     stack = trial_stack(scene, stack, geo, retract)

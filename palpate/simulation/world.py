@@ -52,6 +52,7 @@ class TrialSpec:
     exposed_length: float  # m at contact
     seed: int
     reference: float | None = None  # Pa, the reported reference modulus; None: the truth
+    indent_speed: float | None = None  # m/s; None: the campaign's indent_speed_mm_per_s
 
     @property
     def reported(self) -> float:

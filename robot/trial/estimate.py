@@ -25,31 +25,32 @@ the same inputs and reproduces the fit bit for bit.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from statistics import NormalDist
 
 import numpy as np
 from numpy.typing import NDArray
 
 from config.schema import SensorConfig, StackConfig
 from estimation.beam import Beam
-from estimation.beamstate import BeamStates, infer_states
+from estimation.beamstate import BeamStates
 from estimation.compliance import ComplianceFit, fit_compliance
 from estimation.detect_contact import baseline_deviation
 from estimation.elastica.constants import P_CRIT
 from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from estimation.misalignment import Lean
+from estimation.relaxation import RelaxationFit
 from estimation.section import Section
 from estimation.southwell import SouthwellFit, southwell
 from estimation.stiffness import StiffnessEstimate, paper_estimate
 from estimation.strain_fit import fit_strains
-from estimation.verdict import TrialFacts, Verdict, judge
+from estimation.verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from robot.trial.inputs import EstimatorInputs
 from robot.trial.lean import lean_of_rows, rows_in
+from robot.trial.relaxed import relaxation_of
 from robot.trial.run import TrialResult
+from robot.trial.states import LOADING_STATES, record_lengths, states_at
 from sensor.strain import grating_intervals
 
 __all__ = [
@@ -66,8 +67,6 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})
-_UNIT_SIGMA = 1e-6  # infer_states is linear in sigma: run at 1e-6, rescale by the measured one
 
 
 def loading_rows(
@@ -75,16 +74,6 @@ def loading_rows(
 ) -> tuple[FloatArray, FloatArray]:
     """(advance (N,), strains (N, G)) of the loading rows (state, advance, strains) in order."""
     return rows_in(rows, LOADING_STATES, gratings)
-
-
-def strain_sigma(residual: FloatArray, gratings: int) -> float:
-    """Per-grating strain noise from per-row rms residuals of the 2-parameter fit (median-based,
-    so a few rows the model misses do not inflate it)."""
-    dof = gratings - 2
-    ss = gratings * residual**2  # sum of squares per row ~ sigma^2 chi2(dof)
-    # chi2(1)'s median is exact through the normal; Wilson-Hilferty (< 1 % off) above
-    median = NormalDist().inv_cdf(0.75) ** 2 if dof == 1 else dof * (1 - 2 / (9 * dof)) ** 3
-    return max(math.sqrt(float(np.median(ss)) / median), 1e-9)
 
 
 @dataclass(frozen=True)
@@ -96,6 +85,7 @@ class RecordEstimate:
     southwell: SouthwellFit | None = None
     calibration: ComplianceFit | None = None
     lean: Lean | None = None
+    relaxation: RelaxationFit | None = None
 
 
 def fit_record(
@@ -113,8 +103,8 @@ def fit_record(
         if inputs.rigid:
             return RecordEstimate(None, calibration=ComplianceFit(False, msg, n_points=n))
         return RecordEstimate(JointFit(False, msg, n_points=n, law=inputs.law().name))
-    lengths = _lengths(advance, inputs)
-    states, k = _states(strains, lengths, sensor, section)
+    lengths = record_lengths(advance, inputs)
+    states, k = states_at(strains, lengths, sensor, section)
     if inputs.rigid:
         return RecordEstimate(None, calibration=fit_compliance(advance, states.P, states.e))
     guess = baseline_deviation(advance, states.P, baseline_points=min(30, n // 4))
@@ -130,24 +120,6 @@ def fit_record(
         misalignment=inputs.misalignment,
     )
     return RecordEstimate(joint, _bow(states, lengths, section))
-
-
-def _states(
-    strains: FloatArray, lengths: FloatArray, sensor: SensorConfig, section: Section
-) -> tuple[BeamStates, float]:
-    """The beam's states along the record at unit strain noise, and the strain noise measured
-    on the record (the states' sigmas scale with it)."""
-    intervals = grating_intervals(sensor, 0.0)[None, :, :] + lengths[:, None, None]
-    states = infer_states(
-        strains, intervals, lengths, section.EA, section.fiber_offset, _UNIT_SIGMA
-    )
-    return states, strain_sigma(states.residual, strains.shape[1]) / _UNIT_SIGMA
-
-
-def _lengths(advance: FloatArray, inputs: EstimatorInputs) -> FloatArray:
-    if inputs.kind == "robot":
-        return np.asarray(advance - inputs.flush_translation)
-    return np.full(advance.size, inputs.exposed_length)
 
 
 def critical_load(section: Section, length: float) -> float:
@@ -168,9 +140,11 @@ def fit_rows(
     inputs: EstimatorInputs,
     stack: StackConfig,
     section: Section,
+    times: Sequence[float] | None = None,
 ) -> RecordEstimate:
     """The estimates from (state, advance, strains) rows: the trial's record or a log's samples;
-    beside them the load's lean from the rows before buckling (``robot.trial.lean``)."""
+    beside them the load's lean from the rows before buckling (``robot.trial.lean``) and, with
+    each row's time (s) and a hold in the rows, the relaxation (``robot.trial.relaxed``)."""
     rows = list(rows)
     advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
     fitted = fit_record(advance, strains, inputs, stack.sensor, section)
@@ -184,7 +158,10 @@ def fit_rows(
         exposed_length=inputs.exposed_length,
         flush_translation=inputs.flush_translation,
     )
-    return dataclasses.replace(fitted, lean=lean)
+    relaxation = None
+    if times is not None:
+        relaxation = relaxation_of(rows, times, inputs, stack.sensor, section, fitted.joint)
+    return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
 
 
 def verdict_for(
@@ -194,8 +171,10 @@ def verdict_for(
     reason: str,
     section: Section,
     lean: Lean | None = None,
-) -> Verdict:
-    """The trial's verdict (``estimation.verdict``) from its fit, its inputs and how it ended."""
+    relaxation: RelaxationFit | None = None,
+) -> tuple[Verdict, Verdict | None]:
+    """The trial's verdicts (``estimation.verdict``) from its fit, its inputs and how it ended:
+    on the elastic estimate, and on the relaxed modulus when the trial held (else None)."""
     length = inputs.exposed_length
     if inputs.kind == "robot" and joint is not None and joint.contact is not None:
         length = joint.contact - inputs.flush_translation
@@ -210,8 +189,10 @@ def verdict_for(
         orientation_verified=inputs.orientation_verified,
         lean=lean,
         misalignment_sigma=inputs.misalignment_sigma,
+        relaxation=relaxation,
     )
-    return judge(joint, facts, inputs.tip_radius)
+    elastic = judge(joint, facts, inputs.tip_radius)
+    return elastic, relaxed_verdict(relaxation, elastic, facts)
 
 
 def exposed_length_at(kind: str, x: float, fixed_length: float, flush_translation: float) -> float:
@@ -258,6 +239,8 @@ class TrialEstimate:
         southwell: the beam's bow fitted from the record (None without a joint fit).
         verdict: ok, suspect or none, with reasons (None without a joint fit).
         calibration: the rig's compliance, on a rigid reference (instead of the joint fit).
+        relaxation: the relaxed and instantaneous moduli, when the trial held (else None).
+        relaxed_verdict: the verdict on the relaxed modulus, when the trial held.
     """
 
     paper: StiffnessEstimate | None
@@ -268,6 +251,8 @@ class TrialEstimate:
     verdict: Verdict | None = None
     calibration: ComplianceFit | None = None
     lean: Lean | None = None
+    relaxation: RelaxationFit | None = None
+    relaxed_verdict: Verdict | None = None
 
 
 def estimate_trial(
@@ -295,12 +280,14 @@ def estimate_trial(
     if inputs is None:
         return TrialEstimate(paper, length)
     start = time.perf_counter()
-    fitted = fit_rows(result.record, inputs, stack, section)
+    fitted = fit_rows(result.record, inputs, stack, section, result.times)
     seconds = time.perf_counter() - start
-    verdict = None
+    verdict, relaxed = None, None
     if not inputs.rigid:
         state = result.state.value
-        verdict = verdict_for(fitted.joint, inputs, state, result.reason, section, fitted.lean)
+        verdict, relaxed = verdict_for(
+            fitted.joint, inputs, state, result.reason, section, fitted.lean, fitted.relaxation
+        )
     return TrialEstimate(
         paper,
         length,
@@ -310,4 +297,6 @@ def estimate_trial(
         verdict,
         fitted.calibration,
         fitted.lean,
+        fitted.relaxation,
+        relaxed,
     )

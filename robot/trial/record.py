@@ -10,7 +10,8 @@ written here, and read back here (:func:`recorded_verdict`), tolerant of logs th
 - estimate ``joint``: the joint fit (``JointFit.as_dict``); ``verdict``: ``{status, reasons}``
   (ok, suspect or none); ``southwell``: the beam's bow fitted from the record. A log without
   ``verdict`` was written before verdicts existed. On a rigid reference (``estimator.rigid``)
-  the estimate record carries ``calibration`` (``ComplianceFit.as_dict``, m/N) instead.
+  the estimate record carries ``calibration`` (``ComplianceFit.as_dict``, m/N) instead. A trial
+  that held adds ``relaxation`` (``RelaxationFit.as_dict``) and ``relaxed_verdict``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from config.schema import SensorConfig, TubeConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
 from estimation.misalignment import Lean
+from estimation.relaxation import RelaxationFit
 from estimation.section import Section
 from estimation.southwell import SouthwellFit
 from estimation.verdict import Verdict
@@ -91,6 +93,8 @@ def estimate_record(estimate: TrialEstimate) -> dict[str, Any]:
             estimate.southwell,
             estimate.calibration,
             estimate.lean,
+            estimate.relaxation,
+            estimate.relaxed_verdict,
         )
     )
     return record
@@ -102,6 +106,8 @@ def estimator_keys(
     southwell: SouthwellFit | None,
     calibration: ComplianceFit | None = None,
     lean: Lean | None = None,
+    relaxation: RelaxationFit | None = None,
+    relaxed: Verdict | None = None,
 ) -> dict[str, Any]:
     """The estimate record's keys of the joint fit, its verdict and the bow, or of the
     compliance calibration on a rigid reference (as JSON values); ``palpate replay`` compares
@@ -115,11 +121,38 @@ def estimator_keys(
         out["southwell"] = southwell.as_dict()
     if lean is not None:
         out["lean"] = lean.record()
+    if relaxation is not None:
+        out["relaxation"] = relaxation.as_dict()
+        if relaxed is not None:
+            out["relaxed_verdict"] = relaxed.as_dict()
     return out
 
 
-def recorded_verdict(record: dict[str, Any] | None) -> Verdict | None:
-    """The verdict of a log's estimate record; None for a log written before verdicts."""
-    if record is None or not isinstance(record.get("verdict"), dict):
+def relaxed_row(fit: RelaxationFit | None, verdict: Verdict | None) -> dict[str, Any]:
+    """A trial's row keys (``--json`` of ``palpate sim`` and ``palpate trial``) of its
+    relaxation fit, moduli in kPa; empty for a trial that did not hold."""
+    if fit is None:
+        return {}
+
+    def kpa(v: float | None) -> float | None:
+        return None if v is None else v / 1e3
+
+    return {
+        "relaxed_kpa": kpa(fit.relaxed),
+        "relaxed_ci_kpa": [kpa(fit.relaxed_low), kpa(fit.relaxed_high)],
+        "instantaneous_kpa": kpa(fit.instantaneous),
+        "relaxation_time_s": fit.relaxation_time,
+        "relaxes": fit.relaxes,
+        "relaxation_complete": fit.complete,
+        "relaxation_delta_chi2": fit.delta_chi2,
+        "relaxed_verdict": None if verdict is None else verdict.status,
+        "relaxed_reasons": [] if verdict is None else list(verdict.reasons),
+    }
+
+
+def recorded_verdict(record: dict[str, Any] | None, key: str = "verdict") -> Verdict | None:
+    """The verdict (or ``relaxed_verdict``) of a log's estimate record; None for a log written
+    before verdicts (or without a hold)."""
+    if record is None or not isinstance(record.get(key), dict):
         return None
-    return Verdict.from_dict(record["verdict"])
+    return Verdict.from_dict(record[key])

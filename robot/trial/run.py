@@ -69,6 +69,7 @@ class TrialResult:
     # (state after the tick, advance m, strains) per tick, as in the log's sample records: the
     # whole-record estimators (``robot.trial.estimate``) read it without a log
     record: list[tuple[str, float, tuple[float, ...]]] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)  # each record row's time (s, the rig's clock)
     probe: ProbeResult | None = None  # what probing found, when the trial probed
 
     @property
@@ -101,11 +102,10 @@ def run_trial(
     One tick every ``rig.tick`` seconds of ``clock``; after ``max_ticks`` the trial is aborted
     (and retracts). Every transition and every tick is written to ``log`` as it happens, and
     what probing found as a ``probe`` record when it is found."""
-    transitions: list[Transition] = []
-    record: list[tuple[str, float, tuple[float, ...]]] = []
+    out = TrialResult(State.IDLE, "", TrialMarks(), 0, 0.0)  # filled as the trial runs
 
     def record_transition(tr: Transition) -> None:
-        transitions.append(tr)
+        out.transitions.append(tr)
         if log is not None:
             log.write(_transition_record(tr))
 
@@ -119,7 +119,8 @@ def run_trial(
             if _out_of_ticks(machine, clock.now(), ticks, max_ticks):
                 break
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
-            record.append((machine.state.value, obs.advance, tuple(obs.strains)))
+            out.record.append((machine.state.value, obs.advance, tuple(obs.strains)))
+            out.times.append(obs.t)
             if log is not None:
                 probe_logged = _write_tick(log, obs, machine, cmd, probe_logged)
             if on_tick is not None:
@@ -132,16 +133,9 @@ def run_trial(
         raise
     if machine.state not in PLANNED_ENDS:
         rig.release()  # torque policy: a trial that did not complete leaves the servos limp
-    return TrialResult(
-        state=machine.state,
-        reason=machine.marks.reason,
-        marks=machine.marks,
-        ticks=ticks,
-        duration=clock.now() - t0,
-        transitions=transitions,
-        record=record,
-        probe=machine.probe,
-    )
+    out.state, out.reason, out.marks = machine.state, machine.marks.reason, machine.marks
+    out.ticks, out.duration, out.probe = ticks, clock.now() - t0, machine.probe
+    return out
 
 
 def _out_of_ticks(machine: IndentationMachine, t: float, ticks: int, max_ticks: int) -> bool:

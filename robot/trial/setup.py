@@ -161,7 +161,8 @@ def trial_plan(
 ) -> TrialPlan:
     """The plan of one trial: roll to ``roll`` (rad) at the ``home`` advance (m), advance fast to
     the campaign's stand-off before the expected ``contact`` advance (m), approach and indent at
-    the campaign's speeds, keep indenting ``post_buckling_mm`` after buckling, retract."""
+    the campaign's speeds, keep indenting ``post_buckling_mm`` after buckling, hold ``hold_s``,
+    retract."""
     return TrialPlan(
         roll=roll,
         contact_advance=contact,
@@ -172,6 +173,7 @@ def trial_plan(
         approach_speed=campaign.approach_speed_mm_per_s * MM,
         indent_speed=campaign.indent_speed_mm_per_s * MM,
         position_tolerance=position_tolerance(stack),
+        hold_time=campaign.hold_s,
     )
 
 

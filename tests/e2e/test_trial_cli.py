@@ -156,6 +156,26 @@ REHEARSAL = (
 )
 
 
+def test_a_hold_on_the_ptys_is_logged_fitted_and_replayed(tmp_path: Path) -> None:
+    """The bench file's hold (issue 27) over the hardware path: the stage stands still after
+    buckling, every held tick is logged, the relaxation fit reads an elastic sample as such,
+    and the log replays to the same numbers."""
+    outcomes, _, _ = session_on_ptys(tmp_path, ONE, "campaign: {hold_s: 1.0}\n")
+    (o,) = outcomes
+    assert o.state == "done", o.reason
+    log = read_log(Path(str(o.log_path)))
+    held = [r for r in log.of_kind("sample") if r["state"] == "holding"]
+    assert len(held) == pytest.approx(1.0 * 250, abs=2)  # 1 s at the 250 Hz control rate
+    assert max(r["advance"] for r in held) - min(r["advance"] for r in held) < 10e-6
+    assert o.relaxation is not None
+    assert o.relaxation.success, o.relaxation.message
+    assert not o.relaxation.relaxes  # the robot scene's S8 is elastic
+    assert o.as_dict()["relaxed_verdict"] is not None
+    report = replay(Path(str(o.log_path)))
+    assert report["identical"] is True
+    assert report["replayed_relaxation"] == next(log.of_kind("estimate"))["relaxation"]
+
+
 def test_a_rehearsal_on_the_twin_calibrates_on_the_reference_then_estimates(
     tmp_path: Path,
 ) -> None:

@@ -8,6 +8,7 @@ tests/sim/.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -242,3 +243,81 @@ def test_truncated_log_is_reported(
     assert not back.complete
     assert back.bad_lines == 1
     assert len(back.records) == 1
+
+
+# -- the hold after buckling (a creep test) -------------------------------------------------------
+
+
+@dataclass
+class TimedFaultRig(ScriptedRig):
+    """A rig whose servo or FBG stream fails at a time (s), whatever the advance."""
+
+    servo_fault_t: float | None = None
+    stream_dies_t: float | None = None
+
+    def observe(self, t: float) -> Observation:
+        obs = super().observe(t)
+        if self.servo_fault_t is not None and t >= self.servo_fault_t:
+            self.servo_fault_t = None  # one fault; recover() clears it
+            self._fault = True
+            return dataclasses.replace(obs, servo_fault="overload")
+        if self.stream_dies_t is not None and t >= self.stream_dies_t:
+            return dataclasses.replace(obs, stream_age=1.0)
+        return obs
+
+
+def _hold_span(result) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+    start = next(tr.t for tr in result.transitions if tr.target is State.HOLDING)
+    end = next(tr.t for tr in result.transitions if tr.source is State.HOLDING)
+    return start, end
+
+
+def test_a_hold_stands_still_for_its_length_then_completes() -> None:
+    rig = ScriptedRig(VirtualClock())
+    result = run(rig, plan(hold_time=1.5))
+    assert result.state is State.DONE, result.reason
+    assert states(result.transitions) == [
+        "homing", "positioning", "approach", "contact",
+        "indenting", "buckled", "holding", "retracting", "done",
+    ]  # fmt: skip
+    start, end = _hold_span(result)
+    assert end - start == pytest.approx(1.5, abs=rig.tick)  # on the virtual clock
+    held = [a for (s, a, _), t in zip(result.record, result.times, strict=True) if s == "holding"]
+    assert len(held) == pytest.approx(1.5 / rig.tick, abs=2)
+    assert max(held) - min(held) <= TrialPlan.position_tolerance  # it only settled on its goal
+    assert result.times == sorted(result.times)
+    assert len(result.times) == len(result.record)
+
+
+def test_without_a_hold_the_states_are_unchanged() -> None:
+    result = run(ScriptedRig(VirtualClock()), plan(hold_time=0.0))
+    assert "holding" not in states(result.transitions)
+
+
+def test_a_servo_fault_during_the_hold_retracts() -> None:
+    clock = VirtualClock()
+    rig = TimedFaultRig(clock)
+    first = run(ScriptedRig(VirtualClock()), plan(hold_time=2.0))
+    start, _ = _hold_span(first)
+    rig.servo_fault_t = start + 0.5  # the same trial, faulted half a second into the hold
+    result = run(rig, plan(hold_time=2.0))
+    assert result.state is State.FAULT
+    assert "servo fault" in result.reason
+    assert states(result.transitions)[-3:] == ["holding", "retracting", "fault"]
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)  # pulled back after the reboot
+
+
+def test_a_lost_stream_during_the_hold_faults() -> None:
+    first = run(ScriptedRig(VirtualClock()), plan(hold_time=2.0))
+    start, _ = _hold_span(first)
+    rig = TimedFaultRig(VirtualClock(), stream_dies_t=start + 0.5)
+    result = run(rig, plan(hold_time=2.0))
+    assert result.state is State.FAULT
+    assert "FBG stream lost" in result.reason
+
+
+def test_a_hold_as_long_as_the_state_timeout_is_refused() -> None:
+    with pytest.raises(ValueError, match="hold_time"):
+        IndentationMachine(plan(hold_time=5.0), Guards(state_timeout=5.0), ThresholdDetector())
+    with pytest.raises(ValueError, match="hold_time"):
+        IndentationMachine(plan(hold_time=-1.0), Guards(), ThresholdDetector())

@@ -93,7 +93,7 @@ def test_a_held_advance_relaxes_and_a_released_tip_lets_the_tissue_recover() -> 
 
 
 def test_the_step_law_is_affine_with_a_gap_and_its_own_inverse() -> None:
-    state = ViscoelasticState(elastic_force=0.5, memory=0.2)
+    state = ViscoelasticState(elastic_force=0.5, memory=(0.2,))
     law = step_law(SLS, LAW, state, 0.01)
     assert law.b < 0  # the memory is below the last elastic force: the surface lags behind
     gap = law.inverse_at(0.0)

@@ -12,9 +12,9 @@ import math
 import numpy as np
 import pytest
 
-from estimation.corrections import sneddon_bracket, sneddon_y
 from estimation.hertz import hertz_force
 from estimation.layer import dimitriadis_coefficients
+from estimation.sneddon import sneddon_bracket, sneddon_y
 from sim.fem.problem import LayerProblem
 from sim.fem.solver import SolverOptions, solve_indentation
 

@@ -159,3 +159,16 @@ def test_the_paper_scenes_use_the_independent_world() -> None:
     for name in ("bench", "robot"):
         scene = load(SceneConfig, resolve(f"scenes/{name}.yaml"))
         assert scene.fidelity.tissue_model == "fe"
+
+
+def test_a_power_law_sample_gets_the_power_law_relaxation() -> None:
+    from sim.viscoelastic import PowerLawSolid
+
+    on = FidelityConfig(viscoelastic=True)
+    sample = SampleConfig(
+        name="P", modulus_kpa=500.0, relaxation="power-law", relaxation_time_s=0.1,
+        relaxation_exponent=0.8, relaxed_ratio=0.6,
+    )  # fmt: skip
+    relax = relaxation(sample, on)
+    assert isinstance(relax, PowerLawSolid)
+    assert (relax.tau, relax.ratio, relax.exponent) == (0.1, 0.6, 0.8)

@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 from scipy.special import dawsn
 
-from sim.viscoelastic import StandardLinearSolid, ViscoelasticState, force_history, step
+from sim.viscoelastic import (
+    PowerLawSolid,
+    StandardLinearSolid,
+    ViscoelasticState,
+    creep,
+    force_history,
+    step,
+)
 
 TAU = 0.8
 RATIO = 0.4
@@ -87,7 +94,7 @@ def test_speed_matters_between_the_two_moduli() -> None:
 def test_step_stiffness_is_the_derivative_of_the_step_force() -> None:
     law = PowerLaw(5e4, 1.5)
     sls = StandardLinearSolid(TAU, RATIO)
-    state = ViscoelasticState(elastic_force=law.force_and_stiffness_at(1e-3)[0], memory=3.0)
+    state = ViscoelasticState(elastic_force=law.force_and_stiffness_at(1e-3)[0], memory=(3.0,))
     _, k, _ = step(sls, law, state, 1.2e-3, 0.05)
     h = 1e-9
     fp, _, _ = step(sls, law, state, 1.2e-3 + h, 0.05)
@@ -104,3 +111,66 @@ def test_bad_parameters_are_rejected() -> None:
         StandardLinearSolid(1.0, 0.5).weights(-1.0)
     assert StandardLinearSolid(1.0, 0.5).weights(0.0) == (1.0, 1.0)
     assert math.isclose(float(StandardLinearSolid(1.0, 0.5).relaxation(0.0)), 1.0)
+
+
+# -- the power law, and creep under a held load against each form's closed form ------------------
+
+
+@pytest.mark.parametrize(("tau", "beta"), [(0.1, 0.5), (0.2, 1.0), (1e-3, 0.2), (1.0, 2.0)])
+def test_the_power_laws_prony_series_is_its_relaxation(tau: float, beta: float) -> None:
+    solid = PowerLawSolid(tau, 0.3, beta)
+    t = np.geomspace(1e-3, 1e4, 400)
+    np.testing.assert_allclose(solid.prony.relaxation(t), solid.relaxation(t), rtol=3e-3)
+    assert float(solid.prony.relaxation(0.0)) == pytest.approx(1.0, abs=1e-9)
+    assert sum(solid.prony.weights) == pytest.approx(0.7, rel=1e-12)
+
+
+@pytest.mark.parametrize("solid", [StandardLinearSolid(0.4, 0.5), PowerLawSolid(0.1, 0.5, 0.7)])
+def test_a_depth_step_relaxes_as_the_relaxation_function(
+    solid: StandardLinearSolid | PowerLawSolid,
+) -> None:
+    law = PowerLaw(2e3, 1.0)
+    t = np.concatenate([[0.0, 1e-7], np.geomspace(1e-3, 100.0, 300)])
+    depth = np.where(t > 0, 1e-3, 0.0)
+    f = force_history(solid, law, t, depth)
+    np.testing.assert_allclose(f[2:] / 2.0, solid.relaxation(t[2:] - 1e-7), rtol=3e-3)
+
+
+def test_creep_of_the_standard_linear_solid_is_its_closed_form() -> None:
+    sls = StandardLinearSolid(0.5, 0.4)
+    t = np.concatenate([[0.0], np.geomspace(1e-4, 1e3, 2000)])
+    exact = 1 / 0.4 - (1 / 0.4 - 1) * np.exp(-0.4 * t / 0.5)  # retardation time tau / r
+    np.testing.assert_allclose(creep(sls, t), exact, rtol=1e-5)
+
+
+@pytest.mark.parametrize("beta", [0.2, 0.5])
+def test_creep_of_the_power_law_is_its_closed_form(beta: float) -> None:
+    """G = t^-beta (tau -> 0, r -> 0) creeps as J = t^beta sin(pi beta) / (pi beta) (the
+    Laplace pair of the power law); with tau = 1 ms the shift is gone by t/tau = 1e5."""
+    solid = PowerLawSolid(1e-3, 1e-9, beta)
+    t = np.concatenate([[0.0], np.geomspace(1e-4, 1e3, 3000)])
+    late = t >= 100.0
+    exact = (t[late] / 1e-3) ** beta * math.sin(math.pi * beta) / (math.pi * beta)
+    np.testing.assert_allclose(creep(solid, t)[late], exact, rtol=1e-2)
+
+
+def test_creep_solves_the_volterra_equation_of_the_exact_kernel() -> None:
+    """integral G(t - s) dJ(s) = 1 by direct quadrature with the closed-form G, not the Prony
+    series the world steps with: two routes to the same creep."""
+    solid = PowerLawSolid(0.05, 0.4, 0.6)
+    t = np.linspace(0.0, 5.0, 2001)
+    j = creep(solid, t)
+    dj = np.diff(j)
+    mid = 0.5 * (t[1:] + t[:-1])
+    for k in (200, 1000, 2000):
+        total = j[0] * float(solid.relaxation(t[k])) + float(
+            np.sum(solid.relaxation(t[k] - mid[:k]) * dj[:k])
+        )
+        assert total == pytest.approx(1.0, abs=3e-3)
+
+
+def test_bad_power_laws_are_rejected() -> None:
+    with pytest.raises(ValueError, match="exponent"):
+        PowerLawSolid(0.1, 0.5, 0.0)
+    with pytest.raises(ValueError, match="ratio"):
+        PowerLawSolid(0.1, 0.0, 0.5)
