@@ -11,8 +11,6 @@ from scipy.integrate import quad
 from estimation.corrections import (
     ContactLaw,
     shape_values,
-    sneddon_y,
-    sneddon_y_at,
     validity_warnings,
 )
 from estimation.hertz import hertz_force
@@ -25,6 +23,7 @@ from estimation.layer import (
     layer_coefficients,
     layer_kernel,
 )
+from estimation.sneddon import sneddon_y, sneddon_y_at
 from sim.tissue import TissueModel
 
 R = 3.5e-3
