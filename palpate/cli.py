@@ -56,6 +56,10 @@ COMMANDS: dict[str, Command] = {
         "palpate.commands.replay",
         "Re-run the estimation on a recorded trial log and compare with what the trial reported.",
     ),
+    "export": Command(
+        "palpate.commands.export",
+        "Convert trial logs to MCAP recordings that ROS 2 tools and Foxglove open.",
+    ),
     "emulate": Command(
         "palpate.commands.emulate",
         "Start the Dynamixel bus and board emulators on pseudo-terminals and print their paths.",

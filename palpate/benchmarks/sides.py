@@ -12,7 +12,9 @@ section runs and removed afterwards (:func:`measured`).
 
 - simulator: the virtual clock's advance (servo motion, board frames, the world's contact), the
   emulated servo bus answering the driver's requests, the frame pipe, the contact tables;
-- control path: the trial loop and its ticks less the simulator's calls inside them;
+- control path: the trial loop and its ticks less the simulator's calls inside them, the MCAP
+  recording (its messages as the trial runs; at its close the tip force, whose beam states count
+  as the estimator's);
 - estimator: the joint fit, the beam states, the paper's strain fit, and the rest of the
   trial's estimate (the paper's single point, Southwell, the verdict);
 - set-up: the rest of a trial (geometry, world, emulators, driver, zeroing);
@@ -69,6 +71,8 @@ BOUNDARIES = (
     Boundary("sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
     Boundary("palpate.simulation.trial", "run_trial", "trial loop", CONTROL),
     Boundary("robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
+    Boundary("robot.trial.recording:McapRecorder", "write", "MCAP recording", CONTROL),
+    Boundary("robot.trial.recording:McapRecorder", "close", "MCAP close (tip force)", CONTROL),
     Boundary("robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
     Boundary("robot.trial.states", "infer_states", "beam states", ESTIMATOR),
     Boundary("robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),

@@ -17,6 +17,12 @@ from robot.trial.log import TrialLogError
 
 def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("log", type=Path, help="a trial log (.jsonl) written by palpate sim/trial")
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        metavar="PNG",
+        help="draw the record's force against indentation with the fit (palpate/reports/fitplot)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -24,12 +30,23 @@ def run(args: argparse.Namespace) -> int:
         report = replay(args.log)
     except TrialLogError as exc:
         raise ValueError(str(exc)) from None
+    if args.plot is not None and not report.get("damaged"):
+        from palpate.reports.fitplot import record_fit
+        from robot.trial.log import read_log
+
+        try:
+            report["plot"] = str(record_fit(read_log(args.log), args.plot))
+        except ValueError as exc:  # a truncated log has no fit to draw: said, not an error
+            report["plot"] = None
+            report["plot_message"] = str(exc)
     if args.json:
         print(json.dumps(report, indent=2))
         if report.get("damaged"):
             return 2
     else:
         print(f"trial {report['trial']} ({report['log']})")
+        if args.plot is not None:
+            print(f"plot: {report.get('plot') or report.get('plot_message')}")
         if report.get("damaged"):  # bad input: lines that do not follow the log format
             raise ValueError(f"{args.log}: {report['message']}")
         if "message" in report:

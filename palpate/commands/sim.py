@@ -30,6 +30,7 @@ from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, 
 from palpate.cli import EXIT_FAULT, EXIT_OK
 from palpate.progress import progress_bar
 from palpate.reports import verdicts
+from palpate.reports.fitplot import fit_figures
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
 from palpate.simulation.world import tissue_description
@@ -318,7 +319,7 @@ def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
     figures = [str(plots.estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))]
     if outcomes[0].series.get("advance"):  # not when the first trial was resumed
         figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
-    return figures
+    return figures + fit_figures(outcomes, out_dir, c.scene.name)
 
 
 def _print_report(

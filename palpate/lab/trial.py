@@ -218,7 +218,7 @@ def _run_one(
     section = sensor_section(stack)
     inputs = bench_inputs(trial, loaded, stack)
     path = log_dir / f"{trial.trial_id}.jsonl"
-    with TrialLogWriter(path, _header(trial, loaded, section, inputs)) as log:
+    with TrialLogWriter(path, _header(trial, loaded, section, inputs), mcap=True) as log:
         guards = guards_for(c, stack, rig.tick)
         # the robot probes the surface first when the campaign says so (null: it does)
         prober = prober_for(c, stack, trial.tube) if trial.kind == "robot" else None

@@ -287,7 +287,7 @@ def _trial_log(
         yield None
         return
     header = _header(spec, scene, stack, plan, geo)
-    with TrialLogWriter(log_dir / f"{spec.trial_id}.jsonl", header) as log:
+    with TrialLogWriter(log_dir / f"{spec.trial_id}.jsonl", header, mcap=True) as log:
         if hook is not None:
             hook.log_opened(log)
         yield log

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from robot.trial.logschema import LogRecordError, check_record
+from robot.trial.recording import McapRecorder, axial_loads
 
 FORMAT = "palpate-trial-log"
 VERSION = 1
@@ -56,6 +57,7 @@ class TrialLogWriter:
         *,
         fsync: bool = False,
         flush_every_s: float = 0.1,
+        mcap: bool = False,
     ) -> None:
         if not flush_every_s >= 0:
             raise ValueError(f"flush_every_s must be >= 0, got {flush_every_s}")
@@ -68,7 +70,10 @@ class TrialLogWriter:
         self._pending: list[str] = []
         self._pending_t0 = math.inf  # time ``t`` of the oldest pending sample
         self._fh: IO[str] | None = open(self.path, "x", encoding="utf-8")  # noqa: SIM115
-        self.write({"kind": "header", "format": FORMAT, "version": VERSION, **header})
+        full = {"format": FORMAT, "version": VERSION, **header}
+        # the MCAP recording beside it (robot.trial.recording): every record, as it is written
+        self.recording = McapRecorder(self.path.with_suffix(".mcap"), full) if mcap else None
+        self.write({"kind": "header", **full})
 
     def write(self, record: dict[str, Any]) -> None:
         """Append one record; flushed at once unless it is a sample (see the module docstring)."""
@@ -80,6 +85,8 @@ class TrialLogWriter:
             line = json.dumps(_clean(record), separators=(",", ":"), allow_nan=False)
         self._pending.append(line)
         self.written += 1
+        if self.recording is not None:
+            self.recording.write(record, line)
         t = record.get("t")
         if record.get("kind") != "sample" or not isinstance(t, float | int):
             self.flush()
@@ -89,7 +96,10 @@ class TrialLogWriter:
             self.flush()
 
     def flush(self) -> None:
-        """Write the pending lines and flush them to the OS (fsync'ed on request)."""
+        """Write the pending lines and flush them to the OS (fsync'ed on request), and the
+        recording's messages with them."""
+        if self.recording is not None:
+            self.recording.flush()
         if self._fh is None or not self._pending:
             return
         self._fh.write("\n".join(self._pending) + "\n")
@@ -105,6 +115,8 @@ class TrialLogWriter:
             self.flush()
             self._fh.close()
             self._fh = None
+        if self.recording is not None:
+            self.recording.close(axial_loads)
 
     def __enter__(self) -> TrialLogWriter:
         return self

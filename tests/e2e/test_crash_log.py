@@ -16,6 +16,7 @@ from config.scene import SceneConfig
 from palpate.cli import main
 from palpate.faults import child_command, fault_jobs
 from robot.trial.log import read_log
+from robot.trial.recording import read_recording
 
 SCENE_PATH = resolve("scenes/faults.yaml")
 SCENE = load(SceneConfig, SCENE_PATH)
@@ -63,6 +64,16 @@ def test_sigkill_mid_trial_keeps_every_record_written(
     assert {"sample", "transition"} <= kinds
     assert main(["replay", str(path)]) == 1
     assert "truncated log" in capsys.readouterr().out
+    # the MCAP recording beside it reads up to the kill: a message for every sample the log kept
+    recording = read_recording(path.with_suffix(".mcap"))
+    assert not recording.complete
+    samples = sum(1 for r in log.records if r["kind"] == "sample")
+    assert recording.count("/joint_states") >= samples
+    assert recording.count("/palpate/transition") >= sum(
+        1 for r in log.records if r["kind"] == "transition"
+    )
+    times = [t for t, _ in recording.messages["/joint_states"]]
+    assert times == sorted(times)
 
 
 def test_a_torn_last_line_is_counted_not_fatal(

@@ -1,0 +1,165 @@
+"""Figures that show the fit: a trial's force against indentation with the fitted model, and a
+campaign's estimates with their intervals against the reference.
+
+The trial figure is drawn from the trial's log alone (so ``palpate replay --plot`` draws it for
+any log, simulated or from the bench): the loading record's axial load and depth from the
+strains (the estimator's beam states), the depth measured from the joint fit's contact
+``delta = u - x0 - e - c P``; the fitted model ``P0 + E f(delta)`` at the best hypothesis; the
+fitted contact (delta = 0, with its interval); the paper's single point (Eqs. 13-14: its depth
+from the contact event and the buckling mark, its load from the elastica); for a trial that held
+after buckling, the held samples in their own colour. Nothing of the simulated world is drawn.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from matplotlib.lines import Line2D
+
+from estimation.corrections import ContactLaw
+from robot.trial.log import TrialLog, read_log
+from robot.trial.record import header_sensor
+from robot.trial.relaxed import HOLD_STATE
+from robot.trial.states import LOADING_STATES, record_states
+
+STATUS_COLOURS = {"ok": "tab:green", "suspect": "tab:orange", "none": "0.6"}
+
+
+def record_fit(log: TrialLog, path: Path) -> Path:
+    """The trial's force-indentation record with its fit (see the module docstring) as a PNG at
+    ``path``. Raises ValueError when the log has no joint fit to draw."""
+    estimate = next(log.of_kind("estimate"), None)
+    joint = None if estimate is None else estimate.get("joint")
+    if not isinstance(joint, dict) or joint.get("modulus") is None or joint.get("best") is None:
+        raise ValueError(f"{log.path}: no joint fit to draw (the trial has no estimate)")
+    sensor, section, inputs = header_sensor(log.header, str(log.path))
+    gratings = len(sensor.used_gratings)
+    states_of = [*LOADING_STATES, HOLD_STATE]
+    rows = [r for r in log.of_kind("sample") if r["state"] in states_of]
+    rows = [r for r in rows if len(r["strains"]) == gratings and r["advance"] is not None]
+    advance = np.array([r["advance"] for r in rows], dtype=np.float64)
+    strains = np.array([r["strains"] for r in rows], dtype=np.float64).reshape(-1, gratings)
+    states, _ = record_states(advance, strains, inputs, sensor, section)
+    best: dict[str, Any] = joint["best"]
+    compliance = float(best.get("compliance") or 0.0)
+    x0, offset = float(joint["contact"]), float(joint.get("load_offset") or 0.0)
+    depth = advance - states.e - compliance * states.P - x0
+    held = np.array([r["state"] == HOLD_STATE for r in rows])
+    law = ContactLaw(
+        inputs.tip_radius,
+        float(best["poisson"]),
+        None if best.get("thickness") is None else float(best["thickness"]),
+        bool(best["bonded"]),
+        layer_law=inputs.belief().layer_law,
+    )
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    mm = 1e3
+    ax.plot(depth[~held] * mm, states.P[~held], ".", ms=2, color="0.35", label="record (strains)")
+    if held.any():
+        ax.plot(depth[held] * mm, states.P[held], ".", ms=2, color="tab:purple", label="hold")
+    grid = np.linspace(min(depth.min(), 0.0), depth.max(), 300)
+    model = offset + float(joint["modulus"]) * law.shape(grid)[0]
+    label = f"fit: E = {joint['modulus'] / 1e3:.0f} kPa {_interval(joint)}"
+    ax.plot(grid * mm, model, color="tab:blue", lw=1.5, label=label)
+    relaxation = (estimate or {}).get("relaxation") or {}
+    if relaxation.get("relaxes") and relaxation.get("relaxed") is not None:
+        relaxed = offset + float(relaxation["relaxed"]) * law.shape(grid)[0]
+        text = f"relaxed: E_inf = {relaxation['relaxed'] / 1e3:.0f} kPa"
+        ax.plot(grid * mm, relaxed, color="tab:purple", lw=1.2, ls="--", label=text)
+    _contact(ax, joint, x0)
+    _paper(ax, estimate)
+    verdict = (estimate or {}).get("verdict") or {}
+    status = verdict.get("status", "-")
+    ax.set_title(f"trial {log.header.get('trial')}: verdict {status}")
+    ax.set_xlabel("indentation from the fitted contact (mm)")
+    ax.set_ylabel("axial load P from the strains (N)")
+    ax.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def _interval(joint: dict[str, Any]) -> str:
+    lo, hi = joint.get("ci_low"), joint.get("ci_high")
+    return "" if lo is None or hi is None else f"[{lo / 1e3:.0f}, {hi / 1e3:.0f}]"
+
+
+def _contact(ax: Any, joint: dict[str, Any], x0: float) -> None:
+    """The fitted contact (delta = 0) and its interval, in the record's depth coordinate."""
+    ax.axvline(0.0, color="tab:blue", ls=":", lw=1, label="fitted contact")
+    lo, hi = joint.get("contact_low"), joint.get("contact_high")
+    if lo is not None and hi is not None:
+        ax.axvspan((lo - x0) * 1e3, (hi - x0) * 1e3, color="tab:blue", alpha=0.12)
+
+
+def _paper(ax: Any, estimate: dict[str, Any] | None) -> None:
+    """The paper's single point at its own depth (from its contact event to its buckling mark)
+    and load: where it sits off the record shows what its contact event cost it."""
+    if estimate is None or estimate.get("delta") is None or estimate.get("force") is None:
+        return
+    delta, force = float(estimate["delta"]), float(estimate["force"])
+    modulus = estimate.get("modulus")
+    what = "" if modulus is None else f": {modulus / 1e3:.0f} kPa"
+    ax.plot([delta * 1e3], [force], "r^", ms=7, label=f"paper (Eqs. 13-14){what}")
+
+
+def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: str) -> Path:
+    """Each trial's joint estimate with its 95 % interval (coloured by verdict) and the paper's
+    estimate beside it, over the reference (and, in simulation, the truth): the ``--json``
+    trial rows of ``palpate sim`` (``joint_kpa``, ``joint_ci_kpa``, ``estimated_kpa``,
+    ``verdict``, ``actual_kpa``, ``reference_kpa``)."""
+    fig, ax = plt.subplots(figsize=(max(7.0, 0.18 * len(rows) + 3), 4.8))
+    for i, r in enumerate(rows):
+        truth, reference = r.get("actual_kpa"), r.get("reference_kpa")
+        if truth is not None:
+            ax.plot([i - 0.4, i + 0.4], [truth, truth], color="k", lw=1)
+        if reference is not None:
+            ax.plot([i - 0.4, i + 0.4], [reference, reference], color="0.5", lw=1, ls="--")
+        colour = STATUS_COLOURS.get(str(r.get("verdict")), "0.6")
+        if r.get("joint_kpa") is not None:
+            lo, hi = r.get("joint_ci_kpa") or (None, None)
+            yerr = None
+            if lo is not None and hi is not None:
+                yerr = [[r["joint_kpa"] - lo], [hi - r["joint_kpa"]]]
+            ax.errorbar([i - 0.1], [r["joint_kpa"]], yerr=yerr, fmt="o", ms=4, color=colour)
+        if r.get("estimated_kpa") is not None:
+            ax.plot([i + 0.15], [r["estimated_kpa"]], "x", ms=5, color="tab:red")
+    handles = [
+        Line2D([], [], color="k", lw=1, label="truth"),
+        Line2D([], [], color="0.5", lw=1, ls="--", label="reference"),
+        *(
+            Line2D([], [], marker="o", ls="", color=c, label=f"joint fit, {s}")
+            for s, c in STATUS_COLOURS.items()
+        ),
+        Line2D([], [], marker="x", ls="", color="tab:red", label="paper (Eqs. 13-14)"),
+    ]
+    ax.legend(handles=handles, fontsize=7, ncol=3)
+    ax.set_xticks(range(len(rows)), [str(r.get("trial")) for r in rows], rotation=90, fontsize=6)
+    ax.set_ylabel("Young's modulus (kPa), 95 % interval")
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def fit_figures(outcomes: Sequence[Any], out_dir: Path, name: str) -> list[str]:
+    """``palpate sim``'s figures of the fit: every trial's estimate with its interval
+    (``intervals.png``) and the first trial with a joint fit drawn from its log (``fit.png``)."""
+    rows = [o.as_dict() for o in outcomes if o.calibration is None]
+    title = f"{name}: each trial's estimate, its 95 % interval and verdict"
+    figures = [str(estimates_with_intervals(rows, out_dir / "intervals.png", title))]
+    for o in outcomes:
+        if o.log_path is None or o.joint is None or o.joint.modulus is None:
+            continue
+        figures.append(str(record_fit(read_log(o.log_path), out_dir / "fit.png")))
+        break
+    return figures

@@ -1,0 +1,230 @@
+"""MCAP recordings of trials, beside the JSON Lines log (which stays the replay source).
+
+A :class:`McapRecorder` takes every record its trial log writes (``robot.trial.log``) and
+writes its ROS 2 messages (``robot.trial.ros2``) to ``<log>.mcap`` as the trial runs, flushed
+when the log flushes (every record that is not a sample, every 0.1 s of samples), so a crash
+keeps what the JSON log keeps. The file is written unchunked (every message a record of its
+own, readable up to the last byte written) and closed with MCAP's summary and footer; the
+header record is the recording's metadata ``palpate.trial`` (its keys, values as JSON). When
+the trial ends the tip force is derived from every sample's strains (the estimator's beam
+states, ``robot.trial.states``) and written as ``/tip/wrench``.
+
+:func:`export` converts an existing log; :func:`read_recording` reads one back without ROS,
+through ``mcap``'s stream reader and ``mcap-ros2-support``'s CDR decoder, up to where a killed
+trial's file ends.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from mcap.exceptions import McapError  # type: ignore[import-untyped,unused-ignore]
+from mcap.records import Channel, Message, Schema  # type: ignore[import-untyped,unused-ignore]
+from mcap.stream_reader import StreamReader  # type: ignore[import-untyped,unused-ignore]
+from mcap.well_known import MessageEncoding, SchemaEncoding  # type: ignore[import-untyped,unused-ignore]
+from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,unused-ignore]
+from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
+from mcap_ros2.decoder import DecoderFactory  # type: ignore[import-untyped,unused-ignore]
+
+from robot.trial.ros2 import SCHEMAS, TOPICS, messages, nanoseconds, sample_messages, wrench
+
+LIBRARY = "palpate"
+
+
+class McapRecorder:
+    """One trial's MCAP recording (see the module docstring): ``write`` each log record with
+    its JSON line, ``close`` at the end (idempotent)."""
+
+    def __init__(self, path: str | Path, header: dict[str, Any]) -> None:
+        self.path = Path(path)
+        self._fh: IO[bytes] | None = open(self.path, "wb")  # noqa: SIM115
+        self._writer = Writer(self._fh, use_chunking=False, compression=CompressionType.NONE)
+        self._writer.start(profile="ros2", library=LIBRARY)
+        self._writer.add_metadata("palpate.trial", _metadata(header))
+        self._channels: dict[str, int] = {}
+        self._encoders: dict[str, Callable[[Any], bytes]] = {}
+        self._last_ns = 0
+        self.samples: list[tuple[int, Any, list[Any]]] = []  # (stamp, advance, strains)
+        self.header = header
+        self.count = 0
+
+    def write(self, record: dict[str, Any], line: str) -> None:
+        if self._fh is None:
+            raise ValueError(f"recording {self.path} is closed")
+        if record.get("kind") == "header":
+            return
+        t = record.get("t")
+        if isinstance(t, int | float) and math.isfinite(t):
+            self._last_ns = max(self._last_ns, nanoseconds(float(t)))
+        if record.get("kind") == "sample":
+            for topic, data in sample_messages(record, self._last_ns):
+                self._raw(topic, data)
+            self.samples.append((self._last_ns, record.get("advance"), record.get("strains") or []))
+            return
+        for topic, message in messages(record, self._last_ns, line):
+            self._raw(topic, self._encoder(topic)(message))
+
+    def _channel(self, topic: str) -> int:
+        channel = self._channels.get(topic)
+        if channel is None:
+            name = TOPICS[topic]
+            schema = self._writer.register_schema(name, SchemaEncoding.ROS2, SCHEMAS[name].encode())
+            channel = self._writer.register_channel(topic, MessageEncoding.CDR, schema)
+            self._channels[topic] = channel
+        return channel
+
+    def _encoder(self, topic: str) -> Callable[[Any], bytes]:
+        """The definition-driven CDR encoder of ``topic``'s type (``mcap-ros2-support``)."""
+        encoder = self._encoders.get(topic)
+        if encoder is None:
+            name = TOPICS[topic]
+            encoder = self._encoders[topic] = serialize_dynamic(name, SCHEMAS[name])[name]
+        return encoder
+
+    def _raw(self, topic: str, data: bytes) -> None:
+        stamp = self._last_ns
+        self._writer.add_message(
+            self._channel(topic), log_time=stamp, data=data, publish_time=stamp
+        )
+        self.count += 1
+
+    def flush(self) -> None:
+        """Hand the messages written so far to the OS (the log calls it when it flushes)."""
+        if self._fh is not None:
+            self._fh.flush()
+
+    def close(self, loads: Callable[[McapRecorder], list[float] | None] | None = None) -> None:
+        """Write the derived tip force (``loads``: the axial load per sample, N; None or a
+        failure writes none), then MCAP's summary and footer."""
+        if self._fh is None:
+            return
+        forces = loads(self) if loads is not None else None
+        if forces is not None:
+            for (stamp, _, _), load in zip(self.samples, forces, strict=True):
+                self._last_ns = stamp
+                self._raw(*wrench(stamp, load))
+        self._writer.finish()  # type: ignore[no-untyped-call,unused-ignore]
+        self._fh.close()
+        self._fh = None
+
+
+def _metadata(header: dict[str, Any]) -> dict[str, str]:
+    return {str(k): json.dumps(v, separators=(",", ":"), default=str) for k, v in header.items()}
+
+
+@dataclass
+class Recording:
+    """A recording read back: its metadata, each topic's type and decoded messages (with their
+    log times, ns), and whether the file was closed (``complete``) or ends mid-way."""
+
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    types: dict[str, str] = field(default_factory=dict)
+    schemas: dict[str, str] = field(default_factory=dict)  # type -> its definition text
+    messages: dict[str, list[tuple[int, Any]]] = field(default_factory=dict)
+    complete: bool = False
+
+    def count(self, topic: str) -> int:
+        return len(self.messages.get(topic, []))
+
+
+def read_recording(path: str | Path) -> Recording:
+    """Every message of an MCAP file, decoded without ROS, in file order; a file cut short (a
+    killed trial) reads up to its last whole record (``complete`` False)."""
+    out = Recording()
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, Channel] = {}
+    decoders: dict[int, Callable[[bytes], Any]] = {}
+    factory = DecoderFactory()
+    with open(path, "rb") as fh:
+        try:
+            for record in StreamReader(fh, skip_magic=False).records:
+                _take(record, out, schemas, channels, decoders, factory)
+        except (McapError, EOFError) as exc:
+            out.complete = False
+            if not _is_end_of_file(exc):
+                raise
+    return out
+
+
+def _is_end_of_file(exc: Exception) -> bool:
+    return type(exc).__name__ == "EndOfFile" or isinstance(exc, EOFError)
+
+
+def _take(
+    record: Any,
+    out: Recording,
+    schemas: dict[int, Schema],
+    channels: dict[int, Channel],
+    decoders: dict[int, Callable[[bytes], Any]],
+    factory: DecoderFactory,
+) -> None:
+    kind = type(record).__name__
+    if isinstance(record, Schema):
+        schemas[record.id] = record
+        out.schemas[record.name] = record.data.decode()
+    elif isinstance(record, Channel):
+        channels[record.id] = record
+        out.types[record.topic] = schemas[record.schema_id].name
+        decoder = factory.decoder_for(record.message_encoding, schemas[record.schema_id])
+        if decoder is None:
+            raise McapError(f"no decoder for channel {record.topic}")
+        decoders[record.id] = decoder
+    elif isinstance(record, Message):
+        topic = channels[record.channel_id].topic
+        out.messages.setdefault(topic, []).append(
+            (record.log_time, decoders[record.channel_id](record.data))
+        )
+    elif kind == "Metadata":
+        out.metadata[record.name] = dict(record.metadata)
+    elif kind == "Footer":
+        out.complete = True
+
+
+def export(log_path: str | Path, out: str | Path | None = None) -> Path:
+    """The MCAP recording of an existing trial log (``<log>.mcap`` unless ``out``): the same
+    messages its trial would have recorded. Raises ``TrialLogError`` for an unreadable log."""
+    from robot.trial.log import read_log  # the log module records through this one
+
+    log = read_log(log_path)
+    target = Path(out) if out is not None else Path(log_path).with_suffix(".mcap")
+    recorder = McapRecorder(target, log.header)
+    for record in log.records:
+        recorder.write(record, json.dumps(record, separators=(",", ":"), allow_nan=False))
+    recorder.close(axial_loads)
+    return target
+
+
+def axial_loads(recorder: McapRecorder) -> list[float] | None:
+    """The axial load (N) at every sample of ``recorder`` from its strains (the estimator's beam
+    states; NaN where a sample's strains are incomplete), or None when the header lacks the
+    sensor, the section or the estimator's inputs."""
+    from robot.trial.record import header_sensor
+    from robot.trial.states import record_states
+
+    try:
+        sensor, section, inputs = header_sensor(recorder.header)
+    except (KeyError, TypeError, ValueError):  # ConfigError is a ValueError
+        return None
+    gratings = len(sensor.used_gratings)
+    rows = [i for i, (_, u, s) in enumerate(recorder.samples) if _whole([u, *s], gratings + 1)]
+    loads = [math.nan] * len(recorder.samples)
+    if not rows:
+        return loads
+    strains = np.asarray([recorder.samples[i][2] for i in rows], dtype=np.float64)
+    advance = np.asarray([recorder.samples[i][1] for i in rows], dtype=np.float64)
+    states, _ = record_states(advance, strains, inputs, sensor, section)
+    for i, load in zip(rows, states.P.tolist(), strict=True):
+        loads[i] = load
+    return loads
+
+
+def _whole(strains: list[Any], gratings: int) -> bool:
+    return len(strains) == gratings and all(
+        isinstance(v, int | float) and math.isfinite(v) for v in strains
+    )

@@ -1,0 +1,147 @@
+"""A trial's log records as ROS 2 messages: the definitions and the pure conversions.
+
+Standard definitions where one exists, the project's own (``palpate_msgs``) where none does
+(docs/recordings.md lists them). Each definition is the ``ros2msg`` text MCAP stores: the type's
+fields, then each dependency after a line of ``=`` as ``MSG: pkg/Type``.
+
+Channels, one message per log record of the kind (a ``sample`` gives two):
+
+- ``/joint_states`` (``sensor_msgs/msg/JointState``): each sample's stage translation (m) and
+  outer roll (rad);
+- ``/fbg/strains`` (``palpate_msgs/msg/GratingStrains``): each sample's state, strains, contact
+  event and goal;
+- ``/palpate/transition`` (``palpate_msgs/msg/StateTransition``): each transition;
+- ``/palpate/record`` (``palpate_msgs/msg/Record``): the ``probe``, ``world``, ``estimate`` and
+  ``end`` records, as their JSON lines;
+- ``/tip/wrench`` (``geometry_msgs/msg/WrenchStamped``): each sample with whole strains, the tip
+  force derived from them when the trial ends.
+
+Times: a record's ``t`` (s, the rig's clock) as nanoseconds; a record without one (the estimate,
+the end) takes the last time seen, so every channel's times never decrease.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from robot.trial import cdr
+
+SEP = "\n" + "=" * 80 + "\n"
+TIME = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+HEADER = "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
+VECTOR3 = "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n"
+WRENCH = "MSG: geometry_msgs/Wrench\ngeometry_msgs/Vector3 force\ngeometry_msgs/Vector3 torque\n"
+
+
+def _definition(fields: str, *dependencies: str) -> str:
+    return fields + "".join(SEP + d for d in dependencies)
+
+
+SCHEMAS: dict[str, str] = {
+    "sensor_msgs/msg/JointState": _definition(
+        "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
+        "float64[] effort\n",
+        HEADER,
+        TIME,
+    ),
+    "geometry_msgs/msg/WrenchStamped": _definition(
+        "std_msgs/Header header\ngeometry_msgs/Wrench wrench\n", HEADER, WRENCH, VECTOR3, TIME
+    ),
+    "palpate_msgs/msg/GratingStrains": _definition(
+        "# one control tick: the state machine's state after it, the used gratings' strains\n"
+        "std_msgs/Header header\nstring state\nfloat64[] strain\nbool contact\nfloat64 goal\n",
+        HEADER,
+        TIME,
+    ),
+    "palpate_msgs/msg/StateTransition": _definition(
+        "# a transition of the indentation state machine\n"
+        "std_msgs/Header header\nstring from_state\nstring to_state\nstring reason\n"
+        "float64 advance\nfloat64[] strain\n",
+        HEADER,
+        TIME,
+    ),
+    "palpate_msgs/msg/Record": _definition(
+        "# a trial log record without a standard type: its kind and the record as JSON\n"
+        "std_msgs/Header header\nstring kind\nstring json\n",
+        HEADER,
+        TIME,
+    ),
+}
+
+TOPICS: dict[str, str] = {
+    "/joint_states": "sensor_msgs/msg/JointState",
+    "/fbg/strains": "palpate_msgs/msg/GratingStrains",
+    "/palpate/transition": "palpate_msgs/msg/StateTransition",
+    "/palpate/record": "palpate_msgs/msg/Record",
+    "/tip/wrench": "geometry_msgs/msg/WrenchStamped",
+}
+JOINTS = ["stage_translation", "outer_roll"]
+Message = tuple[str, dict[str, Any]]  # (topic, message)
+
+
+def nanoseconds(t: float) -> int:
+    """Seconds as whole nanoseconds (>= 0: MCAP's times are unsigned)."""
+    return max(round(t * 1e9), 0)
+
+
+def header(stamp_ns: int, frame: str) -> dict[str, Any]:
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    return {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": frame}
+
+
+def _number(value: Any) -> float:
+    return math.nan if value is None else float(value)
+
+
+def _numbers(values: Sequence[Any]) -> list[float]:
+    return [_number(v) for v in values]
+
+
+def sample_messages(record: dict[str, Any], stamp_ns: int) -> list[tuple[str, bytes]]:
+    """A ``sample`` record's two messages, CDR-encoded (``robot.trial.cdr``: they are written
+    every control tick)."""
+    joints = cdr.joint_state(
+        stamp_ns, "stage", JOINTS, _numbers([record["advance"], record["roll"]])
+    )
+    strains = cdr.grating_strains(
+        stamp_ns,
+        "sensor",
+        record["state"],
+        _numbers(record["strains"]),
+        bool(record["contact"]),
+        _number(record.get("goal")),
+    )
+    return [("/joint_states", joints), ("/fbg/strains", strains)]
+
+
+def messages(record: dict[str, Any], stamp_ns: int, line: str) -> list[Message]:
+    """The messages of a log record that is neither the header (the recording's metadata) nor
+    a sample (:func:`sample_messages`); ``line`` is the record as its log writes it (JSON, NaN
+    as null)."""
+    if record.get("kind") == "transition":
+        return [
+            (
+                "/palpate/transition",
+                {
+                    "header": header(stamp_ns, "stage"),
+                    "from_state": record["from"],
+                    "to_state": record["to"],
+                    "reason": record["reason"],
+                    "advance": _number(record["advance"]),
+                    "strain": _numbers(record["strains"]),
+                },
+            )
+        ]
+    kind = str(record.get("kind"))
+    return [("/palpate/record", {"header": header(stamp_ns, ""), "kind": kind, "json": line})]
+
+
+def wrench(stamp_ns: int, load: float) -> tuple[str, bytes]:
+    """The tissue's push on the tip (N) along the sensor axis, in the tip's frame (+z into the
+    tissue): ``-load``, the axial load the strains give (compression positive); CDR-encoded."""
+    return (
+        "/tip/wrench",
+        cdr.wrench_stamped(stamp_ns, "sensor_tip", (0.0, 0.0, -load), (0.0,) * 3),
+    )
