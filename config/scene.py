@@ -84,6 +84,9 @@ class CampaignConfig:
     # Each trial at each of these speeds instead (a viscoelastic scene's speed sweep); empty:
     # indent_speed_mm_per_s alone.
     indent_speeds_mm_per_s: tuple[float, ...] = field(default=(), metadata=limits(gt=0, le=100))
+    # Approach at the indentation speed instead of approach_speed_mm_per_s: one constant-rate
+    # ramp through the contact, the history a relaxing tissue's fit needs (docs/viscoelastic.md).
+    ramp_through_contact: bool = False
     post_buckling_mm: float = field(default=0.3, metadata=limits(ge=0, le=20))
     # Stand still this long after the post-buckling travel: a creep test the gratings record, from
     # which the estimator reads the relaxed and instantaneous moduli (estimation.relaxation);

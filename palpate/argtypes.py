@@ -38,3 +38,14 @@ def positive_float(text: str) -> float:
 
 positive_int = int_at_least(1)
 non_negative_int = int_at_least(0)
+
+
+def port_number(text: str) -> int:
+    """A TCP port, 0-65535 (0: any free port) (``--live``)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"a port is 0-65535 (0: any free one), got {value}")
+    return value

@@ -39,3 +39,18 @@ def test_a_speed_sweep_runs_each_trial_at_each_speed() -> None:
     spec = campaign_trials(plain, STACK)[0]
     assert spec.indent_speed is None
     assert trial_campaign(spec, plain) == plain.campaign
+
+
+def test_a_campaign_that_ramps_through_the_contact_approaches_at_the_indentation_speed() -> None:
+    from robot.trial.setup import trial_plan
+
+    scene = load(SceneConfig, resolve("scenes/viscoelastic/power-law.yaml"))
+    assert scene.campaign.ramp_through_contact
+    spec = campaign_trials(scene, STACK)[0]
+    ramp = trial_plan(trial_campaign(spec, scene), STACK, roll=0.0, contact=0.01, home=0.0)
+    assert ramp.approach_speed == pytest.approx(ramp.indent_speed) == pytest.approx(0.1e-3)
+    plain = load(SceneConfig, resolve("scenes/bench.yaml")).campaign
+    assert not plain.ramp_through_contact
+    step = trial_plan(plain, STACK, roll=0.0, contact=0.01, home=0.0)
+    assert step.approach_speed == pytest.approx(plain.approach_speed_mm_per_s * 1e-3)
+    assert step.approach_speed > step.indent_speed

@@ -17,5 +17,6 @@ SECTIONS: dict[str, str] = {
     "tissue": "palpate.benchmarks.tissue",
     "tissue-fe": "palpate.benchmarks.tissue_fe",
     "hold": "palpate.benchmarks.hold",
+    "live": "palpate.benchmarks.live",
     "fuzz": "palpate.benchmarks.fuzz",
 }

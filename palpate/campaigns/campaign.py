@@ -20,6 +20,7 @@ from estimation.elastica import fast
 from estimation.stiffness import SampleSummary, summarize
 from palpate.calibration import calibrated, is_reference
 from palpate.campaigns.executors import SerialExecutor, process_pool
+from palpate.live import LiveView
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 
 
@@ -97,6 +98,7 @@ class _Job:
     transport: Transport
     log_dir: Path | None
     keep_series: bool
+    live: LiveView | None = None  # in-process only: a serial executor
 
 
 def _run_job(job: _Job) -> TrialOutcome:
@@ -107,6 +109,7 @@ def _run_job(job: _Job) -> TrialOutcome:
         transport=job.transport,
         log_dir=job.log_dir,
         keep_series=job.keep_series,
+        live=job.live,
     )
 
 
@@ -144,6 +147,7 @@ class CampaignRun:
     # trials of this campaign already done (read back by ``--resume``): their reference trials
     # calibrate the rest as if they had run now
     prior: Sequence[TrialOutcome] = ()
+    live: LiveView | None = None  # the live view the trials publish to (a serial executor only)
 
 
 @dataclass(frozen=True)
@@ -223,11 +227,24 @@ def _execute(
     """Run ``trials`` (campaign index, its run, spec) on ``executor`` (None or serial: here, in
     order); the outcomes in the order of ``trials``."""
     jobs = [
-        (i, _Job(s, r.scene, r.stack, r.transport, r.log_dir, s.trial_id == runs[i].series_for))
+        (
+            i,
+            _Job(
+                s,
+                r.scene,
+                r.stack,
+                r.transport,
+                r.log_dir,
+                s.trial_id == runs[i].series_for,
+                r.live,
+            ),
+        )
         for i, r, s in trials
     ]
     if executor is None or isinstance(executor, SerialExecutor):
         return [done(i, _run_job(job)) for i, job in jobs]
+    if any(r.live is not None for r in runs):
+        raise ValueError("--live shows one trial at a time: run with --executor serial")
     futures = {executor.submit(_run_job, job): i for i, job in jobs}
     for fut in as_completed(futures):
         done(futures[fut], fut.result())

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import json
 import logging
 import time
@@ -28,9 +29,10 @@ from palpate.campaigns.executors import add_executor_arguments, open_executor
 from palpate.campaigns.resume import resume_outcomes
 from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
 from palpate.cli import EXIT_FAULT, EXIT_OK
+from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
 from palpate.reports import verdicts
-from palpate.reports.fitplot import fit_figures
+from palpate.reports.plots import campaign_figures
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
 from palpate.simulation.world import tissue_description
@@ -75,6 +77,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "its complete trials are read from their logs, the rest run",
     )
     parser.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
+    add_live_argument(parser, "each trial, one at a time (a serial executor)")
     parser.add_argument(
         "--faults",
         action="store_true",
@@ -167,7 +170,13 @@ def _run(campaigns: list[_Campaign], args: argparse.Namespace) -> float:
     ]
     bar.set_description(" + ".join(c.scene.name for c in campaigns) + " campaign")
     t_all = time.perf_counter()
-    with open_executor(args.executor, max(1, args.workers), args.scheduler) as executor:
+    if args.live is not None:  # the live view shows one trial at a time
+        args.executor, args.workers = "serial", 1
+    with (
+        live_view(args.live, campaigns[0].stack) as live,
+        open_executor(args.executor, max(1, args.workers), args.scheduler) as executor,
+    ):
+        runs = [dataclasses.replace(r, live=live) for r in runs]
         results = run_campaigns(runs, executor=executor, progress=progress)  # one pool for all
     wall_all = time.perf_counter() - t_all
     bar.close()
@@ -276,7 +285,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     sim_time = sum(o.sim_time for o in outcomes)
     mare = median_abs_relative_error(outcomes)
     paper = median_abs_relative_error(outcomes, "paper")
-    figures = [] if args.no_plots else _figures(c, rows)
+    figures = [] if args.no_plots else campaign_figures(c.outcomes, rows, c.run_dir, c.scene.name)
     payload: dict[str, object] = {
         "scene": scene.name,
         "log_dir": str(c.log_dir),
@@ -308,18 +317,6 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         return payload
     _print_report(c, args, rows, found, figures)
     return payload
-
-
-def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
-    """The campaign's PNG figures in its run folder."""
-    from palpate.reports import plots
-
-    outcomes, out_dir = c.outcomes, c.run_dir
-    title = f"{c.scene.name} campaign: estimated vs actual modulus"
-    figures = [str(plots.estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))]
-    if outcomes[0].series.get("advance"):  # not when the first trial was resumed
-        figures.append(str(plots.trial_traces(outcomes[0], out_dir / "trial_traces.png")))
-    return figures + fit_figures(outcomes, out_dir, c.scene.name)
 
 
 def _print_report(

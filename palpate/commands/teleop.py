@@ -29,6 +29,7 @@ from config.schema import StackConfig
 from config.targets import save_target
 from palpate.commands.teleop_screen import draw, key_name, render, screen_width
 from palpate.lab.hardware import open_hardware, run_on_hardware
+from palpate.live import LiveView, Publisher, add_live_argument, live_view
 from palpate.simulation.twin import SimulatedBench
 from robot.indentation import State
 from robot.rig import ServoFbgRig
@@ -54,6 +55,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--targets", type=Path, help="where s saves poses (default: the bench file's targets)"
     )
     parser.add_argument("--rate", type=float, default=100.0, help="control ticks per second")
+    add_live_argument(parser, "the jog")
 
 
 @dataclass
@@ -68,6 +70,13 @@ class Session:
     title: str
     sim: SimulatedBench | None = None
     saved: list[str] = field(default_factory=list)
+    live: LiveView | None = None  # --live: the jog's ticks to Foxglove (palpate.live)
+    feed: Publisher | None = None  # the live view's publisher for the current tube
+
+    def follow_tube(self) -> None:
+        """A publisher for the model's current tube (after a swap)."""
+        if self.live is not None:
+            self.feed = self.live.trial(self.model.tube, "robot", 0.0)
 
 
 @dataclass
@@ -149,6 +158,8 @@ def _body(where: _Where, args: argparse.Namespace, summary: dict[str, Any]) -> i
         )
         session.title = f"palpate teleop ({where.mode})"
         session.sim = where.sim
+        session.live = stack_.enter_context(live_view(args.live, where.stack))
+        session.follow_tube()
         try:
             os.environ.setdefault("ESCDELAY", "25")  # a lone Esc cancels at once
             summary.update(curses.wrapper(_loop, session))
@@ -207,14 +218,18 @@ def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
                 recovered = False
                 if not rig.recover():
                     model.fail("could not clear the servo fault: power-cycle the servos")
-            elif effect.kind == "tube" and s.sim is not None:
-                s.sim.tube = s.sim.stack.tube(effect.value)  # the operator swapped the tube
+            elif effect.kind == "tube":
+                s.follow_tube()
+                if s.sim is not None:  # the operator swapped the tube
+                    s.sim.tube = s.sim.stack.tube(effect.value)
         obs = rig.observe(clock.now())
         cmd = model.step(obs)
         if obs.servo_fault is not None and model.state is State.RETRACTING and not recovered:
             recovered = True  # one reboot so the sensor can be pulled back, as in a trial
             rig.recover()
         rig.command(cmd)
+        if s.feed is not None:
+            s.feed(obs, model.state)
         now = clock.now()
         if now >= next_draw:
             draw(stdscr, render(model.view(), screen_width(stdscr), s.title))

@@ -28,6 +28,7 @@ from palpate.lab.trial import (
     plan_bench_trials,
     run_bench_trials,
 )
+from palpate.live import add_live_argument, live_view
 from sensor.clock import Clock
 from sensor.reader import SerialLike
 
@@ -43,6 +44,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--dry-run", action="store_true", help="check and show the plan; open no port"
     )
     parser.add_argument("--log-dir", type=Path, help="overrides log_dir of the bench file")
+    add_live_argument(parser, "each trial")
     parser.add_argument(
         "--servo-port", help="overrides servos.port of the bench file (e.g. an emulator's pty)"
     )
@@ -59,21 +61,25 @@ def run_session(
     clock: Clock | None = None,
     sync_to_clock: bool = False,
     progress: Callable[[BenchOutcome], None] | None = None,
+    live: int | None = None,
 ) -> list[BenchOutcome]:
     """Open the bench (ports from the file unless given) and run ``trials``; torque is off and
     the ports closed on return, whatever happened. Tests pass the emulators' ptys and a
-    virtual clock (with ``sync_to_clock``)."""
+    virtual clock (with ``sync_to_clock``). ``live``: the live view's port (``--live``)."""
     key = str(loaded.path)
-    with open_hardware(
-        loaded.stack,
-        servo_port=servo_port,
-        board_port=board_port,
-        clock=clock,
-        servo_key=f"servos.port in {key}",
-        board_key=f"board.port in {key}",
-    ) as hw:
+    with (
+        open_hardware(
+            loaded.stack,
+            servo_port=servo_port,
+            board_port=board_port,
+            clock=clock,
+            servo_key=f"servos.port in {key}",
+            board_key=f"board.port in {key}",
+        ) as hw,
+        live_view(live, loaded.stack) as view,
+    ):
         return run_bench_trials(
-            hw, trials, loaded, log_dir, sync_to_clock=sync_to_clock, progress=progress
+            hw, trials, loaded, log_dir, sync_to_clock=sync_to_clock, progress=progress, live=view
         )
 
 
@@ -106,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     outcomes: list[BenchOutcome] = []
 
     def body() -> int:
-        outcomes.extend(run_session(loaded, trials, log_dir, progress=progress))
+        outcomes.extend(run_session(loaded, trials, log_dir, progress=progress, live=args.live))
         return 0
 
     code = run_on_hardware("trial", body)

@@ -21,7 +21,7 @@ from typing import Any
 
 from config.bench import LoadedBench
 from config.sample import UNKNOWN
-from config.schema import MM, StackConfig
+from config.schema import MM, StackConfig, TubeConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
 from estimation.relaxation import RelaxationFit
@@ -31,6 +31,7 @@ from estimation.verdict import Verdict
 from palpate.calibration import calibrate, rig_key, with_compliance
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
+from palpate.live import LiveView, Publisher
 from robot.indentation import PLANNED_ENDS
 from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
@@ -120,8 +121,10 @@ def run_bench_trials(
     *,
     sync_to_clock: bool = False,
     progress: Callable[[BenchOutcome], None] | None = None,
+    live: LiveView | None = None,
 ) -> list[BenchOutcome]:
-    """Run ``trials`` in order on opened hardware; one log per trial in ``log_dir``.
+    """Run ``trials`` in order on opened hardware; one log per trial in ``log_dir``; each
+    trial's ticks go to the ``live`` view when there is one (``palpate.live``).
 
     ``sync_to_clock`` is for emulators on a virtual clock (wait for each tick's frame); on
     hardware it stays False. With ``stop_on_fault`` a trial that does not complete ends the
@@ -140,7 +143,12 @@ def run_bench_trials(
         if not torque_on:
             hw.drive.bus.set_torque(True)
             torque_on = True
-        outcome, rig = _run_one(hw, trial, loaded, session.stack, log_dir, sync_to_clock)
+        publisher = (
+            None if live is None else live.trial(_tube(trial), trial.kind, trial.exposed_length)
+        )
+        outcome, rig = _run_one(
+            hw, trial, loaded, session.stack, log_dir, (sync_to_clock, publisher)
+        )
         session.add(trial, outcome)
         outcomes.append(outcome)
         if progress is not None:
@@ -199,15 +207,21 @@ def bench_inputs(trial: BenchTrial, loaded: LoadedBench, stack: StackConfig) -> 
     )
 
 
+def _tube(trial: BenchTrial) -> TubeConfig | None:
+    return trial.tube if trial.kind == "robot" else None
+
+
 def _run_one(
     hw: Hardware,
     trial: BenchTrial,
     loaded: LoadedBench,
     stack: StackConfig,
     log_dir: Path,
-    sync_to_clock: bool,
+    running: tuple[bool, Publisher | None],
 ) -> tuple[BenchOutcome, ServoFbgRig]:
-    """Zero the strains, run one trial with its log, estimate; the outcome and the rig."""
+    """Zero the strains, run one trial with its log, estimate; the outcome and the rig.
+    ``running``: whether to wait for each tick's frame on the clock, the live view's publisher."""
+    sync_to_clock, publisher = running
     c = loaded.bench.campaign
     tick = 1.0 / loaded.bench.control_rate_hz
     settings = rig_settings(
@@ -222,8 +236,9 @@ def _run_one(
         guards = guards_for(c, stack, rig.tick)
         # the robot probes the surface first when the campaign says so (null: it does)
         prober = prober_for(c, stack, trial.tube) if trial.kind == "robot" else None
+        detector = detector_for(c, chain)
         result = run_trial(
-            rig, hw.clock, trial.plan, guards, detector_for(c, chain), log, prober=prober
+            rig, hw.clock, trial.plan, guards, detector, log, prober=prober, on_tick=publisher
         )
         estimate = estimate_trial(
             result,

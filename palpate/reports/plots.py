@@ -77,3 +77,17 @@ def trial_traces(outcome: TrialOutcome, path: Path) -> Path:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def campaign_figures(
+    outcomes: Sequence[TrialOutcome], rows: Sequence[SampleRow], out_dir: Path, name: str
+) -> list[str]:
+    """``palpate sim``'s PNG figures in the run folder: the estimates against the truth, the
+    first trial's traces (when it ran in this process), the intervals and a trial's fit."""
+    from palpate.reports.fitplot import fit_figures
+
+    title = f"{name} campaign: estimated vs actual modulus"
+    figures = [str(estimates_vs_truth(outcomes, rows, out_dir / "estimates.png", title))]
+    if outcomes[0].series.get("advance"):  # not when the first trial was resumed
+        figures.append(str(trial_traces(outcomes[0], out_dir / "trial_traces.png")))
+    return figures + fit_figures(outcomes, out_dir, name)

@@ -21,6 +21,7 @@ from typing import Any, Literal, Protocol
 
 from config.scene import CampaignConfig, FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
+from palpate.live import LiveView
 from palpate.simulation.result import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
 from palpate.simulation.world import (
     ServoJoints,
@@ -161,8 +162,9 @@ def run_sim_trial(
     log_dir: Path | None = None,
     keep_series: bool = False,
     hook: EmulatorHook | None = None,
+    live: LiveView | None = None,
 ) -> TrialOutcome:
-    """Run one simulated trial end to end and estimate the modulus from it."""
+    """Run one simulated trial end to end and estimate the modulus; ``live``: its live view."""
     c = trial_campaign(spec, scene)
     geo = trial_geometry(stack, spec, trial_sample(scene, spec))
     retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
@@ -172,7 +174,7 @@ def run_sim_trial(
     servos = ServoJoints(stack)
     world = trial_world(spec, scene, stack, geo, servos)
     series: dict[str, list[float]] = {}
-    on_tick = _series_recorder(world, series) if keep_series else None
+    on_tick = _on_tick(world, series if keep_series else None, live, stack, spec)
     timing = bus_timing(scene.fidelity, stack.servos)
     with _emulators(transport, stack, clock, world, hook, timing) as emulators:
         bus, board, servo_port, handler, board_port = emulators
@@ -254,6 +256,37 @@ def _rig_settings(
         # faults, do not wait 0.2 s of wall time for each lost frame
         settings = dataclasses.replace(settings, frame_wait_s=0.0)
     return settings
+
+
+def _on_tick(
+    world: World,
+    series: dict[str, list[float]] | None,
+    live: LiveView | None,
+    stack: StackConfig,
+    spec: TrialSpec,
+) -> Callable[[Observation, State], None] | None:
+    """The trial's ``on_tick``: the series recorder (with ``series``), the live view's feed."""
+    recorder = None if series is None else _series_recorder(world, series)
+    tube = stack.tube(spec.tube) if spec.kind == "robot" else None
+    feed = None if live is None else live.trial(tube, spec.kind, spec.exposed_length)
+    return _ticks(recorder, feed)
+
+
+def _ticks(
+    *hooks: Callable[[Observation, State], None] | None,
+) -> Callable[[Observation, State], None] | None:
+    """One ``on_tick`` calling each given hook in turn (None without any)."""
+    given = [h for h in hooks if h is not None]
+    if not given:
+        return None
+    if len(given) == 1:
+        return given[0]
+
+    def on_tick(obs: Observation, state: State) -> None:
+        for hook in given:
+            hook(obs, state)
+
+    return on_tick
 
 
 def _series_recorder(

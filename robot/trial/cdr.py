@@ -97,3 +97,18 @@ def wrench_stamped(
     b.align(8)
     b.data += struct.pack("<6d", *force, *torque)
     return b.payload()
+
+
+Transform = tuple[str, str, Sequence[float], Sequence[float]]  # parent, child, xyz, quaternion xyzw
+
+
+def tf_message(stamp_ns: int, transforms: Sequence[Transform]) -> bytes:
+    """``tf2_msgs/msg/TFMessage``: each transform stamped ``stamp_ns``."""
+    b = _Buffer()
+    b.u32(len(transforms))
+    for parent, child, xyz, quaternion in transforms:
+        b.header(stamp_ns, parent)
+        b.string(child)
+        b.align(8)
+        b.data += struct.pack("<7d", *xyz, *quaternion)
+    return b.payload()

@@ -7,7 +7,8 @@ keeps what the JSON log keeps. The file is written unchunked (every message a re
 own, readable up to the last byte written) and closed with MCAP's summary and footer; the
 header record is the recording's metadata ``palpate.trial`` (its keys, values as JSON). When
 the trial ends the tip force is derived from every sample's strains (the estimator's beam
-states, ``robot.trial.states``) and written as ``/tip/wrench``.
+states, ``robot.trial.states``) and written as ``/tip/wrench``, and on the robot each sample's
+tip pose as ``/tf``.
 
 :func:`export` converts an existing log; :func:`read_recording` reads one back without ROS,
 through ``mcap``'s stream reader and ``mcap-ros2-support``'s CDR decoder, up to where a killed
@@ -32,7 +33,18 @@ from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,u
 from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
 from mcap_ros2.decoder import DecoderFactory  # type: ignore[import-untyped,unused-ignore]
 
-from robot.trial.ros2 import SCHEMAS, TOPICS, messages, nanoseconds, sample_messages, wrench
+from config.loader import from_mapping
+from config.schema import TubeConfig
+from robot.trial import cdr
+from robot.trial.ros2 import (
+    SCHEMAS,
+    TOPICS,
+    messages,
+    nanoseconds,
+    sample_messages,
+    tip_transforms,
+    wrench,
+)
 
 LIBRARY = "palpate"
 
@@ -51,6 +63,7 @@ class McapRecorder:
         self._encoders: dict[str, Callable[[Any], bytes]] = {}
         self._last_ns = 0
         self.samples: list[tuple[int, Any, list[Any]]] = []  # (stamp, advance, strains)
+        self.rolls: list[Any] = []  # each sample's roll (rad), for the transforms
         self.header = header
         self.count = 0
 
@@ -66,6 +79,7 @@ class McapRecorder:
             for topic, data in sample_messages(record, self._last_ns):
                 self._raw(topic, data)
             self.samples.append((self._last_ns, record.get("advance"), record.get("strains") or []))
+            self.rolls.append(record.get("roll"))
             return
         for topic, message in messages(record, self._last_ns, line):
             self._raw(topic, self._encoder(topic)(message))
@@ -109,9 +123,36 @@ class McapRecorder:
             for (stamp, _, _), load in zip(self.samples, forces, strict=True):
                 self._last_ns = stamp
                 self._raw(*wrench(stamp, load))
+        self._transforms()
         self._writer.finish()  # type: ignore[no-untyped-call,unused-ignore]
         self._fh.close()
         self._fh = None
+
+    def _transforms(self) -> None:
+        """``/tf`` of every sample of a robot trial (its header names the tube)."""
+        tube = _tube(self.header)
+        if tube is None:
+            return
+        for (stamp, advance, _), roll in zip(self.samples, self.rolls, strict=True):
+            found = tip_transforms(tube, _float(roll), _float(advance))
+            if found is not None:
+                self._last_ns = stamp
+                self._raw("/tf", cdr.tf_message(stamp, found))
+
+
+def _float(value: Any) -> float:
+    return float(value) if isinstance(value, int | float) else math.nan
+
+
+def _tube(header: dict[str, Any]) -> TubeConfig | None:
+    """The robot trial's tube from its log header (None on the bench stage or unreadable)."""
+    raw = header.get("tube")
+    if not isinstance(raw, dict):
+        return None
+    try:
+        return from_mapping(TubeConfig, raw, "<log>", "tube")
+    except (TypeError, ValueError):
+        return None
 
 
 def _metadata(header: dict[str, Any]) -> dict[str, str]:

@@ -14,7 +14,10 @@ Channels, one message per log record of the kind (a ``sample`` gives two):
 - ``/palpate/record`` (``palpate_msgs/msg/Record``): the ``probe``, ``world``, ``estimate`` and
   ``end`` records, as their JSON lines;
 - ``/tip/wrench`` (``geometry_msgs/msg/WrenchStamped``): each sample with whole strains, the tip
-  force derived from them when the trial ends.
+  force derived from them when the trial ends;
+- ``/tf`` (``tf2_msgs/msg/TFMessage``): on the robot, each sample's ``base`` -> ``tube_tip`` (the
+  tube's forward kinematics at the sample's roll) and ``tube_tip`` -> ``sensor_tip`` (the exposed
+  length along the tangent, the beam taken straight), written when the trial ends.
 
 Times: a record's ``t`` (s, the rig's clock) as nanoseconds; a record without one (the estimate,
 the end) takes the last time seen, so every channel's times never decrease.
@@ -26,6 +29,8 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from config.schema import TubeConfig
+from robot.kinematics import tube_tip_in_bend_plane
 from robot.trial import cdr
 
 SEP = "\n" + "=" * 80 + "\n"
@@ -33,6 +38,15 @@ TIME = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
 HEADER = "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
 VECTOR3 = "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n"
 WRENCH = "MSG: geometry_msgs/Wrench\ngeometry_msgs/Vector3 force\ngeometry_msgs/Vector3 torque\n"
+QUATERNION = "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w\n"
+TRANSFORM = (
+    "MSG: geometry_msgs/Transform\ngeometry_msgs/Vector3 translation\n"
+    "geometry_msgs/Quaternion rotation\n"
+)
+TRANSFORM_STAMPED = (
+    "MSG: geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\n"
+    "geometry_msgs/Transform transform\n"
+)
 
 
 def _definition(fields: str, *dependencies: str) -> str:
@@ -48,6 +62,15 @@ SCHEMAS: dict[str, str] = {
     ),
     "geometry_msgs/msg/WrenchStamped": _definition(
         "std_msgs/Header header\ngeometry_msgs/Wrench wrench\n", HEADER, WRENCH, VECTOR3, TIME
+    ),
+    "tf2_msgs/msg/TFMessage": _definition(
+        "geometry_msgs/TransformStamped[] transforms\n",
+        TRANSFORM_STAMPED,
+        TRANSFORM,
+        QUATERNION,
+        VECTOR3,
+        HEADER,
+        TIME,
     ),
     "palpate_msgs/msg/GratingStrains": _definition(
         "# one control tick: the state machine's state after it, the used gratings' strains\n"
@@ -76,6 +99,7 @@ TOPICS: dict[str, str] = {
     "/palpate/transition": "palpate_msgs/msg/StateTransition",
     "/palpate/record": "palpate_msgs/msg/Record",
     "/tip/wrench": "geometry_msgs/msg/WrenchStamped",
+    "/tf": "tf2_msgs/msg/TFMessage",
 }
 JOINTS = ["stage_translation", "outer_roll"]
 Message = tuple[str, dict[str, Any]]  # (topic, message)
@@ -145,3 +169,22 @@ def wrench(stamp_ns: int, load: float) -> tuple[str, bytes]:
         "/tip/wrench",
         cdr.wrench_stamped(stamp_ns, "sensor_tip", (0.0, 0.0, -load), (0.0,) * 3),
     )
+
+
+def tip_transforms(tube: TubeConfig, roll: float, advance: float) -> list[cdr.Transform] | None:
+    """A robot sample's ``/tf`` transforms: ``base`` -> ``tube_tip`` -> ``sensor_tip`` (None
+    where the encoders gave no number); as ``robot.kinematics.forward``, the rotation composed as
+    quaternions (roll about x, then the tube's tip angle about y)."""
+    if not (math.isfinite(roll) and math.isfinite(advance)):
+        return None
+    p0, _ = tube_tip_in_bend_plane(tube)
+    c, s = math.cos(roll), math.sin(roll)
+    tip = (float(p0[0]), c * float(p0[1]) - s * float(p0[2]), s * float(p0[1]) + c * float(p0[2]))
+    w1, x1 = math.cos(roll / 2), math.sin(roll / 2)
+    w2, y2 = math.cos(tube.tip_angle / 2), math.sin(tube.tip_angle / 2)
+    quaternion = (x1 * w2, w1 * y2, x1 * y2, w1 * w2)  # (x, y, z, w) of q_x(roll) q_y(angle)
+    exposed = advance - tube.flush_translation
+    return [
+        ("base", "tube_tip", tip, quaternion),
+        ("tube_tip", "sensor_tip", (exposed, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),
+    ]

@@ -161,8 +161,8 @@ def trial_plan(
 ) -> TrialPlan:
     """The plan of one trial: roll to ``roll`` (rad) at the ``home`` advance (m), advance fast to
     the campaign's stand-off before the expected ``contact`` advance (m), approach and indent at
-    the campaign's speeds, keep indenting ``post_buckling_mm`` after buckling, hold ``hold_s``,
-    retract."""
+    the campaign's speeds (the approach at the indentation speed when it ramps through the
+    contact), keep indenting ``post_buckling_mm`` after buckling, hold ``hold_s``, retract."""
     return TrialPlan(
         roll=roll,
         contact_advance=contact,
@@ -170,7 +170,12 @@ def trial_plan(
         standoff=campaign.standoff_mm * MM,
         post_buckling_travel=campaign.post_buckling_mm * MM,
         fast_speed=stack.drive.max_speed,
-        approach_speed=campaign.approach_speed_mm_per_s * MM,
+        approach_speed=(
+            campaign.indent_speed_mm_per_s
+            if campaign.ramp_through_contact
+            else campaign.approach_speed_mm_per_s
+        )
+        * MM,
         indent_speed=campaign.indent_speed_mm_per_s * MM,
         position_tolerance=position_tolerance(stack),
         hold_time=campaign.hold_s,

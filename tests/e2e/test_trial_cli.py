@@ -156,6 +156,27 @@ REHEARSAL = (
 )
 
 
+def test_a_session_with_the_live_view_runs_as_without_it(tmp_path: Path) -> None:
+    """``palpate trial --live``'s path: the view serves on a free port while the session runs
+    (nobody connects: the publisher does no work) and the trial ends as it would without."""
+    loaded = load_bench(bench_file(tmp_path, ONE))
+    clock = VirtualClock()
+    with simulated(loaded, clock) as sim:
+        (o,) = run_session(
+            loaded,
+            plan_bench_trials(loaded),
+            tmp_path / "logs",
+            servo_port=sim.servo_port,
+            board_port=sim.board_port,
+            clock=clock,
+            sync_to_clock=True,
+            live=0,
+        )
+    assert o.state == "done", o.reason
+    assert o.joint is not None
+    assert o.joint.modulus is not None
+
+
 def test_a_hold_on_the_ptys_is_logged_fitted_and_replayed(tmp_path: Path) -> None:
     """The bench file's hold (issue 27) over the hardware path: the stage stands still after
     buckling, every held tick is logged, the relaxation fit reads an elastic sample as such,

@@ -149,3 +149,59 @@ def test_the_fast_encoders_are_byte_for_byte_the_definitions() -> None:
                 {"header": head, "wrench": {"force": force, "torque": torque}},
             )
         )
+
+
+def test_a_robot_trial_records_the_tip_pose_as_the_forward_kinematics(tmp_path: Path) -> None:
+    from transforms3d.quaternions import quat2mat
+
+    from config.scene import SceneConfig as Scene
+    from robot.kinematics import forward
+
+    robot = load(Scene, resolve("scenes/robot.yaml"))
+    spec = TrialSpec(
+        "S8-bent30", "robot", "S8", 314.53e3, 0.45, "bent30", "downward", 0.0, 42e-3, 2
+    )
+    out = run_sim_trial(spec, robot, STACK, log_dir=tmp_path)
+    path = Path(str(out.log_path))
+    rec, log = read_recording(path.with_suffix(".mcap")), read_log(path)
+    samples = list(log.of_kind("sample"))
+    assert rec.types["/tf"] == "tf2_msgs/msg/TFMessage"
+    assert rec.count("/tf") == len(samples)
+    tube = STACK.tube("bent30")
+    for sample, (t, msg) in list(zip(samples, rec.messages["/tf"], strict=True))[::97]:
+        pose = forward(tube, sample["roll"], sample["advance"])
+        to_tip, to_sensor = msg.transforms
+        assert (to_tip.header.frame_id, to_tip.child_frame_id) == ("base", "tube_tip")
+        move = to_tip.transform.translation
+        np.testing.assert_allclose([move.x, move.y, move.z], pose.tube_tip, atol=1e-12)
+        q = to_tip.transform.rotation
+        np.testing.assert_allclose(quat2mat([q.w, q.x, q.y, q.z]), pose.rotation, atol=1e-12)
+        assert to_sensor.transform.translation.x == pytest.approx(pose.exposed_length, abs=1e-12)
+        assert t == round(sample["t"] * 1e9)
+
+
+def test_the_transform_encoder_is_byte_for_byte_the_definition() -> None:
+    from mcap_ros2._dynamic import serialize_dynamic
+
+    from robot.trial import cdr
+    from robot.trial.ros2 import SCHEMAS
+
+    name = "tf2_msgs/msg/TFMessage"
+    encode = serialize_dynamic(name, SCHEMAS[name])[name]
+    stamp = {"sec": 1, "nanosec": 2}
+    transforms = [("base", "tube_tip", (1.0, 2.0, 3.0), (0.1, 0.2, 0.3, 0.9)),
+                  ("tube_tip", "sensor_tip", (0.04, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))]  # fmt: skip
+    message = {
+        "transforms": [
+            {
+                "header": {"stamp": stamp, "frame_id": parent},
+                "child_frame_id": child,
+                "transform": {
+                    "translation": dict(zip("xyz", xyz, strict=True)),
+                    "rotation": dict(zip("xyzw", q, strict=True)),
+                },
+            }
+            for parent, child, xyz, q in transforms
+        ]
+    }
+    assert cdr.tf_message(10**9 + 2, transforms) == bytes(encode(message))

@@ -1,0 +1,287 @@
+"""The live view: a trial's channels on a local Foxglove websocket while the robot moves.
+
+``--live [PORT]`` on ``palpate sim`` (one trial at a time), ``palpate trial`` and ``palpate
+teleop`` starts ``foxglove-sdk``'s websocket server on 127.0.0.1 (only: the bench's data does
+not leave the machine) and PORT (8765 by default; 0 takes a free one, printed); Foxglove
+connects to ``ws://127.0.0.1:PORT``. Off unless asked; the server stops when the command ends.
+
+Channels, published at most ``PUBLISH_HZ`` (the geometry ``SCENE_HZ``) times a second of wall
+time (the simulator runs faster than real time; a person watches at the screen's pace), and
+only while a client listens:
+
+- ``/joint_states`` and ``/fbg/strains`` (JSON): the stage translation and roll, the state, the
+  used gratings' strains, the contact event;
+- ``/tip/force`` (JSON): the axial load and the beam's end shortening from the strains (the
+  estimator's beam state of that tick, ``estimation.beamstate``);
+- ``/tf`` (``foxglove.FrameTransforms``): ``base`` -> ``tube_tip`` -> ``sensor_tip`` from the
+  tube's forward kinematics (``robot.kinematics``);
+- ``/scene`` (``foxglove.SceneUpdate``): the tube's centreline (straight part and arc) and the
+  sensor beam, bent as the elastica at the tick's end shortening (``estimation.elastica``), in
+  the tube's bend plane (the gratings' own plane is not measured: a drawing, not a fit).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import logging
+import math
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from config.schema import SensorConfig, StackConfig, TubeConfig
+from estimation.beamstate import infer_states
+from estimation.elastica import post_buckling
+from estimation.section import Section, sensor_section
+from palpate.argtypes import port_number
+from robot.guards import Observation
+from robot.indentation import State
+from robot.kinematics import forward
+from sensor.strain import grating_intervals
+
+log = logging.getLogger(__name__)
+
+DEFAULT_PORT = 8765
+HOST = "127.0.0.1"
+PUBLISH_HZ = 15.0  # the plain channels (joints, strains, force)
+SCENE_HZ = 5.0  # the geometry (transforms, the tube and the bent beam: an elastica each)
+BEAM_POINTS = 24
+TOPICS = ("/joint_states", "/fbg/strains", "/tip/force", "/tf", "/scene")
+Publisher = Callable[[Observation, State], None]
+FloatArray = NDArray[np.float64]
+
+
+def add_live_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--live [PORT]`` on a command (``what``: what it shows)."""
+    parser.add_argument(
+        "--live",
+        nargs="?",
+        const=DEFAULT_PORT,
+        type=port_number,
+        metavar="PORT",
+        help=f"serve {what} to Foxglove on ws://{HOST}:PORT (default {DEFAULT_PORT}; 0: any "
+        "free port) while it runs (docs/recordings.md)",
+    )
+
+
+@contextlib.contextmanager
+def live_view(port: int | None, stack: StackConfig) -> Iterator[LiveView | None]:
+    """The live view on ``port`` for ``stack``'s sensor while the block runs (None without a
+    port: off); its address is logged."""
+    if port is None:
+        yield None
+        return
+    with LiveView(port, stack.sensor, sensor_section(stack.sensor)) as view:
+        log.warning("live view: ws://%s:%d (open it in Foxglove)", HOST, view.port)
+        yield view
+
+
+def _schema(properties: dict[str, str]) -> dict[str, Any]:
+    kinds: dict[str, dict[str, Any]] = {
+        "number": {"type": "number"},
+        "string": {"type": "string"},
+        "boolean": {"type": "boolean"},
+        "numbers": {"type": "array", "items": {"type": "number"}},
+    }
+    return {"type": "object", "properties": {k: kinds[v] for k, v in properties.items()}}
+
+
+class LiveView:
+    """The server and its channels (see the module docstring); :meth:`trial` gives each trial
+    its publisher, :meth:`close` stops the server (idempotent)."""
+
+    def __init__(self, port: int, sensor: SensorConfig, section: Section) -> None:
+        try:  # the live view's own dependency (the [live] extra), loaded only when asked for
+            import foxglove
+            from foxglove.channels import FrameTransformsChannel, SceneUpdateChannel
+        except ImportError:
+            raise ValueError(
+                "--live needs foxglove-sdk: python3 -m pip install -e '.[live]'"
+            ) from None
+
+        self._fg = foxglove
+        self.context = foxglove.Context()
+        try:
+            self.server = foxglove.start_server(host=HOST, port=port, context=self.context)
+        except Exception as exc:  # the SDK raises its own error for a port it cannot bind
+            raise ValueError(f"--live: cannot serve on {HOST}:{port}: {exc}") from None
+        self.port = int(self.server.port)
+        self.sensor, self.section = sensor, section
+        ctx = self.context
+        self.joints = foxglove.Channel(
+            "/joint_states",
+            schema=_schema({"stage_translation": "number", "outer_roll": "number"}),
+            context=ctx,
+        )
+        self.strains = foxglove.Channel(
+            "/fbg/strains",
+            schema=_schema({"state": "string", "strain": "numbers", "contact": "boolean"}),
+            context=ctx,
+        )
+        self.force = foxglove.Channel(
+            "/tip/force",
+            schema=_schema({"axial_load": "number", "end_shortening": "number"}),
+            context=ctx,
+        )
+        self.tf = FrameTransformsChannel("/tf", context=ctx)
+        self.scene = SceneUpdateChannel("/scene", context=ctx)
+        self._closed = False
+
+    def trial(self, tube: TubeConfig | None, kind: str, exposed_length: float) -> Publisher:
+        """The publisher of one trial: ``tube`` None on the bench stage (fixed ``exposed_length``
+        m); on the robot the exposed length follows the translation."""
+        feed = _Feed(self, tube, kind, exposed_length)
+        return feed.publish
+
+    def close(self) -> None:
+        if not self._closed:
+            self._closed = True
+            self.server.stop()
+
+    def __enter__(self) -> LiveView:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+@dataclass
+class _Feed:
+    view: LiveView
+    tube: TubeConfig | None
+    kind: str
+    exposed_length: float
+    _last: float = -math.inf
+    _last_scene: float = -math.inf
+
+    def publish(self, obs: Observation, state: State) -> None:
+        now = time.monotonic()
+        if now - self._last < 1.0 / PUBLISH_HZ:
+            return
+        self._last = now
+        v = self.view
+        stamp = max(round(obs.t * 1e9), 0)
+        if v.joints.has_sinks():
+            v.joints.log({"stage_translation": obs.advance, "outer_roll": obs.roll}, log_time=stamp)
+        if v.strains.has_sinks():
+            message = {"state": state.value, "strain": list(obs.strains), "contact": obs.contact}
+            v.strains.log(message, log_time=stamp)
+        wanted = v.force.has_sinks() or v.tf.has_sinks() or v.scene.has_sinks()
+        if not wanted or not all(math.isfinite(x) for x in (obs.advance, obs.roll)):
+            return
+        length = self._length(obs.advance)
+        load, shortening = self._beam(obs.strains, length)
+        if v.force.has_sinks():
+            v.force.log({"axial_load": load, "end_shortening": shortening}, log_time=stamp)
+        if now - self._last_scene >= 1.0 / SCENE_HZ:
+            self._last_scene = now
+            self._geometry(obs, length, shortening, stamp)
+
+    def _length(self, advance: float) -> float:
+        if self.tube is None or self.kind == "bench":
+            return self.exposed_length
+        return advance - self.tube.flush_translation
+
+    def _beam(self, strains: tuple[float, ...], length: float) -> tuple[float, float]:
+        """(axial load N, end shortening m) of the tick's strains, NaN when they do not fit."""
+        v = self.view
+        if length <= 0 or len(strains) != len(v.sensor.used_gratings):
+            return math.nan, math.nan
+        intervals = grating_intervals(v.sensor, length)
+        s = infer_states(
+            np.asarray([strains]), intervals, length, v.section.EA, v.section.fiber_offset, 1e-6
+        )
+        return float(s.P[0]), float(s.e[0])
+
+    def _geometry(self, obs: Observation, length: float, shortening: float, stamp: int) -> None:
+        from foxglove.messages import FrameTransforms, SceneEntity, SceneUpdate, Timestamp
+
+        v = self.view
+        ts = Timestamp(*divmod(stamp, 1_000_000_000))
+        tube_points, tip, rotation = _tube(self.tube, obs.roll, obs.advance)
+        beam = _beam_points(length, shortening)  # in the tube tip's frame (x along the tangent)
+        if v.tf.has_sinks():
+            frames = [
+                _frame(ts, "base", "tube_tip", tip, _quaternion(rotation)),
+                _frame(ts, "tube_tip", "sensor_tip", beam[-1], (1.0, 0.0, 0.0, 0.0)),
+            ]
+            v.tf.log(FrameTransforms(transforms=frames), log_time=stamp)
+        if v.scene.has_sinks():
+            world_beam = [tip + rotation @ p for p in beam]
+            lines = [
+                _line(tube_points, (0.6, 0.6, 0.6), 2.0),
+                _line(world_beam, (0.9, 0.3, 0.1), 3.0),
+            ]
+            entity = SceneEntity(timestamp=ts, frame_id="base", id="robot", lines=lines)
+            v.scene.log(SceneUpdate(entities=[entity]), log_time=stamp)
+
+
+def _frame(ts: Any, parent: str, child: str, at: FloatArray, q: tuple[float, ...]) -> Any:
+    from foxglove.messages import FrameTransform, Quaternion, Vector3
+
+    w, x, y, z = q
+    return FrameTransform(
+        timestamp=ts,
+        parent_frame_id=parent,
+        child_frame_id=child,
+        translation=Vector3(x=float(at[0]), y=float(at[1]), z=float(at[2])),
+        rotation=Quaternion(x=x, y=y, z=z, w=w),
+    )
+
+
+def _line(points: list[FloatArray], rgb: tuple[float, float, float], thickness: float) -> Any:
+    from foxglove.messages import Color, LinePrimitive, LinePrimitiveLineType, Point3
+
+    return LinePrimitive(
+        type=LinePrimitiveLineType.LineStrip,
+        thickness=thickness,
+        scale_invariant=True,
+        color=Color(r=rgb[0], g=rgb[1], b=rgb[2], a=1.0),
+        points=[Point3(x=float(p[0]), y=float(p[1]), z=float(p[2])) for p in points],
+    )
+
+
+def _tube(
+    tube: TubeConfig | None, roll: float, advance: float
+) -> tuple[list[FloatArray], FloatArray, FloatArray]:
+    """The tube's centreline points, its tip and its tip frame's rotation in ``base`` (m); on
+    the bench stage (no tube) a stub along x ending at the clamp."""
+    if tube is None:
+        return [np.zeros(3), np.array([0.0, 0.0, 0.0])], np.zeros(3), np.eye(3)
+    pose = forward(tube, roll, advance)
+    rx = pose.rotation @ np.linalg.inv(_rot_y(tube.tip_angle))
+    points = [np.zeros(3), np.array([tube.straight_length, 0.0, 0.0])]
+    for a in np.linspace(0.0, tube.tip_angle, 12)[1:]:
+        # the arc of radius la/angle bends toward -z at roll 0 (robot.kinematics)
+        r = tube.arc_length / tube.tip_angle if tube.tip_angle else math.inf
+        local = np.array([tube.straight_length + r * math.sin(a), 0.0, -r * (1 - math.cos(a))])
+        points.append(rx @ local)
+    return points, pose.tube_tip, pose.rotation
+
+
+def _rot_y(angle: float) -> FloatArray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _beam_points(length: float, shortening: float) -> list[FloatArray]:
+    """The sensor's centreline in the tube tip's frame (x along the tangent): the elastica at
+    e/L (straight below buckling or where the state did not fit)."""
+    s = np.linspace(0.0, 1.0, BEAM_POINTS)
+    ratio = shortening / length if length > 0 and math.isfinite(shortening) else 0.0
+    if not 1e-9 < ratio < 0.5:
+        return [np.array([length * u, 0.0, 0.0]) for u in s]
+    x, y = post_buckling(np.array([ratio]), "accurate").xy(s)
+    return [np.array([length * a, 0.0, length * b]) for a, b in zip(x, y, strict=True)]
+
+
+def _quaternion(rotation: FloatArray) -> tuple[float, float, float, float]:
+    from transforms3d.quaternions import mat2quat
+
+    w, x, y, z = mat2quat(rotation)
+    return float(w), float(x), float(y), float(z)

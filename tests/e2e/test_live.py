@@ -1,0 +1,120 @@
+"""The live view (``palpate.live``): a websocket client on localhost receives every advertised
+channel during a simulated trial; the server listens on loopback only and is gone when the view
+closes; a bad ``--live`` port exits 2 naming the option."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import socket
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import connect
+
+from config import load, load_stack, resolve
+from config.scene import SceneConfig
+from estimation.section import sensor_section
+from palpate.cli import main
+from palpate.live import HOST, TOPICS, LiveView
+from palpate.simulation.trial import TrialSpec, run_sim_trial
+
+STACK = load_stack()
+ROBOT = load(SceneConfig, resolve("scenes/robot.yaml"))
+BOUND = 120.0  # s: generous bounds on waiting, never a measured time
+SUBPROTOCOL = "foxglove.sdk.v1"
+
+
+class Client:
+    """Subscribes to every channel the server advertises; records the topics it gets data on."""
+
+    def __init__(self, port: int) -> None:
+        self.port = port
+        self.advertised: set[str] = set()
+        self.received: set[str] = set()
+        self.subscribed = threading.Event()
+        self.complete = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        with (
+            contextlib.suppress(ConnectionClosed),
+            connect(f"ws://{HOST}:{self.port}", subprotocols=[SUBPROTOCOL]) as ws,
+        ):
+            topics: dict[int, str] = {}
+            while not self.complete.is_set():
+                frame = ws.recv(timeout=BOUND)
+                if isinstance(frame, str):
+                    op = json.loads(frame)
+                    if op.get("op") == "advertise":
+                        new = {c["id"]: c["topic"] for c in op["channels"]}
+                        topics.update(new)
+                        self.advertised.update(new.values())
+                        subs = [{"id": cid, "channelId": cid} for cid in new]
+                        ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+                        if set(TOPICS) <= self.advertised:
+                            self.subscribed.set()
+                    continue
+                if frame[0] == 1:  # message data: opcode, subscription id (u32 LE), time, payload
+                    self.received.add(topics[int.from_bytes(frame[1:5], "little")])
+                    if set(TOPICS) <= self.received:
+                        self.complete.set()
+
+
+def test_a_client_on_localhost_gets_every_channel_during_a_trial(tmp_path: Path) -> None:
+    with LiveView(0, STACK.sensor, sensor_section(STACK.sensor)) as view:
+        client = Client(view.port)
+        assert client.subscribed.wait(BOUND), client.advertised
+        spec = TrialSpec("S8-bent30-down", "robot", "S8", 314.53e3, 0.45, "bent30", "downward",
+                         0.0, 42e-3, 1)  # fmt: skip
+        out = run_sim_trial(spec, ROBOT, STACK, log_dir=tmp_path, live=view)
+        assert out.state in ("done", "unreachable"), out.reason
+        # the trial publishes 25 times a second of wall time at most; let it go on publishing
+        # (rerun trials) until the client has seen every channel, within the bound
+        for seed in range(2, 12):
+            if client.complete.wait(0.0):
+                break
+            again = dataclasses.replace(spec, trial_id=f"again{seed}", seed=seed)
+            run_sim_trial(again, ROBOT, STACK, live=view)
+        assert client.complete.wait(BOUND), (client.advertised, client.received)
+        assert set(TOPICS) <= client.received
+        port = view.port
+        others = _non_loopback_address()
+        if others is not None:  # the server is bound to loopback only
+            with pytest.raises(ConnectionRefusedError):
+                socket.create_connection((others, port), timeout=5).close()
+    assert _refused_within(HOST, port, BOUND)  # closed with the view (its listener stops a moment
+    # after stop() returns: waited for, within the bound)
+
+
+def _refused_within(host: str, port: int, bound: float) -> bool:
+    """Whether connections to ``host:port`` are refused before ``bound`` seconds pass."""
+    deadline = time.monotonic() + bound
+    while time.monotonic() < deadline:
+        try:
+            socket.create_connection((host, port), timeout=5).close()
+        except ConnectionRefusedError:
+            return True
+        threading.Event().wait(0.05)  # the condition is polled, not a timed expectation
+    return False
+
+
+def _non_loopback_address() -> str | None:
+    try:
+        address = socket.gethostbyname(socket.gethostname())
+    except OSError:
+        return None
+    return None if address.startswith("127.") else address
+
+
+@pytest.mark.parametrize("value", ["70000", "-1", "web"])
+def test_a_bad_live_port_exits_2_naming_the_option(
+    value: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["sim", "--campaign", "bench", "--live", value]) == 2
+    assert "--live" in capsys.readouterr().err
