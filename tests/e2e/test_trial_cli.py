@@ -75,9 +75,14 @@ def simulated(loaded: LoadedBench, clock: VirtualClock) -> SimulatedBench:
 
 
 def run_on(
-    sim: SimulatedBench, loaded: LoadedBench, clock: VirtualClock, log_dir: Path
+    sim: SimulatedBench,
+    loaded: LoadedBench,
+    clock: VirtualClock,
+    log_dir: Path,
+    live: int | None = None,
 ) -> list[BenchOutcome]:
-    """Every trial of the bench file through ``run_session`` on the simulated bench's ports."""
+    """Every trial of the bench file through ``run_session`` on the simulated bench's ports
+    (``live``: the live view's port, ``--live``)."""
     return run_session(
         loaded,
         plan_bench_trials(loaded),
@@ -86,6 +91,7 @@ def run_on(
         board_port=sim.board_port,
         clock=clock,
         sync_to_clock=True,
+        live=live,
     )
 
 
@@ -162,16 +168,7 @@ def test_a_session_with_the_live_view_runs_as_without_it(tmp_path: Path) -> None
     loaded = load_bench(bench_file(tmp_path, ONE))
     clock = VirtualClock()
     with simulated(loaded, clock) as sim:
-        (o,) = run_session(
-            loaded,
-            plan_bench_trials(loaded),
-            tmp_path / "logs",
-            servo_port=sim.servo_port,
-            board_port=sim.board_port,
-            clock=clock,
-            sync_to_clock=True,
-            live=0,
-        )
+        (o,) = run_on(sim, loaded, clock, tmp_path / "logs", live=0)
     assert o.state == "done", o.reason
     assert o.joint is not None
     assert o.joint.modulus is not None
