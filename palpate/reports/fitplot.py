@@ -113,25 +113,41 @@ def _paper(ax: Any, estimate: dict[str, Any] | None) -> None:
 
 def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: str) -> Path:
     """Each trial's joint estimate with its 95 % interval (coloured by verdict) and the paper's
-    estimate beside it, over the reference (and, in simulation, the truth): the ``--json``
-    trial rows of ``palpate sim`` (``joint_kpa``, ``joint_ci_kpa``, ``estimated_kpa``,
-    ``verdict``, ``actual_kpa``, ``reference_kpa``)."""
+    estimate beside it, relative to the truth (1; the reported reference dashed), from the
+    ``--json`` trial rows of ``palpate sim`` (``joint_kpa``, ``joint_ci_kpa``,
+    ``estimated_kpa``, ``verdict``, ``actual_kpa``, ``reference_kpa``). The axis spans the
+    joint fit's intervals; a paper estimate beyond it is drawn at the edge, pointing out."""
     fig, ax = plt.subplots(figsize=(max(7.0, 0.18 * len(rows) + 3), 4.8))
+    ax.axhline(1.0, color="k", lw=1)
+    spans: list[float] = [0.9, 1.1]
+    papers: list[tuple[int, float]] = []
     for i, r in enumerate(rows):
-        truth, reference = r.get("actual_kpa"), r.get("reference_kpa")
-        if truth is not None:
-            ax.plot([i - 0.4, i + 0.4], [truth, truth], color="k", lw=1)
-        if reference is not None:
-            ax.plot([i - 0.4, i + 0.4], [reference, reference], color="0.5", lw=1, ls="--")
+        truth = r.get("actual_kpa")
+        if not truth:
+            continue
+        if r.get("reference_kpa") is not None:
+            ref = r["reference_kpa"] / truth
+            ax.plot([i - 0.4, i + 0.4], [ref, ref], color="0.5", lw=1, ls="--")
+            spans.append(ref)
         colour = STATUS_COLOURS.get(str(r.get("verdict")), "0.6")
         if r.get("joint_kpa") is not None:
+            est = r["joint_kpa"] / truth
             lo, hi = r.get("joint_ci_kpa") or (None, None)
             yerr = None
             if lo is not None and hi is not None:
-                yerr = [[r["joint_kpa"] - lo], [hi - r["joint_kpa"]]]
-            ax.errorbar([i - 0.1], [r["joint_kpa"]], yerr=yerr, fmt="o", ms=4, color=colour)
+                yerr = [[est - lo / truth], [hi / truth - est]]
+                spans += [lo / truth, hi / truth]
+            ax.errorbar([i - 0.1], [est], yerr=yerr, fmt="o", ms=4, color=colour, capsize=2)
         if r.get("estimated_kpa") is not None:
-            ax.plot([i + 0.15], [r["estimated_kpa"]], "x", ms=5, color="tab:red")
+            papers.append((i, r["estimated_kpa"] / truth))
+    low, high = min(spans), max(spans)
+    pad = 0.1 * (high - low)
+    low, high = low - pad, high + pad
+    for i, ratio in papers:
+        inside = low <= ratio <= high
+        marker = "x" if inside else ("^" if ratio > high else "v")
+        ax.plot([i + 0.15], [min(max(ratio, low), high)], marker, ms=5, color="tab:red")
+    ax.set_ylim(low, high)
     handles = [
         Line2D([], [], color="k", lw=1, label="truth"),
         Line2D([], [], color="0.5", lw=1, ls="--", label="reference"),
@@ -139,11 +155,13 @@ def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: 
             Line2D([], [], marker="o", ls="", color=c, label=f"joint fit, {s}")
             for s, c in STATUS_COLOURS.items()
         ),
-        Line2D([], [], marker="x", ls="", color="tab:red", label="paper (Eqs. 13-14)"),
+        Line2D(
+            [], [], marker="x", ls="", color="tab:red", label="paper (Eqs. 13-14; ^ v: off axis)"
+        ),
     ]
     ax.legend(handles=handles, fontsize=7, ncol=3)
     ax.set_xticks(range(len(rows)), [str(r.get("trial")) for r in rows], rotation=90, fontsize=6)
-    ax.set_ylabel("Young's modulus (kPa), 95 % interval")
+    ax.set_ylabel("estimate / truth, with its 95 % interval")
     ax.set_title(title)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
