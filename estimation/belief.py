@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
@@ -71,6 +72,22 @@ class Hypothesis:
             "poisson": self.law.poisson,
             "compliance": self.compliance,
         }
+
+    @classmethod
+    def described(
+        cls, best: Mapping[str, object], tip_radius: float, layer_law: LayerLaw = "exact"
+    ) -> Hypothesis:
+        """The hypothesis a :meth:`describe` dict (a fit's ``best``, a log's) stands for; the
+        tip radius (m) and the layer law are the estimator's."""
+        thickness = best.get("thickness")
+        law = ContactLaw(
+            tip_radius,
+            float(best.get("poisson", 0.45)),  # type: ignore[arg-type]
+            None if thickness is None else float(thickness),  # type: ignore[arg-type]
+            bool(best.get("bonded", True)),
+            layer_law=layer_law,
+        )
+        return cls(law, float(best.get("compliance") or 0.0))  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ from typing import Literal
 
 import numpy as np
 
-from estimation.corrections import ContactLaw
+from estimation.belief import Hypothesis
 from estimation.jointfit import JointFit
 from estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
 from estimation.misalignment import Lean
@@ -229,21 +229,14 @@ def _depth_to_buckle(fit: JointFit | None, facts: TrialFacts, tip_radius: float)
     p_cr = facts.critical_load
     if fit is None or not fit.success or fit.modulus is None or fit.best is None or not p_cr:
         return None
-    best = fit.best
-    thickness = best.get("thickness")
-    law = ContactLaw(
-        tip_radius,
-        float(best.get("poisson", 0.45)),  # type: ignore[arg-type]
-        None if thickness is None else float(thickness),  # type: ignore[arg-type]
-        bool(best.get("bonded", True)),
-    )
+    best = Hypothesis.described(fit.best, tip_radius)
+    law = best.law
     depth = np.geomspace(1e-7, 0.02, 600)
     force = np.maximum.accumulate(law.force(fit.modulus, depth))
     k = int(np.searchsorted(force, p_cr))
     if k >= depth.size:
         return math.inf
-    compliance = float(best.get("compliance", 0.0))  # type: ignore[arg-type]
-    return float(depth[k]) + compliance * p_cr
+    return float(depth[k]) + best.compliance * p_cr
 
 
 def relaxed_verdict(

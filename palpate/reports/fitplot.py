@@ -23,7 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
-from estimation.corrections import ContactLaw
+from estimation.belief import Hypothesis
 from robot.trial.log import TrialLog, read_log
 from robot.trial.record import header_sensor
 from robot.trial.relaxed import HOLD_STATE
@@ -47,18 +47,11 @@ def record_fit(log: TrialLog, path: Path) -> Path:
     advance = np.array([r["advance"] for r in rows], dtype=np.float64)
     strains = np.array([r["strains"] for r in rows], dtype=np.float64).reshape(-1, gratings)
     states, _ = record_states(advance, strains, inputs, sensor, section)
-    best: dict[str, Any] = joint["best"]
-    compliance = float(best.get("compliance") or 0.0)
+    best = Hypothesis.described(joint["best"], inputs.tip_radius, inputs.belief().layer_law)
+    law, compliance = best.law, best.compliance
     x0, offset = float(joint["contact"]), float(joint.get("load_offset") or 0.0)
     depth = advance - states.e - compliance * states.P - x0
     held = np.array([r["state"] == HOLD_STATE for r in rows])
-    law = ContactLaw(
-        inputs.tip_radius,
-        float(best["poisson"]),
-        None if best.get("thickness") is None else float(best["thickness"]),
-        bool(best["bonded"]),
-        layer_law=inputs.belief().layer_law,
-    )
     fig, ax = plt.subplots(figsize=(7, 4.5))
     mm = 1e3
     ax.plot(depth[~held] * mm, states.P[~held], ".", ms=2, color="0.35", label="record (strains)")

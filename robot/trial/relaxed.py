@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from config.schema import SensorConfig
-from estimation.corrections import ContactLaw
+from estimation.belief import Hypothesis
 from estimation.jointfit import JointFit
 from estimation.relaxation import RelaxationFit, RelaxationRecord, fit_relaxation
 from estimation.section import Section
@@ -56,16 +56,8 @@ def relaxation_of(
     _, k = record_states(*_rows_in(rows, len(sensor.used_gratings)), inputs, sensor, section)
     states, _ = record_states(advance, strains, inputs, sensor, section)
     thin = 1.0 / np.sqrt(counts)  # a block's mean has 1/sqrt(n) of a row's noise
-    best = joint.best
-    compliance = float(best.get("compliance", 0.0))  # type: ignore[arg-type]
-    thickness = best.get("thickness")
-    law = ContactLaw(
-        inputs.tip_radius,
-        float(best.get("poisson", inputs.poisson)),  # type: ignore[arg-type]
-        None if thickness is None else float(thickness),  # type: ignore[arg-type]
-        bool(best.get("bonded", True)),
-        layer_law=inputs.belief().layer_law,
-    )
+    best = Hypothesis.described(joint.best, inputs.tip_radius, inputs.belief().layer_law)
+    law, compliance = best.law, best.compliance
     record = RelaxationRecord(
         times=t,
         load=np.asarray(states.P - (joint.load_offset or 0.0)),
