@@ -249,24 +249,22 @@ def _line(points: list[FloatArray], rgb: tuple[float, float, float], thickness: 
 def _tube(
     tube: TubeConfig | None, roll: float, advance: float
 ) -> tuple[list[FloatArray], FloatArray, FloatArray]:
-    """The tube's centreline points, its tip and its tip frame's rotation in ``base`` (m); on
-    the bench stage (no tube) a stub along x ending at the clamp."""
+    """The tube's centreline points, its tip and its tip frame's rotation in ``base`` (m), as
+    ``robot.kinematics`` has them (the arc's points are the tip of the arc cut short); on the
+    bench stage (no tube) no centreline, the clamp at the origin."""
     if tube is None:
-        return [np.zeros(3), np.array([0.0, 0.0, 0.0])], np.zeros(3), np.eye(3)
+        return [np.zeros(3)], np.zeros(3), np.eye(3)
     pose = forward(tube, roll, advance)
-    rx = pose.rotation @ np.linalg.inv(_rot_y(tube.tip_angle))
-    points = [np.zeros(3), np.array([tube.straight_length, 0.0, 0.0])]
-    for a in np.linspace(0.0, tube.tip_angle, 12)[1:]:
-        # the arc of radius la/angle bends toward -z at roll 0 (robot.kinematics)
-        r = tube.arc_length / tube.tip_angle if tube.tip_angle else math.inf
-        local = np.array([tube.straight_length + r * math.sin(a), 0.0, -r * (1 - math.cos(a))])
-        points.append(rx @ local)
+    c, s = math.cos(roll), math.sin(roll)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    points = [np.zeros(3)]
+    for u in np.linspace(0.0, 1.0, 12):
+        a, la = u * tube.tip_angle, u * tube.arc_length
+        # robot.kinematics.tube_tip_in_bend_plane for the arc's first u (sinc: exact at a = 0)
+        along = tube.straight_length + la * float(np.sinc(a / math.pi))
+        drop = -la * 0.5 * a * float(np.sinc(a / (2.0 * math.pi))) ** 2
+        points.append(rx @ np.array([along, 0.0, drop]))
     return points, pose.tube_tip, pose.rotation
-
-
-def _rot_y(angle: float) -> FloatArray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _beam_points(length: float, shortening: float) -> list[FloatArray]:

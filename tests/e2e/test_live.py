@@ -118,3 +118,24 @@ def test_a_bad_live_port_exits_2_naming_the_option(
 ) -> None:
     assert main(["sim", "--campaign", "bench", "--live", value]) == 2
     assert "--live" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("tube", ["straight", "bent30", "bent50"])
+def test_the_drawn_tube_ends_at_the_kinematics_tip(tube: str) -> None:
+    import numpy as np
+
+    from palpate.live import _beam_points, _tube
+    from robot.kinematics import forward
+
+    config = STACK.tube(tube)
+    points, tip, rotation = _tube(config, 0.7, 0.05)
+    np.testing.assert_allclose(tip, forward(config, 0.7, 0.05).tube_tip, atol=1e-12)
+    pose = forward(config, 0.7, 0.05)
+    assert np.all(np.isfinite(points))
+    np.testing.assert_allclose(points[-1], pose.tube_tip, atol=1e-12)
+    np.testing.assert_allclose(rotation, pose.rotation, atol=1e-12)
+    straight = _beam_points(0.042, 0.0)  # below buckling: the sensor straight along x
+    assert straight[-1][0] == pytest.approx(0.042)
+    bent = _beam_points(0.042, 0.042 * 0.02)  # e/L = 0.02: the elastica, its pin on the axis
+    assert bent[-1][0] == pytest.approx(0.042 * 0.98, rel=1e-6)
+    assert max(abs(p[2]) for p in bent) > 1e-3
