@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-from mcap.exceptions import McapError  # type: ignore[import-untyped,unused-ignore]
+from mcap.exceptions import EndOfFile, McapError  # type: ignore[import-untyped,unused-ignore]
 from mcap.records import Channel, Message, Schema  # type: ignore[import-untyped,unused-ignore]
 from mcap.stream_reader import StreamReader  # type: ignore[import-untyped,unused-ignore]
 from mcap.well_known import MessageEncoding, SchemaEncoding  # type: ignore[import-untyped,unused-ignore]
@@ -186,15 +186,9 @@ def read_recording(path: str | Path) -> Recording:
         try:
             for record in StreamReader(fh, skip_magic=False).records:
                 _take(record, out, schemas, channels, decoders, factory)
-        except (McapError, EOFError) as exc:
+        except EndOfFile:  # a file cut short: read up to its last whole record
             out.complete = False
-            if not _is_end_of_file(exc):
-                raise
     return out
-
-
-def _is_end_of_file(exc: Exception) -> bool:
-    return type(exc).__name__ == "EndOfFile" or isinstance(exc, EOFError)
 
 
 def _take(
