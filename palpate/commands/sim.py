@@ -77,6 +77,9 @@ def register(parser: argparse.ArgumentParser) -> None:
         "its complete trials are read from their logs, the rest run",
     )
     parser.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
+    parser.add_argument(
+        "--no-mcap", action="store_true", help="no MCAP recording beside each trial's log"
+    )
     add_live_argument(parser, "each trial, one at a time (a serial executor)")
     parser.add_argument(
         "--faults",
@@ -214,6 +217,8 @@ def _print_results(campaigns: list[_Campaign], args: argparse.Namespace, wall_al
 
 def _prepare(path: Path, args: argparse.Namespace) -> _Campaign:
     scene = load(SceneConfig, path)
+    if args.no_mcap:
+        scene = dataclasses.replace(scene, mcap=False)
     stack = load_stack(resolve(scene.robot))
     check_campaign(scene, stack, str(path), str(resolve(scene.robot)))
     specs = campaign_trials(scene, stack, args.seed)

@@ -320,7 +320,7 @@ def _trial_log(
         yield None
         return
     header = _header(spec, scene, stack, plan, geo)
-    with TrialLogWriter(log_dir / f"{spec.trial_id}.jsonl", header, mcap=True) as log:
+    with TrialLogWriter(log_dir / f"{spec.trial_id}.jsonl", header, mcap=scene.mcap) as log:
         if hook is not None:
             hook.log_opened(log)
         yield log

@@ -205,3 +205,14 @@ def test_the_transform_encoder_is_byte_for_byte_the_definition() -> None:
         ]
     }
     assert cdr.tf_message(10**9 + 2, transforms) == bytes(encode(message))
+
+
+@pytest.mark.parametrize(("flags", "recorded"), [([], True), (["--no-mcap"], False)])
+def test_palpate_sim_records_each_trial_unless_told_not_to(
+    flags: list[str], recorded: bool, tmp_path: Path
+) -> None:
+    argv = ["sim", "--campaign", "bench", "--limit", "1", "--workers", "1", "--no-plots"]
+    assert main([*argv, "--out", str(tmp_path), *flags]) == 0
+    logs = list(tmp_path.rglob("*.jsonl"))
+    assert len(logs) == 1
+    assert logs[0].with_suffix(".mcap").exists() is recorded
