@@ -184,16 +184,24 @@ def _within_tolerance(facts: TrialFacts) -> list[str]:
 
 def _imprecise(fit: JointFit) -> str | None:
     """Why the interval is too wide for "ok", or None."""
-    E, lo, hi = fit.modulus, fit.ci_low, fit.ci_high
-    if E is None or lo is None or hi is None or E <= 0:
+    opened = f" (profiled over {', '.join(fit.profiled)})" if fit.profiled else ""
+    what = f"the {round(100 * fit.confidence)} % interval"
+    return _wider_than_imprecise(what, fit.modulus, fit.ci_low, fit.ci_high, opened)
+
+
+def _wider_than_imprecise(
+    what: str, value: float | None, lo: float | None, hi: float | None, note: str = ""
+) -> str | None:
+    """Why ``what``, [lo, hi] about ``value``, is too wide for "ok" (beyond ``IMPRECISE`` on
+    either side), or None."""
+    if value is None or lo is None or hi is None or value <= 0:
         return None
-    down, up = (E - lo) / E, (hi - E) / E
+    down, up = (value - lo) / value, (hi - value) / value
     if max(down, up) <= IMPRECISE:
         return None
-    opened = f" (profiled over {', '.join(fit.profiled)})" if fit.profiled else ""
     return (
-        f"imprecise: the {round(100 * fit.confidence)} % interval spans -{100 * down:.0f} % / "
-        f"+{100 * up:.0f} %{opened}, beyond +-{100 * IMPRECISE:.0f} %"
+        f"imprecise: {what} spans -{100 * down:.0f} % / +{100 * up:.0f} %{note}, "
+        f"beyond +-{100 * IMPRECISE:.0f} %"
     )
 
 
@@ -256,10 +264,8 @@ def relaxed_verdict(
         why = fit.message if not fit.success else "no elastic estimate to start from"
         return Verdict("none", (f"no relaxed modulus: {why}",))
     reasons = _trial_reasons(facts) + list(fit.warnings)
-    lo, hi, e = fit.relaxed_low, fit.relaxed_high, fit.relaxed
-    if lo is not None and hi is not None and e > 0 and max(e - lo, hi - e) / e > IMPRECISE:
-        reasons.append(
-            f"imprecise: the relaxed modulus's interval spans -{100 * (e - lo) / e:.0f} % / "
-            f"+{100 * (hi - e) / e:.0f} %, beyond +-{100 * IMPRECISE:.0f} %"
-        )
+    what = "the relaxed modulus's interval"
+    wide = _wider_than_imprecise(what, fit.relaxed, fit.relaxed_low, fit.relaxed_high)
+    if wide is not None:
+        reasons.append(wide)
     return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
