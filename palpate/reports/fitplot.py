@@ -26,8 +26,8 @@ from matplotlib.lines import Line2D
 from estimation.belief import Hypothesis
 from robot.trial.log import TrialLog, read_log
 from robot.trial.record import header_sensor
-from robot.trial.relaxed import HOLD_STATE
-from robot.trial.states import LOADING_STATES, record_states
+from robot.trial.relaxed import HOLD_STATE, RECORD_STATES
+from robot.trial.states import record_states
 
 STATUS_COLOURS = {"ok": "tab:green", "suspect": "tab:orange", "none": "0.6"}
 
@@ -41,8 +41,7 @@ def record_fit(log: TrialLog, path: Path) -> Path:
         raise ValueError(f"{log.path}: no joint fit to draw (the trial has no estimate)")
     sensor, section, inputs = header_sensor(log.header, str(log.path))
     gratings = len(sensor.used_gratings)
-    states_of = [*LOADING_STATES, HOLD_STATE]
-    rows = [r for r in log.of_kind("sample") if r["state"] in states_of]
+    rows = [r for r in log.of_kind("sample") if r["state"] in RECORD_STATES]
     rows = [r for r in rows if len(r["strains"]) == gratings and r["advance"] is not None]
     advance = np.array([r["advance"] for r in rows], dtype=np.float64)
     strains = np.array([r["strains"] for r in rows], dtype=np.float64).reshape(-1, gratings)

@@ -22,6 +22,7 @@ from estimation.jointfit import JointFit
 from estimation.relaxation import RelaxationFit, RelaxationRecord, fit_relaxation
 from estimation.section import Section
 from robot.trial.inputs import EstimatorInputs
+from robot.trial.lean import rows_in
 from robot.trial.states import LOADING_STATES, record_states
 
 HOLD_STATE = "holding"
@@ -53,7 +54,9 @@ def relaxation_of(
         return RelaxationFit(False, "no joint fit to start from")
     t, advance, strains, counts = _blocks(rows, times, len(sensor.used_gratings))
     hold_t = [times[i] for i, r in enumerate(rows) if r[0] == HOLD_STATE]
-    _, k = record_states(*_rows_in(rows, len(sensor.used_gratings)), inputs, sensor, section)
+    _, k = record_states(
+        *rows_in(rows, RECORD_STATES, len(sensor.used_gratings)), inputs, sensor, section
+    )
     states, _ = record_states(advance, strains, inputs, sensor, section)
     thin = 1.0 / np.sqrt(counts)  # a block's mean has 1/sqrt(n) of a row's noise
     best = Hypothesis.described(joint.best, inputs.tip_radius, inputs.belief().layer_law)
@@ -83,13 +86,6 @@ def _held(times: Sequence[float]) -> float:
     if len(times) < 2:
         return 0.0
     return float(times[-1] - times[0] + np.median(np.diff(times)))
-
-
-def _rows_in(rows: Sequence[Row], gratings: int) -> tuple[FloatArray, FloatArray]:
-    """(advance (N,), strains (N, G)) of the record's rows, one per row (for the noise)."""
-    keep = [r for r in rows if r[0] in RECORD_STATES and len(r[2]) == gratings]
-    advance = np.asarray([r[1] for r in keep], dtype=np.float64)
-    return advance, np.asarray([r[2] for r in keep], dtype=np.float64).reshape(-1, gratings)
 
 
 def _blocks(
