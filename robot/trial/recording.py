@@ -22,7 +22,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, NamedTuple
 
 import numpy as np
 from mcap.exceptions import EndOfFile, McapError  # type: ignore[import-untyped,unused-ignore]
@@ -49,6 +49,16 @@ from robot.trial.ros2 import (
 LIBRARY = "palpate"
 
 
+class Sample(NamedTuple):
+    """A sample as the recorder keeps it for what it derives when the trial ends: its stamp
+    (ns), stage advance (m) and roll (rad) (NaN where not measured), and its strains."""
+
+    stamp: int
+    advance: float
+    roll: float
+    strains: list[Any]
+
+
 class McapRecorder:
     """One trial's MCAP recording (see the module docstring): ``write`` each log record with
     its JSON line, ``close`` at the end (idempotent)."""
@@ -62,10 +72,8 @@ class McapRecorder:
         self._channels: dict[str, int] = {}
         self._encoders: dict[str, Callable[[Any], bytes]] = {}
         self._last_ns = 0
-        self.samples: list[tuple[int, Any, list[Any]]] = []  # (stamp, advance, strains)
-        self.rolls: list[Any] = []  # each sample's roll (rad), for the transforms
+        self.samples: list[Sample] = []  # what the tip force and pose are derived from
         self.header = header
-        self.count = 0
 
     def write(self, record: dict[str, Any], line: str) -> None:
         if self._fh is None:
@@ -77,12 +85,12 @@ class McapRecorder:
             self._last_ns = max(self._last_ns, nanoseconds(float(t)))
         if record.get("kind") == "sample":
             for topic, data in sample_messages(record, self._last_ns):
-                self._raw(topic, data)
-            self.samples.append((self._last_ns, record.get("advance"), record.get("strains") or []))
-            self.rolls.append(record.get("roll"))
+                self._raw(topic, data, self._last_ns)
+            advance, roll = _float(record.get("advance")), _float(record.get("roll"))
+            self.samples.append(Sample(self._last_ns, advance, roll, record.get("strains") or []))
             return
         for topic, message in messages(record, self._last_ns, line):
-            self._raw(topic, self._encoder(topic)(message))
+            self._raw(topic, self._encoder(topic)(message), self._last_ns)
 
     def _channel(self, topic: str) -> int:
         channel = self._channels.get(topic)
@@ -101,12 +109,11 @@ class McapRecorder:
             encoder = self._encoders[topic] = serialize_dynamic(name, SCHEMAS[name])[name]
         return encoder
 
-    def _raw(self, topic: str, data: bytes) -> None:
-        stamp = self._last_ns
+    def _raw(self, topic: str, data: bytes, stamp: int) -> None:
+        """Write one encoded message, logged and published at ``stamp`` (ns)."""
         self._writer.add_message(
             self._channel(topic), log_time=stamp, data=data, publish_time=stamp
         )
-        self.count += 1
 
     def flush(self) -> None:
         """Hand the messages written so far to the OS (the log calls it when it flushes)."""
@@ -120,9 +127,8 @@ class McapRecorder:
             return
         forces = loads(self) if loads is not None else None
         if forces is not None:
-            for (stamp, _, _), load in zip(self.samples, forces, strict=True):
-                self._last_ns = stamp
-                self._raw(*wrench(stamp, load))
+            for sample, load in zip(self.samples, forces, strict=True):
+                self._raw(*wrench(sample.stamp, load), sample.stamp)
         self._transforms()
         self._writer.finish()  # type: ignore[no-untyped-call,unused-ignore]
         self._fh.close()
@@ -133,11 +139,10 @@ class McapRecorder:
         tube = _tube(self.header)
         if tube is None:
             return
-        for (stamp, advance, _), roll in zip(self.samples, self.rolls, strict=True):
-            found = tip_transforms(tube, _float(roll), _float(advance))
+        for sample in self.samples:
+            found = tip_transforms(tube, sample.roll, sample.advance)
             if found is not None:
-                self._last_ns = stamp
-                self._raw("/tf", cdr.tf_message(stamp, found))
+                self._raw("/tf", cdr.tf_message(sample.stamp, found), sample.stamp)
 
 
 def _float(value: Any) -> float:
@@ -247,12 +252,13 @@ def axial_loads(recorder: McapRecorder) -> list[float] | None:
     except (KeyError, TypeError, ValueError):  # ConfigError is a ValueError
         return None
     gratings = len(sensor.used_gratings)
-    rows = [i for i, (_, u, s) in enumerate(recorder.samples) if _whole([u, *s], gratings + 1)]
-    loads = [math.nan] * len(recorder.samples)
+    samples = recorder.samples
+    rows = [i for i, x in enumerate(samples) if _whole([x.advance, *x.strains], gratings + 1)]
+    loads = [math.nan] * len(samples)
     if not rows:
         return loads
-    strains = np.asarray([recorder.samples[i][2] for i in rows], dtype=np.float64)
-    advance = np.asarray([recorder.samples[i][1] for i in rows], dtype=np.float64)
+    strains = np.asarray([samples[i].strains for i in rows], dtype=np.float64)
+    advance = np.asarray([samples[i].advance for i in rows], dtype=np.float64)
     states, _ = record_states(advance, strains, inputs, sensor, section)
     for i, load in zip(rows, states.P.tolist(), strict=True):
         loads[i] = load
