@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import logging
 import math
 import time
@@ -42,6 +43,8 @@ from palpate.argtypes import port_number
 from robot.guards import Observation
 from robot.indentation import State
 from robot.kinematics import forward
+from robot.trial.cdr import Transform
+from robot.trial.ros2 import tip_transforms
 from sensor.strain import grating_intervals
 
 log = logging.getLogger(__name__)
@@ -206,10 +209,12 @@ class _Feed:
         tube_points, tip, rotation = _tube(self.tube, obs.roll, obs.advance)
         beam = _beam_points(length, shortening)  # in the tube tip's frame (x along the tangent)
         if v.tf.has_sinks():
-            frames = [
-                _frame(ts, "base", "tube_tip", tip, _quaternion(rotation)),
-                _frame(ts, "tube_tip", "sensor_tip", beam[-1], (1.0, 0.0, 0.0, 0.0)),
-            ]
+            # the recording's transforms (robot.trial.ros2), the sensor tip at the bent beam's end
+            known = None if self.tube is None else tip_transforms(self.tube, obs.roll, obs.advance)
+            identity = (0.0, 0.0, 0.0, 1.0)
+            to_tip: Transform = known[0] if known else ("base", "tube_tip", (0, 0, 0), identity)
+            end = tuple(float(x) for x in beam[-1])
+            frames = [_frame(ts, to_tip), _frame(ts, ("tube_tip", "sensor_tip", end, identity))]
             v.tf.log(FrameTransforms(transforms=frames), log_time=stamp)
         if v.scene.has_sinks():
             world_beam = [tip + rotation @ p for p in beam]
@@ -221,10 +226,11 @@ class _Feed:
             v.scene.log(SceneUpdate(entities=[entity]), log_time=stamp)
 
 
-def _frame(ts: Any, parent: str, child: str, at: FloatArray, q: tuple[float, ...]) -> Any:
+def _frame(ts: Any, transform: Transform) -> Any:
+    """A foxglove transform of the recording's (parent, child, xyz, quaternion xyzw)."""
     from foxglove.messages import FrameTransform, Quaternion, Vector3
 
-    w, x, y, z = q
+    parent, child, at, (x, y, z, w) = transform
     return FrameTransform(
         timestamp=ts,
         parent_frame_id=parent,
@@ -249,21 +255,18 @@ def _line(points: list[FloatArray], rgb: tuple[float, float, float], thickness: 
 def _tube(
     tube: TubeConfig | None, roll: float, advance: float
 ) -> tuple[list[FloatArray], FloatArray, FloatArray]:
-    """The tube's centreline points, its tip and its tip frame's rotation in ``base`` (m), as
-    ``robot.kinematics`` has them (the arc's points are the tip of the arc cut short); on the
-    bench stage (no tube) no centreline, the clamp at the origin."""
+    """The tube's centreline points, its tip and its tip frame's rotation in ``base`` (m): the
+    forward kinematics of the tube cut short along its arc; on the bench stage (no tube) no
+    centreline, the clamp at the origin."""
     if tube is None:
         return [np.zeros(3)], np.zeros(3), np.eye(3)
-    pose = forward(tube, roll, advance)
-    c, s = math.cos(roll), math.sin(roll)
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
     points = [np.zeros(3)]
     for u in np.linspace(0.0, 1.0, 12):
-        a, la = u * tube.tip_angle, u * tube.arc_length
-        # robot.kinematics.tube_tip_in_bend_plane for the arc's first u (sinc: exact at a = 0)
-        along = tube.straight_length + la * float(np.sinc(a / math.pi))
-        drop = -la * 0.5 * a * float(np.sinc(a / (2.0 * math.pi))) ** 2
-        points.append(rx @ np.array([along, 0.0, drop]))
+        partial = dataclasses.replace(
+            tube, tip_angle_deg=u * tube.tip_angle_deg, arc_length_mm=u * tube.arc_length_mm
+        )
+        points.append(forward(partial, roll, advance).tube_tip)
+    pose = forward(tube, roll, advance)
     return points, pose.tube_tip, pose.rotation
 
 
@@ -276,10 +279,3 @@ def _beam_points(length: float, shortening: float) -> list[FloatArray]:
         return [np.array([length * u, 0.0, 0.0]) for u in s]
     x, y = post_buckling(np.array([ratio]), "accurate").xy(s)
     return [np.array([length * a, 0.0, length * b]) for a, b in zip(x, y, strict=True)]
-
-
-def _quaternion(rotation: FloatArray) -> tuple[float, float, float, float]:
-    from transforms3d.quaternions import mat2quat
-
-    w, x, y, z = mat2quat(rotation)
-    return float(w), float(x), float(y), float(z)
