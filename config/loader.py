@@ -262,3 +262,22 @@ def resolve(name: str | Path) -> Path:
     if shipped.exists():
         return shipped
     raise ConfigError(str(name), "", "file not found (neither as given nor in the shipped config/)")
+
+
+def to_mapping(obj: Any) -> Any:
+    """A configuration dataclass as the YAML mapping :func:`from_mapping` reads back (tuples as
+    lists, nested dataclasses as mappings)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: to_mapping(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, tuple | list):
+        return [to_mapping(v) for v in obj]
+    if isinstance(obj, float) and math.isfinite(obj):
+        return float(f"{obj:.12g}")  # 0.04, not the 0.039999999999999994 of a unit conversion
+    return obj
+
+
+def write_yaml(obj: Any, path: str | Path, comment: str = "") -> None:
+    """Write a configuration dataclass to ``path`` as YAML (``comment`` lines first)."""
+    head = "".join(f"# {line}\n" for line in comment.splitlines())
+    text = yaml.safe_dump(to_mapping(obj), sort_keys=False, default_flow_style=None)
+    Path(path).write_text(head + text, encoding="utf-8")

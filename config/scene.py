@@ -93,7 +93,7 @@ class CampaignConfig:
     # 0: no hold (an elastic sample needs none). docs/viscoelastic.md has the length's table.
     hold_s: float = field(default=0.0, metadata=limits(ge=0, le=50))
     max_travel_past_contact_mm: float = field(default=2.5, metadata=limits(gt=0, le=50))
-    contact: Literal["event", "fbg"] = "event"
+    contact: Literal["event", "fbg", "tip"] = "event"
     detector: Literal["paper", "cusum"] = "paper"
     detector_threshold_ue: float = field(default=300.0, metadata=limits(gt=0, le=10000))
     outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))

@@ -11,13 +11,32 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
+from config.drive import DriveConfig
 from config.loader import limits
+from config.optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
 
-MM = 1e-3
+__all__ = [
+    "DEFAULT_CONTROL_RATE_HZ",
+    "GPA",
+    "MM",
+    "NM",
+    "PM",
+    "UE",
+    "BoardConfig",
+    "CalibrationConfig",
+    "DriveConfig",
+    "FbgConfig",
+    "SensorConfig",
+    "ServoBusConfig",
+    "ServoConfig",
+    "StackConfig",
+    "TipGratingConfig",
+    "TubeConfig",
+    "check_compliance",
+    "compliance_range",
+]
+
 GPA = 1e9
-UE = 1e-6
-PM = 1e-12
-NM = 1e-9
 
 # Control ticks per second when a scene or a bench file does not say (``control_rate_hz``): one
 # default for the simulator and the bench, the rate the shipped files use.
@@ -44,8 +63,18 @@ class SensorConfig:
     # MJP resin) and the beam (four NiTi wires, 6.45 g/cm^3, and the fiber).
     tip_mass_g: float = field(default=0.21, metadata=limits(ge=0, le=100))
     linear_mass_g_per_m: float = field(default=0.9, metadata=limits(ge=0, le=1000))
+    # An optional force grating at the tip (null: the paper's sensor, without one)
+    tip_grating: TipGratingConfig | None = None
+    # The tissue moduli the sensor was designed for (`palpate design --write`); an estimate
+    # whose interval lies wholly outside gets no number. null: not stated.
+    designed_range_kpa: tuple[float, float] | None = field(
+        default=None, metadata=limits(gt=0, le=1e7)
+    )
 
     def validate(self) -> None:
+        r = self.designed_range_kpa
+        if r is not None and not r[0] < r[1]:
+            raise ValueError(f"designed_range_kpa: [min, max] needs min < max, got {list(r)}")
         if not self.used_gratings:
             raise ValueError("used_gratings: at least one grating must be used")
         for g in self.used_gratings:
@@ -53,6 +82,12 @@ class SensorConfig:
                 raise ValueError(f"used_gratings: grating {g} is not in 1..{self.grating_count}")
         if len(set(self.used_gratings)) != len(self.used_gratings):
             raise ValueError("used_gratings: a grating is listed twice")
+
+    @property
+    def designed_range(self) -> tuple[float, float] | None:
+        """The designed moduli (Pa), or None."""
+        r = self.designed_range_kpa
+        return None if r is None else (r[0] * 1e3, r[1] * 1e3)
 
     @property
     def fiber_radius(self) -> float:
@@ -96,42 +131,6 @@ class SensorConfig:
             (self.first_grating_from_tip_mm + (g - 1) * self.grating_spacing_mm) * MM
             for g in self.used_gratings
         )
-
-
-@dataclass(frozen=True)
-class FbgConfig:
-    """Optics of the FBG fiber: Eq. (1) coefficients and the gratings' Bragg wavelengths."""
-
-    strain_coefficient_pm_per_ue: float = field(default=0.424, metadata=limits(gt=0, le=10))
-    bare_strain_coefficient_pm_per_ue: float = field(default=1.2, metadata=limits(gt=0, le=10))
-    temperature_coefficient_pm_per_degc: float = field(default=10.0, metadata=limits(ge=0, le=100))
-    # "measured" (a separately measured dT) is not offered: the board's frame protocol carries
-    # no temperature, so nothing could supply it (sensor.strain keeps it for offline use)
-    temperature_compensation: Literal["none", "reference"] = "none"
-    base_wavelengths_nm: tuple[float, ...] = (1530.0, 1535.0, 1540.0, 1545.0, 1550.0)
-    reference_wavelength_nm: float | None = None
-    strain_limit_ue: float = field(default=5000.0, metadata=limits(gt=0, le=20000))
-
-    def validate(self) -> None:
-        if self.temperature_compensation == "reference" and self.reference_wavelength_nm is None:
-            raise ValueError(
-                "temperature_compensation 'reference' needs reference_wavelength_nm "
-                "(a strain-free grating)"
-            )
-
-    @property
-    def strain_coefficient(self) -> float:
-        """k'_eps in m of wavelength per unit strain."""
-        return self.strain_coefficient_pm_per_ue * PM / UE
-
-    @property
-    def temperature_coefficient(self) -> float:
-        """S_T in m of wavelength per kelvin."""
-        return self.temperature_coefficient_pm_per_degc * PM
-
-    @property
-    def strain_limit(self) -> float:
-        return self.strain_limit_ue * UE
 
 
 @dataclass(frozen=True)
@@ -185,92 +184,6 @@ class ServoBusConfig:
     def max_goal_step(self) -> float:
         """Largest change of a servo goal per control tick, rad of servo shaft."""
         return math.radians(self.max_goal_step_deg)
-
-
-@dataclass(frozen=True)
-class DriveConfig:
-    """Dual roller-gear drive: joint space (roll phi, stage translation) <-> servo shaft angles.
-
-    Servo shaft angles: outer = outer_roll_ratio * phi, inner = inner_roll_ratio * phi (the inner
-    roll is slaved to the outer one so the sensor does not twist), translation servo =
-    2 pi / lead * (translation - coupling * phi). ``coupling_mm_per_rad`` is the translation a
-    roll produces by itself (0 for an ideal roller gear). ``home_*`` is the pose the drive is in
-    when it is homed (software homing: present shaft angles are taken as this pose).
-    """
-
-    outer_roll_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1000))
-    inner_roll_ratio: float = field(default=1.0, metadata=limits(gt=0, le=1000))
-    lead_mm_per_rev: float = field(default=20.0, metadata=limits(gt=0, le=1000))
-    coupling_mm_per_rad: float = field(default=0.0, metadata=limits(ge=-100, le=100))
-    translation_min_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
-    translation_max_mm: float = field(default=80.0, metadata=limits(ge=-1000, le=1000))
-    roll_min_deg: float = field(default=-200.0, metadata=limits(ge=-3600, le=3600))
-    roll_max_deg: float = field(default=200.0, metadata=limits(ge=-3600, le=3600))
-    max_speed_mm_per_s: float = field(default=5.0, metadata=limits(gt=0, le=1000))
-    max_roll_speed_deg_per_s: float = field(default=90.0, metadata=limits(gt=0, le=10000))
-    max_accel_mm_per_s2: float = field(default=50.0, metadata=limits(gt=0, le=100000))
-    max_roll_accel_deg_per_s2: float = field(default=360.0, metadata=limits(gt=0, le=1000000))
-    home_translation_mm: float = field(default=0.0, metadata=limits(ge=-1000, le=1000))
-    home_roll_deg: float = field(default=0.0, metadata=limits(ge=-3600, le=3600))
-    # The inner roller gear is slaved to the outer one; a twist between them beyond this (a
-    # slipping gear, a stalled servo) stops the trial and retracts.
-    max_twist_deg: float = field(default=3.0, metadata=limits(gt=0, le=360))
-
-    def validate(self) -> None:
-        if self.translation_min_mm >= self.translation_max_mm:
-            raise ValueError("translation_min_mm must be below translation_max_mm")
-        if self.roll_min_deg >= self.roll_max_deg:
-            raise ValueError("roll_min_deg must be below roll_max_deg")
-        if not self.translation_min_mm <= self.home_translation_mm <= self.translation_max_mm:
-            raise ValueError("home_translation_mm must lie within the translation limits")
-        if not self.roll_min_deg <= self.home_roll_deg <= self.roll_max_deg:
-            raise ValueError("home_roll_deg must lie within the roll limits")
-
-    @property
-    def lead(self) -> float:
-        """Translation of the inner roller gear per servo revolution, in m."""
-        return self.lead_mm_per_rev * MM
-
-    @property
-    def coupling(self) -> float:
-        """Translation per rad of roll, m/rad."""
-        return self.coupling_mm_per_rad * MM
-
-    @property
-    def translation_limits(self) -> tuple[float, float]:
-        return self.translation_min_mm * MM, self.translation_max_mm * MM
-
-    @property
-    def roll_limits(self) -> tuple[float, float]:
-        return math.radians(self.roll_min_deg), math.radians(self.roll_max_deg)
-
-    @property
-    def max_speed(self) -> float:
-        return self.max_speed_mm_per_s * MM
-
-    @property
-    def max_twist(self) -> float:
-        return math.radians(self.max_twist_deg)
-
-    @property
-    def max_roll_speed(self) -> float:
-        return math.radians(self.max_roll_speed_deg_per_s)
-
-    @property
-    def max_accel(self) -> float:
-        return self.max_accel_mm_per_s2 * MM
-
-    @property
-    def max_roll_accel(self) -> float:
-        return math.radians(self.max_roll_accel_deg_per_s2)
-
-    @property
-    def home_translation(self) -> float:
-        return self.home_translation_mm * MM
-
-    @property
-    def home_roll(self) -> float:
-        return math.radians(self.home_roll_deg)
 
 
 @dataclass(frozen=True)
@@ -360,14 +273,15 @@ class StackConfig:
     """Everything the control stack needs to run one robot: ``config/robot.yaml``."""
 
     sensor: SensorConfig = SensorConfig()
-    fbg: FbgConfig = FbgConfig()
+    fbg: FbgConfig = FbgConfig()  # noqa: RUF009 - frozen
     board: BoardConfig = BoardConfig()
     servos: ServoBusConfig = ServoBusConfig()
-    drive: DriveConfig = DriveConfig()
+    drive: DriveConfig = DriveConfig()  # noqa: RUF009 - frozen
     tubes: tuple[TubeConfig, ...] = DEFAULT_TUBES
     calibration: CalibrationConfig = CalibrationConfig()
 
     def validate(self) -> None:
+        self._validate_tip_grating()
         names = [t.name for t in self.tubes]
         if len(set(names)) != len(names):
             raise ValueError(f"tubes: names must be unique, got {names}")
@@ -377,19 +291,38 @@ class StackConfig:
                 f"sensor.grating_count is {self.sensor.grating_count}"
             )
 
+    def _validate_tip_grating(self) -> None:
+        tip = self.sensor.tip_grating
+        if tip is None or tip.temperature_compensation != "reference":
+            return
+        key = "sensor.tip_grating.temperature_compensation"
+        if self.fbg.reference_wavelength_nm is None:
+            raise ValueError(
+                f"{key}: 'reference' needs a strain-free reference grating "
+                "(fbg.reference_wavelength_nm)"
+            )
+        if not self.board.has_reference:
+            raise ValueError(f"{key}: 'reference' needs the board to send it (board.has_reference)")
+
     def compliance(self, tube: str | None) -> tuple[tuple[float, float], bool]:
         """The compliance (min, max) in m/N between the stage encoder and the sensor's clamp of
         ``tube`` (None: the bench-top stage), and whether it is calibrated (else the
-        uncalibrated range)."""
+        uncalibrated range); a tip grating's element (``sensor.tip_grating.compliance_mm_per_n``)
+        is added, travel that is not indentation either. A tube's calibrated value is the tube's
+        own: a calibration on a rigid reference with a tip-grating sensor measures both."""
         value = (
             self.calibration.stage_compliance_mm_per_n
             if tube is None
             else self.tube(tube).compliance_mm_per_n
         )
         calibrated = compliance_range(value)
-        if calibrated is not None:
+        element = 0.0 if self.sensor.tip_grating is None else self.sensor.tip_grating.compliance
+        if calibrated is None:
+            high = self.calibration.uncalibrated_compliance_max_mm_per_n * MM
+            return (element, high + element), False
+        if element == 0.0:
             return calibrated, True
-        return (0.0, self.calibration.uncalibrated_compliance_max_mm_per_n * MM), False
+        return (calibrated[0] + element, calibrated[1] + element), True
 
     def tube(self, name: str) -> TubeConfig:
         for t in self.tubes:

@@ -90,6 +90,10 @@ class TrialFacts:
         lean: the load's lean measured from the strains (``estimation.misalignment``).
         misalignment_sigma: the measured normal's 1-sigma angle (rad), None if not measured.
         relaxation: the relaxation fit of a trial that held (``estimation.relaxation``).
+        designed_range: the moduli (Pa) the sensor was designed for, None: not stated.
+        buckling_tip_load: the tip grating's load at the buckling mark (N), None without one.
+        bow: the beam's bow w0/L fitted against the tip grating's load (Southwell), None
+            without one (a bow fitted against the strains' own load is not independent).
     """
 
     state: str = "done"
@@ -103,6 +107,17 @@ class TrialFacts:
     lean: Lean | None = None
     misalignment_sigma: float | None = None
     relaxation: RelaxationFit | None = None
+    designed_range: tuple[float, float] | None = None
+    buckling_tip_load: float | None = None
+    bow: float | None = None
+
+
+EARLY_BUCKLING = 0.5
+"""A buckling mark at a tip load below this share of P_cr was not the tissue's buckling."""
+BOW_LIMIT = 0.01
+"""The bow w0/L past which the shortening read as a straight beam's is not trusted: the bow's
+share of the shortening, 2 z0 z L, is first order in the bending and left out
+(``estimation.southwell``); docs/lung.md measures it (w0/L 4-5 %: -9 to -27 %)."""
 
 
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
@@ -113,6 +128,9 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
         return Verdict("none", (soft,))
     if fit is None or not fit.success or fit.modulus is None:
         return Verdict("none", ("no estimate: " + ("no fit" if fit is None else fit.message),))
+    outside = _outside_range(fit, facts.designed_range)
+    if outside is not None:
+        return Verdict("none", (outside,))
     reasons = [w for w in fit.warnings if _is_suspect(w)]
     imprecise = _imprecise(fit)
     if imprecise is not None:
@@ -124,6 +142,34 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
             "indentation speed, between the two; the relaxed modulus is the tissue's long-time one"
         )
     return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+
+
+def _outside_range(fit: JointFit, designed: tuple[float, float] | None) -> str | None:
+    """Why a modulus whose whole interval lies outside the sensor's designed range has no number,
+    or None."""
+    if designed is None or fit.modulus is None:
+        return None
+    lo = fit.modulus if fit.ci_low is None else fit.ci_low
+    hi = fit.modulus if fit.ci_high is None else fit.ci_high
+    if lo <= designed[1] and hi >= designed[0]:
+        return None
+    side = "below" if hi < designed[0] else "above"
+    return (
+        f"outside the sensor's designed range: {fit.modulus / 1e3:.3g} kPa is {side} "
+        f"{designed[0] / 1e3:g}-{designed[1] / 1e3:g} kPa (see `palpate design`)"
+    )
+
+
+def _early_buckling(facts: TrialFacts) -> str | None:
+    """Why a buckling mark at a small tip load (a tip grating's) was not the tissue's, or None."""
+    load, p_cr = facts.buckling_tip_load, facts.critical_load
+    if load is None or p_cr is None or load >= EARLY_BUCKLING * p_cr:
+        return None
+    return (
+        f"buckling detected at a tip load of {load * 1e3:.3g} mN, {load / p_cr:.0%} of the beam's "
+        f"critical load ({p_cr * 1e3:.3g} mN): the gratings bent under something else than the "
+        "tissue (the beam's own weight across it, a bow), and the record ends before buckling"
+    )
 
 
 def _trial_reasons(facts: TrialFacts) -> list[str]:
@@ -142,6 +188,15 @@ def _trial_reasons(facts: TrialFacts) -> list[str]:
             f"of {math.degrees(tol):g} deg"
         )
     reasons.extend(_orientation(facts))
+    early = _early_buckling(facts)
+    if early is not None:
+        reasons.append(early)
+    if facts.bow is not None and abs(facts.bow) > BOW_LIMIT:
+        reasons.append(
+            f"the beam is bowed before it buckles, w0/L = {abs(facts.bow):.1%} against the tip "
+            f"grating's load (its own weight across it, or a crooked beam): past "
+            f"{BOW_LIMIT:.0%} the shortening read as a straight beam's is not trusted"
+        )
     if facts.state != "done":
         reasons.append(f"the trial ended in {facts.state}: {facts.reason}")
     return reasons

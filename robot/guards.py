@@ -35,6 +35,7 @@ class Observation:
     bus_lost: bool = False  # servo_fault is a transport failure (no or garbled replies)
     abort: bool = False  # the operator pressed stop
     twist: float = 0.0  # rad, inner roller gear's roll minus the outer's (the sensor's twist)
+    tip_force: float | None = None  # N, the tip force grating's load (None: no tip grating)
 
 
 def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -> str | None:

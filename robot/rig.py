@@ -22,7 +22,7 @@ from typing import Literal
 
 import numpy as np
 
-from config.schema import DEFAULT_CONTROL_RATE_HZ
+from config.schema import DEFAULT_CONTROL_RATE_HZ, StackConfig
 from estimation.beamstate import axial_strain
 from robot.drive import DriveController, JointState
 from robot.indentation import Command, Observation
@@ -30,9 +30,10 @@ from robot.motors import ServoFaultError, ServoTransportError
 from sensor.clock import Clock
 from sensor.reader import FrameReader, SensorPortError
 from sensor.strain import StrainChain
+from sensor.tipforce import TipForceChain, tip_chain
 from wire.frame import Frame, Status
 
-ContactMode = Literal["event", "fbg"]
+ContactMode = Literal["event", "fbg", "tip"]
 REZERO_FRAMES = 8  # frames a zero taken again during a trial averages
 
 
@@ -45,6 +46,10 @@ class RigSettings:
     # FBG contact reads the axial strain with the bow of a not-quite-straight beam taken out.
     # None: the mean strain (right for a straight beam only).
     fbg_bending_mode: tuple[float, ...] | None = None
+    # Tip contact: the tip grating's load over this many of its standard deviations at rest
+    # (the zero's), and at least ``tip_contact_floor`` (N)
+    tip_contact_sigmas: float = 5.0
+    tip_contact_floor: float = 1e-5
     # Simulation: before using a tick's frames, wait until what the emulator has sent up to the
     # current clock time has come through the transport (``sent_bytes``: the bytes it has put on
     # the wire so far; without it, the frame due by ``frame_period`` after the last one).
@@ -65,10 +70,12 @@ class ServoFbgRig:
         chain: StrainChain,
         clock: Clock,
         settings: RigSettings | None = None,
+        tip: TipForceChain | None = None,
     ) -> None:
         self.drive = drive
         self.reader = reader
         self.chain = chain
+        self.tip = tip
         self.clock = clock
         self.settings = settings or RigSettings()
         self._setpoint: JointState | None = None
@@ -77,6 +84,19 @@ class ServoFbgRig:
         self._frame_t = -math.inf
         self._twist = 0.0
         self.frames: list[Frame] = []  # every frame received, for the trial log and plots
+
+    @classmethod
+    def for_stack(
+        cls,
+        drive: DriveController,
+        reader: FrameReader,
+        stack: StackConfig,
+        clock: Clock,
+        settings: RigSettings | None = None,
+    ) -> ServoFbgRig:
+        """The rig of a robot configuration: its strain chain, and its tip grating's if any."""
+        tip = tip_chain(stack.sensor.tip_grating, stack.fbg)
+        return cls(drive, reader, StrainChain.from_config(stack.fbg), clock, settings, tip)
 
     @property
     def tick(self) -> float:
@@ -108,6 +128,14 @@ class ServoFbgRig:
         if frames[0].reference is not None:
             ref = np.asarray([f.reference for f in frames], dtype=float)
         self.chain = self.chain.zeroed(wl, ref)
+        if self.tip is not None:
+            tips = [f.tip for f in frames]
+            if any(t is None for t in tips):
+                raise SensorPortError(
+                    f"board port {self.reader.port_name!r}: the sensor has a tip grating and the "
+                    "board's frames carry none (frame protocol revision 1.1, options bit 2)"
+                )
+            self.tip = self.tip.zeroed(np.asarray(tips, dtype=float), ref)
         return self.chain
 
     # -- Rig protocol ------------------------------------------------------------------------
@@ -132,16 +160,13 @@ class ServoFbgRig:
             self._frame_t = t
         strains: tuple[float, ...] = ()
         contact = False
+        tip_force: float | None = None
         if self._frame is not None:
             f = self._frame
             eps = self.chain.strains(f.wavelengths, reference=f.reference)
             strains = tuple(float(x) for x in eps)
-            if self.settings.contact == "event":
-                contact = bool(f.flags & Status.CONTACT_EVENT)
-            else:
-                mode = self.settings.fbg_bending_mode
-                axial = axial_strain(eps, mode) if mode else -float(np.mean(eps))
-                contact = axial > self.settings.fbg_contact_strain
+            tip_force = self._tip_force(f)
+            contact = self._contact(f, eps, tip_force)
         return Observation(
             t=t,
             advance=joints.translation,
@@ -152,7 +177,28 @@ class ServoFbgRig:
             servo_fault=fault,
             bus_lost=lost,
             twist=self._twist,
+            tip_force=tip_force,
         )
+
+    def _tip_force(self, f: Frame) -> float | None:
+        """The tip grating's load (N) in frame ``f``; None without a tip grating or its zero."""
+        if self.tip is None or self.tip.zero is None or f.tip is None:
+            return None
+        return self.tip.force(f.tip, f.reference)
+
+    def _contact(self, f: Frame, eps: np.ndarray, tip_force: float | None) -> bool:
+        """The contact as the settings read it: the rig's event input, the beam's axial strain
+        (``fbg``) or the tip grating's load (``tip``)."""
+        s = self.settings
+        if s.contact == "event":
+            return bool(f.flags & Status.CONTACT_EVENT)
+        if s.contact == "tip":
+            if tip_force is None or self.tip is None:
+                return False
+            return tip_force > max(s.tip_contact_sigmas * self.tip.noise(), s.tip_contact_floor)
+        mode = s.fbg_bending_mode
+        axial = axial_strain(eps, mode) if mode else -float(np.mean(eps))
+        return axial > s.fbg_contact_strain
 
     def command(self, cmd: Command) -> None:
         if cmd.rezero and self.frames:

@@ -134,8 +134,13 @@ def _fit(
     )
 
 
-def load_pairs_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Read ``strain_ue``/``shift_pm`` columns; returns (strain, shift in m) as float arrays.
+def load_pairs_csv(
+    path: str | Path,
+    columns: tuple[str, str] = ("strain_ue", "shift_pm"),
+    scales: tuple[float, float] = (UE, PM),
+) -> tuple[np.ndarray, np.ndarray]:
+    """Read two columns (``strain_ue``/``shift_pm`` by default; the tip grating's calibration
+    reads ``force_mn``/``shift_pm``); returns them as float arrays times ``scales`` (SI).
 
     ValueError names the file and, where it applies, the line.
     """
@@ -156,10 +161,10 @@ def load_pairs_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     if not rows:
         raise ValueError(f"{p}: empty file")
     head = [h.strip() for h in rows[0]]
-    missing = [c for c in ("strain_ue", "shift_pm") if c not in head]
+    missing = [c for c in columns if c not in head]
     if missing:
         raise ValueError(f"{p}: header lacks column(s) {missing}; found {head}")
-    i_s, i_w = head.index("strain_ue"), head.index("shift_pm")
+    i_s, i_w = head.index(columns[0]), head.index(columns[1])
     strain, shift = [], []
     for line, row in enumerate(rows[1:], start=2):
         try:
@@ -167,4 +172,16 @@ def load_pairs_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
             shift.append(float(row[i_w]))
         except (IndexError, ValueError) as exc:
             raise ValueError(f"{p}: data row {line}: {exc}") from None
-    return np.asarray(strain) * UE, np.asarray(shift) * PM
+    return np.asarray(strain) * scales[0], np.asarray(shift) * scales[1]
+
+
+def csv_columns(path: str | Path) -> list[str]:
+    """The header of a calibration CSV (the first line that is not a comment), [] if none."""
+    try:
+        with Path(path).open(newline="", encoding="utf-8") as fh:
+            for line in fh:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return [h.strip() for h in next(csv.reader([line]))]
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return []
+    return []

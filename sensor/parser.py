@@ -148,4 +148,9 @@ class FrameParser:
 
 def layout_from_config(sensor: SensorConfig, board: BoardConfig) -> FrameLayout:
     """The stream's layout: one peak per used grating, in ``sensor.used_gratings`` order."""
-    return layout_of(len(sensor.used_gratings), board.has_reference, board.has_force)
+    return layout_of(
+        len(sensor.used_gratings),
+        board.has_reference,
+        board.has_force,
+        sensor.tip_grating is not None,
+    )

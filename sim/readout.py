@@ -8,9 +8,10 @@ replaced, so the same bits (``sim.world.World.sample`` calls it at every board s
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from config.scene import FidelityConfig
-from config.schema import FbgConfig, SensorConfig
+from config.schema import FbgConfig, SensorConfig, TipGratingConfig
 
 
 class GratingReadout:
@@ -53,3 +54,36 @@ class GratingReadout:
         if noise:
             wl = [w + n for w, n in zip(wl, noise[: len(wl)], strict=True)]
         return tuple(wl)
+
+
+class TipReadout:
+    """The tip force grating's peak: its Bragg wavelength plus the sensitivity times the tip's
+    axial load (clipped at the element's range: past it the element has bottomed out and the
+    grating reads no more), its own thermal shift, and the interrogator's noise."""
+
+    def __init__(self, tip: TipGratingConfig, fidelity: FidelityConfig) -> None:
+        self._base = tip.base_wavelength
+        self._sensitivity = tip.sensitivity
+        self._range = tip.range
+        self._thermal = tip.temperature_coefficient
+        self._noise = fidelity.fbg_noise_pm * 1e-12
+
+    @classmethod
+    def of(cls, tip: TipGratingConfig | None, fidelity: FidelityConfig) -> TipReadout | None:
+        """The readout of a sensor's tip grating, None for a sensor without one."""
+        return None if tip is None else cls(tip, fidelity)
+
+    def read(self, load: float, drift: float, rng: np.random.Generator) -> float:
+        """The peak (m) at an axial tip load ``load`` (N) and a temperature change ``drift``
+        (deg C); the noise is drawn from ``rng`` after the gratings' own."""
+        wl = self._base + self._sensitivity * min(load, self._range) + self._thermal * drift
+        if self._noise > 0:
+            wl += float(rng.normal(0.0, self._noise))
+        return wl
+
+
+def grating_ends(centres: tuple[float, ...], grating_length: float) -> NDArray[np.float64]:
+    """(n, 2) distances from the tip (m) of each grating's two ends."""
+    half = 0.5 * grating_length
+    ends: NDArray[np.float64] = np.asarray(centres)[:, None] + np.array([-half, half])
+    return ends

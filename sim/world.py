@@ -40,7 +40,7 @@ from sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_
 from sim.equilibrium import ContactEffects, TissueLaw
 from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
 from sim.oblique import ObliqueContact
-from sim.readout import GratingReadout
+from sim.readout import GratingReadout, TipReadout, grating_ends
 from sim.viscoelastic import Relaxation
 from wire.frame import Status
 
@@ -157,9 +157,10 @@ class World:
         self.joints = joints
         self.rng = rng
         self.has_force = has_force
-        self.effects, self.contact_offset = _contact_effects(fidelity, rng)
+        self.effects, self.contact_offset = _contact_effects(fidelity, rng, sensor)
         self._centres = tuple(sensor.grating_centres_from_tip())
         self.readout = GratingReadout(sensor, fbg, fidelity)
+        self.tip_readout = TipReadout.of(sensor.tip_grating, fidelity)
         self._tip_radius = sensor.tip_radius
         self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
@@ -167,8 +168,7 @@ class World:
         self.friction = friction
         self.poisson = poisson
         self.weight = weight
-        # each grating's ends, from the tip (m): where gravity's sag is averaged
-        self._from_tip = _grating_ends(self._centres, sensor.grating_length)
+        self._from_tip = grating_ends(self._centres, sensor.grating_length)  # gravity's sag
         self._tables: dict[float, ContactTable] = {}
         self.relaxation = relaxation
         self._histories: dict[float, ViscoelasticContact] = {}
@@ -368,31 +368,32 @@ class World:
         if self.has_force:
             force = st.P
             flags |= _FORCE_FLAG
+        tip = None
+        if self.tip_readout is not None:
+            tip = self.tip_readout.read(st.P, drift, self.rng)
         return BoardSample(
             wavelengths=wavelengths,
             encoder=st.encoder,
             reference=reference,
             force=force,
             flags=flags,
+            tip=tip,
         )
 
 
 def _contact_effects(
-    fidelity: FidelityConfig, rng: np.random.Generator
+    fidelity: FidelityConfig, rng: np.random.Generator, sensor: SensorConfig
 ) -> tuple[ContactEffects, float]:
-    """What the scene's fidelity adds at the contact (a compliant tube tip, the beam's bow) and
-    this trial's contact-event error (m, drawn once)."""
+    """What the scene and the sensor add at the contact (a compliant tube tip and a tip grating's
+    element in series, the beam's bow) and this trial's contact-event error (m, drawn once)."""
     k_tube = fidelity.tube_tip_stiffness_n_per_mm
+    stiffness = None if k_tube is None else k_tube * 1e3
+    tip = sensor.tip_grating
+    if tip is not None and tip.compliance > 0:  # in series with the tube
+        stiffness = 1.0 / (tip.compliance + (0.0 if stiffness is None else 1.0 / stiffness))
     effects = ContactEffects(
-        tube_stiffness=None if k_tube is None else k_tube * 1e3,
+        tube_stiffness=stiffness,
         imperfection=fidelity.imperfection_w0_over_l,
     )
     sd = fidelity.contact_uncertainty_mm * 1e-3
     return effects, float(rng.normal(0.0, sd)) if sd > 0 else 0.0
-
-
-def _grating_ends(centres: tuple[float, ...], grating_length: float) -> Vector:
-    """(n, 2) distances from the tip (m) of each grating's two ends."""
-    half = 0.5 * grating_length
-    ends: Vector = np.asarray(centres)[:, None] + np.array([-half, half])
-    return ends

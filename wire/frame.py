@@ -12,8 +12,8 @@ Layout (little-endian, ``N`` peaks, optional reference and force fields)::
     0    2     sync           u8[2]  0xA5 0x5A
     2    1     version        u8     1
     3    1     n_peaks        u8     N, 1..32
-    4    1     options        u8     bit0 reference present, bit1 force present
-    5    1     length         u8     payload bytes = 18 + 4 N (+4 reference) (+4 force)
+    4    1     options        u8     bit0 reference, bit1 force, bit2 tip grating present
+    5    1     length         u8     payload bytes = 18 + 4 N (+4 reference) (+4 force) (+4 tip)
     6    4     seq            u32    sample counter, +1 per sample, wraps at 2**32
     10   8     timestamp_us   u64    board time of the sample, microseconds
     18   4     encoder        i32    stage encoder count
@@ -21,6 +21,7 @@ Layout (little-endian, ``N`` peaks, optional reference and force fields)::
     24   4N    peak_fm        u32[N] peak (Bragg) wavelengths, femtometres
     ..   4     reference_fm   u32    strain-free reference grating, femtometres (optional)
     ..   4     force_un       i32    force reading, micronewtons (optional)
+    ..   4     tip_fm         u32    tip force grating, femtometres (optional, revision 1.1)
     ..   4     crc            u32    CRC-32/ISO-HDLC (zlib.crc32) of every preceding byte
 
 Raw fields keep their wire units in their names (``peak_fm``, ``force_un``); the properties
@@ -50,6 +51,11 @@ CRC_SIZE = 4
 MAX_PEAKS = 32
 OPTION_REFERENCE = 0x01
 OPTION_FORCE = 0x02
+OPTION_TIP = 0x04
+"""Revision 1.1: a tip force grating's peak follows every other field. A frame without the bit is
+byte for byte a revision 1.0 frame; a 1.0 receiver rejects a frame with it (a bad header),
+never misreads it."""
+OPTIONS = OPTION_REFERENCE | OPTION_FORCE | OPTION_TIP
 
 FM = 1e-15
 """One femtometre in metres (wavelength unit on the wire)."""
@@ -96,7 +102,7 @@ HEADER: tuple[FieldSpec, ...] = (
     FieldSpec("sync1", "B", doc="0x5A"),
     FieldSpec("version", "B", doc="protocol version, 1"),
     FieldSpec("n_peaks", "B", doc="number of peak wavelengths N, 1..32"),
-    FieldSpec("options", "B", doc="bit0: reference present, bit1: force present, others 0"),
+    FieldSpec("options", "B", doc="bit0: reference, bit1: force, bit2: tip grating; others 0"),
     FieldSpec("length", "B", doc="payload bytes between the header and the CRC"),
 )
 FIXED_PAYLOAD: tuple[FieldSpec, ...] = (
@@ -107,6 +113,7 @@ FIXED_PAYLOAD: tuple[FieldSpec, ...] = (
 )
 REFERENCE_FIELD = FieldSpec("reference_fm", "I", unit="fm", doc="strain-free reference grating")
 FORCE_FIELD = FieldSpec("force_un", "i", unit="uN", doc="force reading")
+TIP_FIELD = FieldSpec("tip_fm", "I", unit="fm", doc="tip force grating (revision 1.1)")
 CRC_FIELD = FieldSpec("crc", "I", doc="CRC-32/ISO-HDLC of all preceding bytes")
 
 U32_MAX = 2**32 - 1
@@ -131,6 +138,7 @@ class FrameLayout:
     n_peaks: int
     has_reference: bool = False
     has_force: bool = False
+    has_tip: bool = False
 
     def __post_init__(self) -> None:
         if not 1 <= self.n_peaks <= MAX_PEAKS:
@@ -138,15 +146,21 @@ class FrameLayout:
 
     @property
     def options(self) -> int:
-        return (OPTION_REFERENCE if self.has_reference else 0) | (
-            OPTION_FORCE if self.has_force else 0
+        return (
+            (OPTION_REFERENCE if self.has_reference else 0)
+            | (OPTION_FORCE if self.has_force else 0)
+            | (OPTION_TIP if self.has_tip else 0)
         )
 
     @cached_property
     def fields(self) -> tuple[FieldSpec, ...]:
         """Every field in wire order, header to CRC."""
         peaks = FieldSpec("peak_fm", "I", self.n_peaks, "fm", "peak wavelengths")
-        optional = (REFERENCE_FIELD,) * self.has_reference + (FORCE_FIELD,) * self.has_force
+        optional = (
+            (REFERENCE_FIELD,) * self.has_reference
+            + (FORCE_FIELD,) * self.has_force
+            + (TIP_FIELD,) * self.has_tip
+        )
         return (*HEADER, *FIXED_PAYLOAD, peaks, *optional, CRC_FIELD)
 
     @property
@@ -178,11 +192,13 @@ class FrameLayout:
 
 
 @lru_cache(maxsize=256)
-def layout_of(n_peaks: int, has_reference: bool = False, has_force: bool = False) -> FrameLayout:
+def layout_of(
+    n_peaks: int, has_reference: bool = False, has_force: bool = False, has_tip: bool = False
+) -> FrameLayout:
     """The shared :class:`FrameLayout` instance for these fields, so its cached ``struct`` and
     ``dtype`` are built once per layout rather than once per frame (a frame's ``layout`` is
     asked for on every encode and decode)."""
-    return FrameLayout(n_peaks, has_reference, has_force)
+    return FrameLayout(n_peaks, has_reference, has_force, has_tip)
 
 
 def parse_header(header: bytes) -> FrameLayout:
@@ -192,9 +208,14 @@ def parse_header(header: bytes) -> FrameLayout:
     if header[:3] != MARKER:
         raise FrameError("sync", f"expected {MARKER.hex()}, got {header[:3].hex()}")
     n, options, length = header[3], header[4], header[5]
-    if not 1 <= n <= MAX_PEAKS or options & ~(OPTION_REFERENCE | OPTION_FORCE):
+    if not 1 <= n <= MAX_PEAKS or options & ~OPTIONS:
         raise FrameError("header", f"n_peaks {n} or options {options:#04x} out of range")
-    layout = layout_of(n, bool(options & OPTION_REFERENCE), bool(options & OPTION_FORCE))
+    layout = layout_of(
+        n,
+        bool(options & OPTION_REFERENCE),
+        bool(options & OPTION_FORCE),
+        bool(options & OPTION_TIP),
+    )
     if length != layout.payload_size:
         raise FrameError("header", f"length {length} impossible for {layout}")
     return layout
@@ -210,11 +231,15 @@ class Frame(NamedTuple):
     peak_fm: tuple[int, ...]
     reference_fm: int | None = None
     force_un: int | None = None
+    tip_fm: int | None = None
 
     @property
     def layout(self) -> FrameLayout:
         return layout_of(
-            len(self.peak_fm), self.reference_fm is not None, self.force_un is not None
+            len(self.peak_fm),
+            self.reference_fm is not None,
+            self.force_un is not None,
+            self.tip_fm is not None,
         )
 
     @property
@@ -236,6 +261,11 @@ class Frame(NamedTuple):
     def force(self) -> float | None:
         """Force in N, or None."""
         return None if self.force_un is None else self.force_un * UN
+
+    @property
+    def tip(self) -> float | None:
+        """Tip force grating's wavelength in m, or None."""
+        return None if self.tip_fm is None else self.tip_fm * FM
 
     @property
     def status(self) -> Status:
@@ -267,6 +297,7 @@ def frame_from_si(
     reference: float | None = None,
     force: float | None = None,
     flags: int = 0,
+    tip: float | None = None,
 ) -> Frame:
     """Build a frame from SI values (time in s, wavelengths in m, force in N)."""
     return Frame(
@@ -277,6 +308,7 @@ def frame_from_si(
         peak_fm=tuple(to_fm(float(w)) for w in wavelengths),
         reference_fm=None if reference is None else to_fm(reference),
         force_un=None if force is None else to_un(force),
+        tip_fm=None if tip is None else to_fm(tip),
     )
 
 
@@ -289,6 +321,7 @@ def check_ranges(frame: Frame) -> None:
         ("flags", frame.flags, 0, 0xFFFF),
         ("reference_fm", frame.reference_fm or 0, 0, U32_MAX),
         ("force_un", frame.force_un or 0, I32_MIN, I32_MAX),
+        ("tip_fm", frame.tip_fm or 0, 0, U32_MAX),
         *(("peak_fm", p, 0, U32_MAX) for p in frame.peak_fm),
     )
     for name, value, lo, hi in checks:
@@ -300,7 +333,11 @@ def encode(frame: Frame) -> bytes:
     """The bytes of one frame, CRC included; ValueError if a field does not fit its type."""
     layout = frame.layout
     check_ranges(frame)
-    optional = (frame.reference_fm,) * layout.has_reference + (frame.force_un,) * layout.has_force
+    optional = (
+        (frame.reference_fm,) * layout.has_reference
+        + (frame.force_un,) * layout.has_force
+        + (frame.tip_fm,) * layout.has_tip
+    )
     body = layout.struct.pack(
         *layout.header,
         frame.seq,
@@ -320,7 +357,8 @@ def unpack(layout: FrameLayout, values: tuple[int, ...]) -> Frame:
     end = 10 + n
     ref = values[end] if layout.has_reference else None
     force = values[end + layout.has_reference] if layout.has_force else None
-    return Frame(values[6], values[7], values[8], values[9], values[10:end], ref, force)
+    tip = values[end + layout.has_reference + layout.has_force] if layout.has_tip else None
+    return Frame(values[6], values[7], values[8], values[9], values[10:end], ref, force, tip)
 
 
 def decode(data: bytes | bytearray | memoryview, layout: FrameLayout | None = None) -> Frame:

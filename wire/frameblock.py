@@ -33,6 +33,7 @@ class FrameBlock:
     peak_fm: NDArray[np.uint32]
     reference_fm: NDArray[np.uint32] | None = None
     force_un: NDArray[np.int32] | None = None
+    tip_fm: NDArray[np.uint32] | None = None
     offset: NDArray[np.int64] | None = None
 
     def __len__(self) -> int:
@@ -41,7 +42,10 @@ class FrameBlock:
     @property
     def layout(self) -> FrameLayout:
         return layout_of(
-            int(self.peak_fm.shape[1]), self.reference_fm is not None, self.force_un is not None
+            int(self.peak_fm.shape[1]),
+            self.reference_fm is not None,
+            self.force_un is not None,
+            self.tip_fm is not None,
         )
 
     @property
@@ -72,6 +76,7 @@ class FrameBlock:
             tuple(int(p) for p in self.peak_fm[i]),
             None if self.reference_fm is None else int(self.reference_fm[i]),
             None if self.force_un is None else int(self.force_un[i]),
+            None if self.tip_fm is None else int(self.tip_fm[i]),
         )
 
 
@@ -153,6 +158,7 @@ def decode_block(
         peak_fm=rec["peak_fm"].astype(np.uint32).reshape(good.size, layout.n_peaks),
         reference_fm=rec["reference_fm"].astype(np.uint32) if layout.has_reference else None,
         force_un=rec["force_un"].astype(np.int32) if layout.has_force else None,
+        tip_fm=rec["tip_fm"].astype(np.uint32) if layout.has_tip else None,
         offset=good,
     )
     stats = BlockStats(
@@ -197,6 +203,8 @@ def encode_block(block: FrameBlock) -> bytes:
         rec["reference_fm"] = block.reference_fm
     if block.force_un is not None:
         rec["force_un"] = block.force_un
+    if block.tip_fm is not None:
+        rec["tip_fm"] = block.tip_fm
     rows = rec.view(np.uint8).reshape(n, layout.size)
     rec["crc"] = crc32_rows(rows[:, : layout.size - CRC_SIZE])
     return rec.tobytes()

@@ -19,8 +19,9 @@ import numpy as np
 
 from config.sample import SampleConfig
 from config.scene import SceneConfig
-from config.schema import StackConfig
+from config.schema import StackConfig, TipGratingConfig
 from estimation.design import DesignEvaluation
+from estimation.design.tipgrating import TipGratingChoice
 from palpate.campaigns.campaign import median_abs_relative_error, run_campaign
 from palpate.campaigns.executors import open_executor
 from palpate.simulation.trial import TrialOutcome, TrialSpec
@@ -99,6 +100,47 @@ def design_scene(
         base, name="design", samples=_phantoms(ev, settings), fidelity=fidelity, campaign=campaign
     )
     return scene, dataclasses.replace(stack, sensor=sensor)
+
+
+SILICA_DENSITY = 2200.0  # kg/m^3, the fiber
+NITI_DENSITY = 6450.0  # kg/m^3, the wires
+REFERENCE_WAVELENGTH_NM = (
+    1525.0  # the strain-free reference grating a tip grating's compensation uses
+)
+
+
+def designed_stack(
+    stack: StackConfig,
+    modulus_range: tuple[float, float],
+    tip: TipGratingChoice | None,
+) -> StackConfig:
+    """The robot configuration with the designed sensor (``stack``'s, from :func:`design_scene`):
+    its designed range (Pa) stated, and with ``tip`` a tip grating, temperature-compensated by a
+    strain-free reference grating the board sends."""
+    s = stack.sensor
+    sensor = dataclasses.replace(
+        s,
+        designed_range_kpa=(modulus_range[0] / 1e3, modulus_range[1] / 1e3),
+        linear_mass_g_per_m=1e3
+        * math.pi
+        * (SILICA_DENSITY * s.fiber_radius**2 + NITI_DENSITY * s.wire_count * s.wire_radius**2),
+    )
+    if tip is None:
+        return dataclasses.replace(stack, sensor=sensor)
+    grating = TipGratingConfig(
+        sensitivity_pm_per_mn=tip.sensitivity_pm_per_mn,
+        range_mn=tip.range_mn,
+        compliance_mm_per_n=tip.compliance_mm_per_n,
+    )
+    fbg = stack.fbg
+    if fbg.reference_wavelength_nm is None:
+        fbg = dataclasses.replace(fbg, reference_wavelength_nm=REFERENCE_WAVELENGTH_NM)
+    return dataclasses.replace(
+        stack,
+        sensor=dataclasses.replace(sensor, tip_grating=grating),
+        fbg=fbg,
+        board=dataclasses.replace(stack.board, has_reference=True),
+    )
 
 
 def _phantoms(ev: DesignEvaluation, settings: CheckSettings) -> tuple[SampleConfig, ...]:

@@ -4,6 +4,8 @@ One command, by what it is given:
 
 - a CSV with ``strain_ue`` and ``shift_pm`` columns: k'_eps from paired known strains and
   measured shifts (``sensor/calibration.py``), as the paper's Fig. 1d;
+- a CSV with ``force_mn`` and ``shift_pm`` columns, or a frame stream with ``--tip``: the tip
+  force grating's sensitivity against a force scale (``sensor/tipcal.py``);
 - a recorded stream of raw board frames (any other file, e.g. ``cat /dev/ttyACM0 > frames.bin``
   while the sensor buckles on a rigid reference on the bench-top stage): k'_eps against the
   elastica's strains (``sensor/framecal.py``; ``--exposed-length-mm``, ``--config``);
@@ -26,8 +28,14 @@ from estimation.compliance import ComplianceFit
 from palpate.calibration import calibrate, config_lines, rig_key
 from palpate.reports.replay import replay
 from robot.trial.log import read_log
-from sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
+from sensor.calibration import (
+    CalibrationFit,
+    csv_columns,
+    fit_strain_coefficient,
+    load_pairs_csv,
+)
 from sensor.framecal import calibrate_frames, read_frames
+from sensor.tipcal import fit_tip_csv, fit_tip_frames, is_tip_csv
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -54,6 +62,11 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--rest-frames", type=int, default=20, help="frames: the first N are at rest (zero)"
     )
+    parser.add_argument(
+        "--tip",
+        action="store_true",
+        help="frames: calibrate the tip force grating against the board's force scale reading",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -63,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
     if len(files) != 1:
         raise ValueError("give one CSV or one frame stream, or trial logs (.jsonl) only")
     path = files[0]
+    if args.tip or is_tip_csv(path, csv_columns(path)):
+        return _tip(path, args)
     if path.suffix.lower() == ".csv":
         strain, shift = load_pairs_csv(path)
         try:
@@ -98,6 +113,29 @@ def _print_fit(path: Path, fit: CalibrationFit, args: argparse.Namespace) -> Non
     print(f"  R^2        = {fit.r_squared:.5f}")
     print(f"  residual   = {fit.residual_std * 1e12:.3f} pm (std)")
     print(f"  config: fbg.strain_coefficient_pm_per_ue: {fit.k_pm_per_ue:.4f}")
+
+
+def _tip(path: Path, args: argparse.Namespace) -> int:
+    """The tip grating's sensitivity from a force_mn/shift_pm CSV or a frame stream."""
+    if path.suffix.lower() == ".csv":
+        fit = fit_tip_csv(path, confidence=args.confidence)
+    else:
+        stack = load_stack(args.config)
+        block = read_frames(path, stack)
+        fit = fit_tip_frames(block, stack, rest_frames=args.rest_frames, confidence=args.confidence)
+    if getattr(args, "json", False):
+        print(json.dumps({"file": str(path), **fit.as_dict()}, indent=2))
+        return 0
+    lo, hi = fit.ci_pm_per_mn
+    pct = round(100 * fit.line.confidence)
+    print(f"tip grating calibration of {path} ({fit.line.n} points)")
+    print(
+        f"  sensitivity = {fit.sensitivity_pm_per_mn:.4f} pm/mN  ({pct}% CI {lo:.4f} .. {hi:.4f})"
+    )
+    print(f"  R^2         = {fit.line.r_squared:.5f}")
+    print(f"  residual    = {fit.line.residual_std * 1e12:.3f} pm (std)")
+    print(f"  config: {fit.config_line()}")
+    return 0
 
 
 def _compliance(files: list[Path], args: argparse.Namespace) -> int:

@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 
 from config import load, load_stack, resolve
+from config.loader import write_yaml
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from estimation.design import (
@@ -22,12 +23,14 @@ from estimation.design import (
     DesignSpace,
     design_sensor,
 )
+from estimation.design.tipgrating import TipGratingChoice, choose_tip_grating
 from palpate.argtypes import non_negative_int, positive_int
 from palpate.campaigns.campaign import campaign_trials, default_workers
 from palpate.campaigns.designcheck import (
     UNITS,
     CheckSettings,
     design_scene,
+    designed_stack,
     run_check,
 )
 from palpate.campaigns.executors import add_executor_arguments
@@ -138,6 +141,19 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     )
     add_executor_arguments(parser)
     parser.add_argument("--no-sim", action="store_true", help="skip the simulated campaign")
+    parser.add_argument(
+        "--tip-grating",
+        action="store_true",
+        help="give the sensor a tip force grating (its sensitivity and range chosen against the "
+        "noise) and check the design with it",
+    )
+    parser.add_argument(
+        "--write",
+        type=Path,
+        metavar="YAML",
+        help="write the robot configuration with the designed sensor here (what `palpate sim`, "
+        "`emulate`, `trial` and `teleop` read: a scene's `robot:`, `--config`)",
+    )
 
 
 def _inputs(
@@ -211,6 +227,29 @@ def _run_sim(
     return outcomes, wall
 
 
+def _written_note(args: argparse.Namespace) -> str:
+    tip = " --tip-grating" if args.tip_grating else ""
+    return (
+        f"Written by `palpate design --modulus-range {args.modulus_range} --unit {args.unit}"
+        f"{tip}`:\nthe robot configuration ({args.config}) with the designed sensor."
+    )
+
+
+def _tip_payload(tip: TipGratingChoice | None) -> dict[str, object]:
+    return {} if tip is None else {"tip_grating": tip.as_dict()}
+
+
+def _print_tip(tip: TipGratingChoice | None, written: Path | None) -> None:
+    if tip is not None:
+        print(
+            f"\ntip grating: {tip.sensitivity_pm_per_mn:g} pm/mN, range {tip.range_mn:.3g} mN, "
+            f"element {tip.compliance_mm_per_n:.3g} mm/N, resolution {tip.resolution_mn:.3g} mN "
+            f"({tip.resolution_share:.2%} of P_cr at 1 sigma)"
+        )
+    if written is not None:
+        print(f"wrote {written}")
+
+
 def run(args: argparse.Namespace) -> int:
     stack = load_stack(args.config)
     scene_path = args.scene if args.scene else resolve("scenes/bench.yaml")
@@ -223,18 +262,27 @@ def run(args: argparse.Namespace) -> int:
     result = design_sensor(modulus_range, constraints, space)
     outcomes: list[TrialOutcome] = []
     wall = 0.0
-    if result.success and not args.no_sim:
+    tip: TipGratingChoice | None = None
+    if result.success:
         assert result.evaluation is not None
         assert result.length_window is not None
         scene, sim_stack = design_scene(
             result.evaluation, result.length_window, stack, base, _settings(args)
         )
-        outcomes, wall = _run_sim(scene, sim_stack, args)
+        if args.tip_grating:
+            noise = base.fidelity.fbg_noise_pm
+            tip = choose_tip_grating(result.evaluation.critical_load, max(noise, 1e-3))
+        sim_stack = designed_stack(sim_stack, modulus_range, tip)
+        if args.write is not None:
+            write_yaml(sim_stack, args.write, _written_note(args))
+        if not args.no_sim:
+            outcomes, wall = _run_sim(scene, sim_stack, args)
     run = CheckRun(outcomes, wall, args.unit, args.executor)
     if args.json:
-        print(json.dumps(payload(result, constraints, run), indent=2))
+        print(json.dumps({**payload(result, constraints, run), **_tip_payload(tip)}, indent=2))
     else:
         print_report(result, constraints, run)
+        _print_tip(tip, args.write)
     if not result.success:
         return EXIT_NO_DESIGN
     if any(o.state != "done" for o in outcomes):  # a trial of the check faulted

@@ -36,7 +36,6 @@ from robot.rig import ServoFbgRig
 from robot.teleop import Teleop
 from robot.trial.setup import detector_for, guards_for, rig_settings
 from sensor.clock import Clock, SystemClock
-from sensor.strain import StrainChain
 
 DRAW_PERIOD_S = 0.05
 
@@ -184,7 +183,7 @@ def _session(
 ) -> Session:
     tick = 1.0 / args.rate
     settings = rig_settings(campaign, stack, tick)
-    rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
+    rig = ServoFbgRig.for_stack(drive, reader, stack, clock, settings)
     chain = rig.zero()  # the sensor must be free now, as before a trial
     model = Teleop(
         stack.drive,

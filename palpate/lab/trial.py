@@ -47,7 +47,6 @@ from robot.trial.setup import (
     rig_settings,
     sensor_section,
 )
-from sensor.strain import StrainChain
 
 __all__ = ["SKIPPED", "BenchOutcome", "BenchTrial", "plan_bench_trials", "run_bench_trials"]
 
@@ -202,6 +201,7 @@ def bench_inputs(trial: BenchTrial, loaded: LoadedBench, stack: StackConfig) -> 
         compliance_calibrated=calibrated,
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
         travel_window=c.max_travel_past_contact_mm * MM,
+        designed_range=stack.sensor.designed_range,
         rigid=trial.rigid,
         **belief,
     )
@@ -227,7 +227,7 @@ def _run_one(
     settings = rig_settings(
         c, stack, tick, sync_to_clock=sync_to_clock, exposed_length=trial.exposed_length
     )
-    rig = ServoFbgRig(hw.drive, hw.reader, StrainChain.from_config(stack.fbg), hw.clock, settings)
+    rig = ServoFbgRig.for_stack(hw.drive, hw.reader, stack, hw.clock, settings)
     chain = rig.zero()
     section = sensor_section(stack)
     inputs = bench_inputs(trial, loaded, stack)

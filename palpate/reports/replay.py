@@ -26,6 +26,8 @@ from robot.trial.estimate import (
     estimate_from_marks,
     exposed_length_at,
     fit_rows,
+    tip_bow,
+    tip_load_at_buckling,
     verdict_for,
 )
 from robot.trial.inputs import VERSION, probe_inputs
@@ -138,13 +140,24 @@ def _replay_joint(
     inputs = EstimatorInputs.from_dict(raw)
     samples = list(log.of_kind("sample"))
     rows = [(r["state"], r["advance"], r["strains"]) for r in samples]
-    fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples])
+    tips = [r.get("tip_force") for r in samples]
+    fitted = fit_rows(
+        rows, inputs, stack, section, [r["t"] for r in samples], tips if any(tips) else None
+    )
     end = log.end or {}
     verdict, relaxed = None, None
     if not inputs.rigid:
         state, reason = str(end.get("state")), str(end.get("reason"))
         verdict, relaxed = verdict_for(
-            fitted.joint, inputs, state, reason, section, fitted.lean, fitted.relaxation
+            fitted.joint,
+            inputs,
+            state,
+            reason,
+            section,
+            fitted.lean,
+            fitted.relaxation,
+            tip_load_at_buckling(rows, tips if any(tips) else None),
+            tip_bow(fitted.southwell, tips if any(tips) else None),
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

@@ -19,7 +19,14 @@ from palpate.simulation.world import TrialSpec, trial_geometry
 def check_campaign(
     scene: SceneConfig, stack: StackConfig, scene_source: str, robot_source: str
 ) -> None:
-    """Raise ConfigError if the scene's campaign names a tube the robot configuration lacks."""
+    """Raise ConfigError if the scene's campaign names a tube the robot configuration lacks, or
+    reads the contact from a tip grating the sensor does not have."""
+    if scene.campaign.contact == "tip" and stack.sensor.tip_grating is None:
+        raise ConfigError(
+            scene_source,
+            "campaign.contact",
+            f"'tip' needs a tip force grating: {robot_source} has no sensor.tip_grating",
+        )
     known = [t.name for t in stack.tubes]
     if scene.campaign.kind != "robot":
         return

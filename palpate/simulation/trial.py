@@ -50,7 +50,6 @@ from robot.trial.setup import (
 )
 from sensor.parser import layout_from_config
 from sensor.reader import FrameReader
-from sensor.strain import StrainChain
 from sim.board import BoardEmulator, BoardFaults
 from sim.clock import VirtualClock
 from sim.dynamixel.bus import EmulatedBus
@@ -190,7 +189,7 @@ def run_sim_trial(
         settings = dataclasses.replace(settings, sent_bytes=lambda: board.stats.bytes_sent)
         with DriveController(driver, stack.drive) as drive, reader:
             board.start()
-            rig = ServoFbgRig(drive, reader, StrainChain.from_config(stack.fbg), clock, settings)
+            rig = ServoFbgRig.for_stack(drive, reader, stack, clock, settings)
             chain = rig.zero()
             with _trial_log(log_dir, spec, scene, stack, plan, geo, hook) as log:
                 guards = guards_for(c, stack, rig.tick)

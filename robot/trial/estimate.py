@@ -25,6 +25,7 @@ the same inputs and reproduces the fit bit for bit.
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -52,6 +53,7 @@ from robot.trial.relaxed import relaxation_of
 from robot.trial.run import TrialResult
 from robot.trial.states import LOADING_STATES, record_lengths, states_at
 from sensor.strain import grating_intervals
+from sensor.tipforce import force_sigma
 
 __all__ = [
     "EstimatorInputs",
@@ -63,6 +65,8 @@ __all__ = [
     "fit_record",
     "fit_rows",
     "loading_rows",
+    "tip_bow",
+    "tip_load_at_buckling",
     "verdict_for",
 ]
 
@@ -94,9 +98,12 @@ def fit_record(
     inputs: EstimatorInputs,
     sensor: SensorConfig,
     section: Section,
+    tip_forces: FloatArray | None = None,
 ) -> RecordEstimate:
     """The joint fit of one trial's loading record (see the module docstring), and the beam's
-    bow from its pre-buckling part (``estimation.southwell``)."""
+    bow from its pre-buckling part (``estimation.southwell``). With ``tip_forces`` (N, one per
+    row, from a tip force grating) the fit reads the load from them instead of the beam's axial
+    strain, with their noise measured on the record (``sensor.tipforce.force_sigma``)."""
     n = strains.shape[0]
     if n < MIN_POINTS:
         msg = f"too few points: {n} loading samples, the fit needs {MIN_POINTS}"
@@ -107,19 +114,23 @@ def fit_record(
     states, k = states_at(strains, lengths, sensor, section)
     if inputs.rigid:
         return RecordEstimate(None, calibration=fit_compliance(advance, states.P, states.e))
-    guess = baseline_deviation(advance, states.P, baseline_points=min(30, n // 4))
+    force, sigma_force = states.P, k * states.sigma_P
+    if tip_forces is not None:
+        force, sigma_force = tip_forces, np.full(n, force_sigma(tip_forces))
+    guess = baseline_deviation(advance, force, baseline_points=min(30, n // 4))
     joint = joint_fit(
         advance,
-        states.P,
+        force,
         states.e,
         inputs.belief(),
-        sigma_force=k * states.sigma_P,
+        sigma_force=sigma_force,
         sigma_shortening=k * states.sigma_e,
         encoder_resolution=inputs.encoder_resolution,
         contact_guess=guess.position if guess.success else None,
         misalignment=inputs.misalignment,
     )
-    return RecordEstimate(joint, _bow(states, lengths, section))
+    # the bow against the load the fit read: the tip grating's, independent of the strains
+    return RecordEstimate(joint, _bow(force, states, lengths, section))
 
 
 def critical_load(section: Section, length: float) -> float:
@@ -127,12 +138,15 @@ def critical_load(section: Section, length: float) -> float:
     return float(P_CRIT * section.EI / length**2)
 
 
-def _bow(states: BeamStates, lengths: FloatArray, section: Section) -> SouthwellFit:
-    """The Southwell fit at the exposed length of the record's largest load."""
-    length = float(lengths[int(np.argmax(states.P))])
+def _bow(
+    load: FloatArray, states: BeamStates, lengths: FloatArray, section: Section
+) -> SouthwellFit:
+    """The Southwell fit of ``load`` (the strains' or a tip grating's, N) against the bending
+    amplitude, at the exposed length of the record's largest load."""
+    length = float(lengths[int(np.argmax(load))])
     if length <= 0:
         return SouthwellFit(False, "no exposed length at the largest load")
-    return southwell(states.P, states.z, length, critical_load(section, length))
+    return southwell(load, states.z, length, critical_load(section, length))
 
 
 def fit_rows(
@@ -141,13 +155,17 @@ def fit_rows(
     stack: StackConfig,
     section: Section,
     times: Sequence[float] | None = None,
+    tip_forces: Sequence[float | None] | None = None,
 ) -> RecordEstimate:
     """The estimates from (state, advance, strains) rows: the trial's record or a log's samples;
     beside them the load's lean from the rows before buckling (``robot.trial.lean``) and, with
-    each row's time (s) and a hold in the rows, the relaxation (``robot.trial.relaxed``)."""
+    each row's time (s) and a hold in the rows, the relaxation (``robot.trial.relaxed``). With
+    each row's tip-grating load (N), the joint fit reads the load from it."""
     rows = list(rows)
-    advance, strains = loading_rows(rows, len(stack.sensor.used_gratings))
-    fitted = fit_record(advance, strains, inputs, stack.sensor, section)
+    gratings = len(stack.sensor.used_gratings)
+    advance, strains = loading_rows(rows, gratings)
+    tip = _loading_tip(rows, tip_forces, gratings)
+    fitted = fit_record(advance, strains, inputs, stack.sensor, section, tip)
     if inputs.rigid:
         return fitted
     lean = lean_of_rows(
@@ -164,6 +182,46 @@ def fit_rows(
     return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
 
 
+def tip_bow(
+    southwell: SouthwellFit | None, tip_forces: Sequence[float | None] | None
+) -> float | None:
+    """The bow w0/L of a record whose Southwell fit read the tip grating's load, else None."""
+    if not tip_forces or southwell is None or not southwell.success:
+        return None
+    return southwell.w0_over_l
+
+
+def tip_load_at_buckling(
+    rows: Sequence[tuple[str, float, Sequence[float]]],
+    tip_forces: Sequence[float | None] | None,
+) -> float | None:
+    """The tip grating's load (N) at the first row past the buckling mark, None without one."""
+    if not tip_forces or len(tip_forces) != len(rows):
+        return None
+    for (state, _, _), f in zip(rows, tip_forces, strict=True):
+        if state == "buckled":
+            return None if f is None or not math.isfinite(f) else float(f)
+    return None
+
+
+def _loading_tip(
+    rows: list[tuple[str, float, Sequence[float]]],
+    tip_forces: Sequence[float | None] | None,
+    gratings: int,
+) -> FloatArray | None:
+    """The tip loads (N) of the loading rows (as :func:`loading_rows` picks them); None without
+    a tip grating or where a loading row has no finite load."""
+    if not tip_forces or len(tip_forces) != len(rows):
+        return None
+    picked = [
+        math.nan if f is None else float(f)
+        for (state, _, strains), f in zip(rows, tip_forces, strict=True)
+        if state in LOADING_STATES and len(strains) == gratings
+    ]
+    tip = np.asarray(picked, dtype=np.float64)
+    return tip if tip.size and np.all(np.isfinite(tip)) else None
+
+
 def verdict_for(
     joint: JointFit | None,
     inputs: EstimatorInputs,
@@ -172,9 +230,13 @@ def verdict_for(
     section: Section,
     lean: Lean | None = None,
     relaxation: RelaxationFit | None = None,
+    buckling_tip_load: float | None = None,
+    bow: float | None = None,
 ) -> tuple[Verdict, Verdict | None]:
     """The trial's verdicts (``estimation.verdict``) from its fit, its inputs and how it ended:
-    on the elastic estimate, and on the relaxed modulus when the trial held (else None)."""
+    on the elastic estimate, and on the relaxed modulus when the trial held (else None).
+    ``buckling_tip_load``: the tip grating's load at the buckling mark (N), None without one;
+    ``bow``: w0/L fitted against the tip grating's load (:func:`tip_bow`)."""
     length = inputs.exposed_length
     if inputs.kind == "robot" and joint is not None and joint.contact is not None:
         length = joint.contact - inputs.flush_translation
@@ -190,6 +252,9 @@ def verdict_for(
         lean=lean,
         misalignment_sigma=inputs.misalignment_sigma,
         relaxation=relaxation,
+        designed_range=inputs.designed_range,
+        buckling_tip_load=buckling_tip_load,
+        bow=bow,
     )
     elastic = judge(joint, facts, inputs.tip_radius)
     return elastic, relaxed_verdict(relaxation, elastic, facts)
@@ -280,13 +345,21 @@ def estimate_trial(
     if inputs is None:
         return TrialEstimate(paper, length)
     start = time.perf_counter()
-    fitted = fit_rows(result.record, inputs, stack, section, result.times)
+    fitted = fit_rows(result.record, inputs, stack, section, result.times, result.tip_forces)
     seconds = time.perf_counter() - start
     verdict, relaxed = None, None
     if not inputs.rigid:
         state = result.state.value
         verdict, relaxed = verdict_for(
-            fitted.joint, inputs, state, result.reason, section, fitted.lean, fitted.relaxation
+            fitted.joint,
+            inputs,
+            state,
+            result.reason,
+            section,
+            fitted.lean,
+            fitted.relaxation,
+            tip_load_at_buckling(result.record, result.tip_forces),
+            tip_bow(fitted.southwell, result.tip_forces),
         )
     return TrialEstimate(
         paper,

@@ -48,6 +48,7 @@ class EstimatorInputs:
             straight tube): the misalignment told is then not known.
         misalignment_sigma: the measured normal's 1-sigma angle (rad), None when no normal was
             measured (no probing, or none found).
+        designed_range: the moduli (Pa) the sensor was designed for (None: not stated).
         rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
             (``estimation.compliance``) instead of estimating a modulus.
         version: the inputs' format (VERSION; 1 for logs that predate it).
@@ -72,6 +73,7 @@ class EstimatorInputs:
     rigid: bool = False
     orientation_verified: bool = True
     misalignment_sigma: float | None = None
+    designed_range: Range | None = None
     version: int = VERSION
 
     def as_dict(self) -> dict[str, Any]:

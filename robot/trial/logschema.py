@@ -193,6 +193,7 @@ ESTIMATOR = {  # robot.trial.estimate.EstimatorInputs
     "rigid": opt(boolean),
     "orientation_verified": opt(boolean),  # absent before issue 25: verified
     "misalignment_sigma": opt(number(null=True, ge=0, le=math.pi)),
+    "designed_range": opt(numbers(null=True)),  # absent before issue 28: not stated
     "version": opt(integer(ge=1)),
 }
 PROBE = {  # robot.probe_plan.ProbeResult: what probing found (robot trials that probe)
@@ -233,6 +234,7 @@ RECORDS: dict[str, dict[str, Field]] = {
         "strains": req(numbers(null_items=True)),
         "contact": req(boolean),
         "goal": opt(number(null=True)),
+        "tip_force": opt(number(null=True)),
     },
     "transition": {
         "t": req(number()),

@@ -70,6 +70,8 @@ class TrialResult:
     # whole-record estimators (``robot.trial.estimate``) read it without a log
     record: list[tuple[str, float, tuple[float, ...]]] = field(default_factory=list)
     times: list[float] = field(default_factory=list)  # each record row's time (s, the rig's clock)
+    # each row's tip-grating load (N; NaN where the rig had none), empty without a tip grating
+    tip_forces: list[float] = field(default_factory=list)
     probe: ProbeResult | None = None  # what probing found, when the trial probed
 
     @property
@@ -121,6 +123,8 @@ def run_trial(
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
             out.record.append((machine.state.value, obs.advance, tuple(obs.strains)))
             out.times.append(obs.t)
+            if obs.tip_force is not None or out.tip_forces:
+                _append_tip(out, obs.tip_force)
             if log is not None:
                 probe_logged = _write_tick(log, obs, machine, cmd, probe_logged)
             if on_tick is not None:
@@ -136,6 +140,13 @@ def run_trial(
     out.state, out.reason, out.marks = machine.state, machine.marks.reason, machine.marks
     out.ticks, out.duration, out.probe = ticks, clock.now() - t0, machine.probe
     return out
+
+
+def _append_tip(out: TrialResult, force: float | None) -> None:
+    """The row's tip load, the rows before the first one NaN (the list stays row-aligned)."""
+    if not out.tip_forces:
+        out.tip_forces.extend([math.nan] * (len(out.record) - 1))
+    out.tip_forces.append(math.nan if force is None else force)
 
 
 def _out_of_ticks(machine: IndentationMachine, t: float, ticks: int, max_ticks: int) -> bool:
@@ -193,7 +204,7 @@ def _crashed(
 
 
 def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, Any]:
-    return {
+    record = {
         "kind": "sample",
         "t": obs.t,
         "state": state.value,
@@ -203,6 +214,9 @@ def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, An
         "contact": obs.contact,
         "goal": cmd.advance,
     }
+    if obs.tip_force is not None:
+        record["tip_force"] = obs.tip_force
+    return record
 
 
 def _transition_record(tr: Transition) -> dict[str, Any]:

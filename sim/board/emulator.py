@@ -252,6 +252,7 @@ class BoardEmulator:
             reference=s.reference if self.layout.has_reference else None,
             force=s.force if self.layout.has_force else None,
             flags=flags,
+            tip=s.tip if self.layout.has_tip else None,
         )
         layout = frame.layout
         if layout is not self.layout and layout != self.layout:

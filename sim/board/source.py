@@ -20,6 +20,7 @@ class BoardSample(NamedTuple):
     reference: float | None = None
     force: float | None = None
     flags: int = 0
+    tip: float | None = None  # the tip force grating's peak (m), when the sensor has one
 
 
 SampleSource = Callable[[float], BoardSample]

@@ -45,9 +45,15 @@ for _h in (20e-3, 30e-3):
     SHIPPED[f"layers-deep-{_h * 1e3:g}mm"] = LayerProblem.from_dimensions(
         3.5e-3, _h, 40e-3, poisson=0.45, contact="frictionless"
     )
+for _h in (10e-3, 20e-3, 40e-3):
+    for _nu in (0.45, 0.49):
+        SHIPPED[f"lung-{_h * 1e3:g}mm-nu{_nu:g}"] = LayerProblem.from_dimensions(
+            10e-3, _h, 60e-3, poisson=_nu, material="neo-hookean", contact="stick"
+        )
 """The problems whose tables ship in ``sim/fem/tables``, by name: the paper's and the soft
-designs' phantoms, the half-space stand-in, and the thin and deep layers of
-``config/scenes/layers/`` (R = 3.5 mm, frictionless tip)."""
+designs' phantoms, the half-space stand-in, the thin and deep layers of
+``config/scenes/layers/`` (R = 3.5 mm, frictionless tip) and the lung scene's neo-Hookean layers
+(R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung.yaml``)."""
 
 
 def main(argv: list[str] | None = None) -> int:

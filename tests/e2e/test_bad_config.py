@@ -79,6 +79,16 @@ CASES = [
     ("tube that cannot reach", SCENE,
      ROBOT.replace("translation_max_mm: 80", "translation_max_mm: 30"), "scene",
      "campaign: trial S7-straight-downward-L42: target not reachable"),
+    # a tip grating (issue 28) that cannot work
+    ("tip grating of sensitivity 0", SCENE,
+     ROBOT.replace("sensor:\n", "sensor:\n  tip_grating: {sensitivity_pm_per_mn: 0}\n"),
+     "robot", "sensor.tip_grating.sensitivity_pm_per_mn: must be > 0"),
+    ("tip grating compensated without a reference grating", SCENE,
+     ROBOT.replace("sensor:\n", "sensor:\n  tip_grating: {temperature_compensation: reference}\n"),
+     "robot", "sensor.tip_grating.temperature_compensation: 'reference' needs a strain-free"),
+    ("contact from a tip grating the sensor lacks",
+     SCENE.replace("contact: event ", "contact: tip   "), None, "scene",
+     "campaign.contact: 'tip' needs a tip force grating"),
 ]  # fmt: skip
 
 

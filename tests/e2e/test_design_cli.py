@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -67,3 +68,21 @@ def test_bad_arguments_exit_2(
 ) -> None:
     assert main(["design", *argv]) == 2
     assert needle in capsys.readouterr().err
+
+
+def test_design_writes_a_robot_file_the_stack_reads(tmp_path: Path) -> None:
+    from config import load_stack
+
+    out = tmp_path / "lung.yaml"
+    code = main(
+        ["design", "--modulus-range", "1:20", "--unit", "kPa", "--tip-grating", "--no-sim",
+         "--write", str(out)]
+    )  # fmt: skip
+    assert code == 0
+    stack = load_stack(out)
+    assert stack.sensor.designed_range == (1e3, 20e3)
+    assert stack.sensor.tip_grating is not None
+    assert stack.sensor.tip_grating.sensitivity_pm_per_mn == 8.0
+    assert stack.board.has_reference
+    assert stack.fbg.reference_wavelength_nm is not None
+    assert stack.sensor.tip_radius_mm == 10.0

@@ -185,3 +185,17 @@ def test_bad_inputs_raise() -> None:
     short = SensorDesign(**{**PAPER.__dict__, "exposed_length": 20e-3})
     with pytest.raises(ValueError, match="gratings inside the tube"):
         evaluate_design(short, (1 * KPA, 10 * KPA))
+
+
+def test_the_tip_grating_is_the_most_sensitive_whose_range_carries_twice_p_cr() -> None:
+    from estimation.design.tipgrating import choose_tip_grating
+
+    lung = choose_tip_grating(18e-3, 1.0)  # the 1-20 kPa design: P_cr 18 mN, 1 pm of noise
+    assert lung.sensitivity_pm_per_mn == 8.0
+    assert lung.range_mn >= 2 * 18.0
+    assert lung.resolution_mn == pytest.approx(0.125)
+    assert lung.compliance_mm_per_n == pytest.approx(3e-3 * 8.0 / 1.2 * 1e-6 * 1e6)  # L s / k
+    stiff = choose_tip_grating(0.6, 1.0)  # 1.2 N in a 2 nm window: the coarsest element
+    assert stiff.sensitivity_pm_per_mn == 1.0
+    with pytest.raises(ValueError, match="carries"):
+        choose_tip_grating(1.35, 1.0)  # the paper's sensor: 2.7 N needs a stiffer element

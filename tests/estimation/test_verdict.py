@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from estimation.jointfit import JointFit
@@ -96,3 +97,38 @@ def test_an_interval_wider_than_ten_percent_either_side_is_not_ok() -> None:
     assert v.status == "suspect"
     assert "+12 %" in v.reasons[0]
     assert "+-10 %" in v.reasons[0]
+
+
+# -- a sensor that knows its range, and a tip grating's evidence (issue 28) -------------------
+LUNG = TrialFacts(travel_window=6e-3, critical_load=18e-3, designed_range=(1e3, 20e3))
+
+
+def test_an_estimate_outside_the_designed_range_has_no_number() -> None:
+    v = judge(fit(E=60e3), LUNG, 10e-3)
+    assert v.status == "none"
+    assert "outside the sensor's designed range" in v.reasons[0]
+    assert "1-20 kPa" in v.reasons[0]
+    below = judge(fit(E=0.5e3), LUNG, 10e-3)
+    assert below.status == "none"
+    assert "below" in below.reasons[0]
+
+
+def test_an_interval_that_reaches_into_the_range_keeps_its_number() -> None:
+    assert judge(fit(E=20.3e3), LUNG, 10e-3).status == "ok"  # 19.7-20.9 kPa reaches 20
+
+
+def test_buckling_marked_at_a_small_tip_load_is_suspect() -> None:
+    early = dataclasses.replace(LUNG, buckling_tip_load=0.7e-3)
+    v = judge(fit(E=15e3), early, 10e-3)
+    assert v.status == "suspect"
+    assert "buckling detected at a tip load of 0.7 mN, 4%" in v.reasons[0]
+    late = dataclasses.replace(LUNG, buckling_tip_load=17e-3)
+    assert judge(fit(E=15e3), late, 10e-3).status == "ok"
+
+
+def test_a_bow_measured_against_the_tip_load_beyond_one_percent_is_suspect() -> None:
+    bowed = judge(fit(E=15e3), dataclasses.replace(LUNG, bow=0.044), 10e-3)
+    assert bowed.status == "suspect"
+    assert "w0/L = 4.4%" in bowed.reasons[0]
+    straight = dataclasses.replace(LUNG, bow=5e-4)
+    assert judge(fit(E=15e3), straight, 10e-3).status == "ok"
