@@ -97,6 +97,15 @@ class CampaignConfig:
     detector: Literal["paper", "cusum"] = "paper"
     detector_threshold_ue: float = field(default=300.0, metadata=limits(gt=0, le=10000))
     outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))
+    # A diagnostic threshold (normal below, diseased above): `palpate sim` counts the trials with
+    # a number on its right side (null: no threshold)
+    classify_at_kpa: float | None = field(default=None, metadata=limits(gt=0))
+
+    @property
+    def classify_at(self) -> float | None:
+        """The diagnostic threshold in Pa, or None."""
+        return None if self.classify_at_kpa is None else self.classify_at_kpa * 1e3
+
     # Find the surface normal by light touches before indenting (robot.probing), then re-plan
     # the roll and advance orthogonal to it; null: on for robot campaigns, off on the vertical
     # bench stage. "measure": touch, fit and log the misalignment, but indent as planned.

@@ -59,9 +59,16 @@ def run(args: argparse.Namespace) -> int:
     stack = load_stack(args.config or "robot.yaml")
     wavelengths = [stack.fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in stack.sensor.used_gratings]
     layout = layout_from_config(stack.sensor, stack.board)
+    ref_nm, tip = stack.fbg.reference_wavelength_nm, stack.sensor.tip_grating
+    source = constant_source(
+        wavelengths,
+        reference=ref_nm * 1e-9 if layout.has_reference and ref_nm is not None else None,
+        force=0.0 if layout.has_force else None,
+        tip=None if tip is None else tip.base_wavelength,
+    )
     with (
         EmulatedBus.from_config(stack.servos) as bus,
-        BoardEmulator(constant_source(wavelengths), layout, rate_hz=stack.board.rate_hz) as board,
+        BoardEmulator(source, layout, rate_hz=stack.board.rate_hz) as board,
     ):
         ports = {"dynamixel": bus.port, "board": board.port}
         _announce(ports, stack.servos.baudrate, stack.board.rate_hz, args)

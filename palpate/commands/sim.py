@@ -310,7 +310,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         "speedup": sim_time / wall if wall > 0 else None,
         "figures": figures,
     }
-    payload.update(verdicts.verdict_payload(outcomes))
+    payload.update(verdicts.verdict_payload(outcomes, c.scene.campaign.classify_at))
     found = calibrate(
         (rig_key(o.spec.kind, o.spec.tube), o.calibration)
         for o in outcomes
@@ -342,7 +342,8 @@ def _print_report(
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
     print(f"world tissue: {', '.join(levels)}{note}")
     print()
-    for line in verdicts.summary_lines(outcomes):
+    threshold = scene.campaign.classify_at
+    for line in verdicts.summary_lines(outcomes) + verdicts.classified_line(outcomes, threshold):
         print(line)
     for line in config_lines(found):
         print(f"calibrated on the rigid reference: {line}")

@@ -140,10 +140,8 @@ def _replay_joint(
     inputs = EstimatorInputs.from_dict(raw)
     samples = list(log.of_kind("sample"))
     rows = [(r["state"], r["advance"], r["strains"]) for r in samples]
-    tips = [r.get("tip_force") for r in samples]
-    fitted = fit_rows(
-        rows, inputs, stack, section, [r["t"] for r in samples], tips if any(tips) else None
-    )
+    tips = [r.get("tip_force") for r in samples] if any("tip_force" in r for r in samples) else None
+    fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples], tips)
     end = log.end or {}
     verdict, relaxed = None, None
     if not inputs.rigid:
@@ -156,8 +154,8 @@ def _replay_joint(
             section,
             fitted.lean,
             fitted.relaxation,
-            tip_load_at_buckling(rows, tips if any(tips) else None),
-            tip_bow(fitted.southwell, tips if any(tips) else None),
+            tip_load_at_buckling(rows, tips),
+            tip_bow(fitted.southwell, tips),
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

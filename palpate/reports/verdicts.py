@@ -172,9 +172,44 @@ def relaxed_tally(outcomes: Iterable[TrialOutcome]) -> RelaxedTally:
     return RelaxedTally(len(held), relaxes, tally(held, relaxed_reading))
 
 
-def verdict_payload(outcomes: Sequence[TrialOutcome]) -> dict[str, object]:
-    """``--json``'s ``verdicts`` (and ``relaxed`` when trials held)."""
+def classified(outcomes: Iterable[TrialOutcome], threshold: float) -> dict[str, object]:
+    """How the joint fit's numbers sort the samples at a diagnostic ``threshold`` (Pa): of the
+    trials with a number (ok, suspect), how many fall on the true side, and of the ok ones."""
+    rows = [
+        (o.status, o.joint.modulus, o.spec.modulus)
+        for o in estimating(outcomes)
+        if o.status != "none" and o.joint is not None and o.joint.modulus is not None
+    ]
+    right = [s for s, m, true in rows if (m >= threshold) == (true >= threshold)]
+    return {
+        "threshold_kpa": threshold / 1e3,
+        "with_number": len(rows),
+        "right_side": len(right),
+        "ok": sum(1 for s, _, _ in rows if s == "ok"),
+        "ok_right_side": sum(1 for s in right if s == "ok"),
+    }
+
+
+def classified_line(outcomes: Sequence[TrialOutcome], threshold: float | None) -> list[str]:
+    """``palpate sim``'s line of :func:`classified` (none without a threshold)."""
+    if threshold is None:
+        return []
+    c = classified(outcomes, threshold)
+    return [
+        f"at the scene's threshold of {c['threshold_kpa']:g} kPa: {c['right_side']}/"
+        f"{c['with_number']} trials with a number on the true side ({c['ok_right_side']}/"
+        f"{c['ok']} ok)"
+    ]
+
+
+def verdict_payload(
+    outcomes: Sequence[TrialOutcome], threshold: float | None = None
+) -> dict[str, object]:
+    """``--json``'s ``verdicts`` (and ``relaxed`` when trials held, ``classified`` with a
+    diagnostic threshold, Pa)."""
     out: dict[str, object] = {"verdicts": tally(outcomes).as_dict()}
+    if threshold is not None:
+        out["classified"] = classified(outcomes, threshold)
     held = relaxed_tally(outcomes)
     if held.held:
         out["relaxed"] = held.as_dict()

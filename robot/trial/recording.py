@@ -51,12 +51,14 @@ LIBRARY = "palpate"
 
 class Sample(NamedTuple):
     """A sample as the recorder keeps it for what it derives when the trial ends: its stamp
-    (ns), stage advance (m) and roll (rad) (NaN where not measured), and its strains."""
+    (ns), stage advance (m) and roll (rad) (NaN where not measured), its strains, and the tip
+    grating's load (N; NaN without one)."""
 
     stamp: int
     advance: float
     roll: float
     strains: list[Any]
+    tip_force: float = math.nan
 
 
 class McapRecorder:
@@ -87,7 +89,8 @@ class McapRecorder:
             for topic, data in sample_messages(record, self._last_ns):
                 self._raw(topic, data, self._last_ns)
             advance, roll = _float(record.get("advance")), _float(record.get("roll"))
-            self.samples.append(Sample(self._last_ns, advance, roll, record.get("strains") or []))
+            strains, tip = record.get("strains") or [], _float(record.get("tip_force"))
+            self.samples.append(Sample(self._last_ns, advance, roll, strains, tip))
             return
         for topic, message in messages(record, self._last_ns, line):
             self._raw(topic, self._encoder(topic)(message), self._last_ns)
@@ -241,9 +244,13 @@ def export(log_path: str | Path, out: str | Path | None = None) -> Path:
 
 
 def axial_loads(recorder: McapRecorder) -> list[float] | None:
-    """The axial load (N) at every sample of ``recorder`` from its strains (the estimator's beam
-    states; NaN where a sample's strains are incomplete), or None when the header lacks the
-    sensor, the section or the estimator's inputs."""
+    """The axial load (N) at every sample of ``recorder``: the tip grating's where the sensor
+    has one, else from its strains (the estimator's beam states; NaN where a sample's strains are
+    incomplete), or None when the header lacks the sensor, the section or the estimator's
+    inputs."""
+    tips = [x.tip_force for x in recorder.samples]
+    if any(math.isfinite(f) for f in tips):
+        return tips
     from robot.trial.record import header_sensor
     from robot.trial.states import record_states
 

@@ -26,9 +26,19 @@ class BoardSample(NamedTuple):
 SampleSource = Callable[[float], BoardSample]
 
 
-def constant_source(wavelengths: Sequence[float], encoder: int = 0) -> SampleSource:
-    """A source that always returns the same sample (a sensor at rest)."""
-    sample = BoardSample(wavelengths=tuple(wavelengths), encoder=encoder)
+def constant_source(
+    wavelengths: Sequence[float],
+    encoder: int = 0,
+    *,
+    reference: float | None = None,
+    force: float | None = None,
+    tip: float | None = None,
+) -> SampleSource:
+    """A source that always returns the same sample (a sensor at rest), with the optional
+    fields a layout may carry (reference and tip grating's wavelengths, m; force, N)."""
+    sample = BoardSample(
+        wavelengths=tuple(wavelengths), encoder=encoder, reference=reference, force=force, tip=tip
+    )
 
     def source(t: float) -> BoardSample:
         return sample

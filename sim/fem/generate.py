@@ -53,7 +53,7 @@ for _h in (10e-3, 20e-3, 40e-3):
 """The problems whose tables ship in ``sim/fem/tables``, by name: the paper's and the soft
 designs' phantoms, the half-space stand-in, the thin and deep layers of
 ``config/scenes/layers/`` (R = 3.5 mm, frictionless tip) and the lung scene's neo-Hookean layers
-(R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung.yaml``)."""
+(R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung/``)."""
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from config import load, load_stack, resolve
@@ -14,8 +15,9 @@ from config.scene import SceneConfig
 from palpate.campaigns.campaign import campaign_trials
 from palpate.reports.replay import replay
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
+from robot.trial.states import LOADING_STATES
 
-LUNG = load(SceneConfig, resolve("scenes/lung.yaml"))
+LUNG = load(SceneConfig, resolve("scenes/lung/lung.yaml"))
 STACK = load_stack(LUNG.robot)
 
 
@@ -53,6 +55,18 @@ def test_the_log_carries_the_tip_load_and_replays_identically(fibrotic: TrialOut
     assert report["identical"], report
 
 
+def test_the_recordings_wrench_is_the_tip_gratings_load(fibrotic: TrialOutcome) -> None:
+    from robot.trial.recording import read_recording
+
+    assert fibrotic.log_path is not None
+    log = Path(fibrotic.log_path)
+    rows = [json.loads(line) for line in log.read_text().splitlines()]
+    tips = np.array([r.get("tip_force", np.nan) for r in rows if r["kind"] == "sample"])
+    rec = read_recording(log.with_suffix(".mcap"))
+    force = np.array([m.wrench.force.z for _, m in rec.messages["/tip/wrench"]])
+    np.testing.assert_array_equal(force, -tips)
+
+
 def test_without_its_tip_grating_the_board_and_reader_disagree_cleanly() -> None:
     """A sensor file with a tip grating and a board whose frames lack it: the reader's layout
     has the tip bit, so the frames are rejected as bad headers, never misread."""
@@ -66,3 +80,92 @@ def test_without_its_tip_grating_the_board_and_reader_disagree_cleanly() -> None
     parser = FrameParser(layout)
     assert parser.feed(old) == []
     assert parser.counters.bad_headers == 1
+
+
+def test_a_bench_rehearsal_on_the_twin_reads_the_tip_grating(tmp_path: Path) -> None:
+    """`palpate emulate --scene` + `palpate trial`: the designed sensor's robot file (as
+    `palpate design --write` wrote it) in a bench file, a fibrotic sample in front of the twin,
+    the session on the ptys reads its load from the tip grating and estimates it."""
+    import dataclasses
+
+    from config.bench import load_bench
+    from config.loader import write_yaml
+    from palpate.commands.trial import run_session
+    from palpate.lab.trial import plan_bench_trials
+    from palpate.simulation.twin import SimulatedBench, surface_at
+    from sim.clock import VirtualClock
+
+    quick = dataclasses.replace(
+        STACK,
+        drive=dataclasses.replace(STACK.drive, home_translation_mm=26.0),
+        servos=dataclasses.replace(STACK.servos, timeout_ms=2000.0),
+    )
+    write_yaml(quick, tmp_path / "robot.yaml")
+    (tmp_path / "targets.yaml").write_text(
+        "targets:\n  - {name: side, tube: bent30, roll_deg: 90, translation_mm: 27.5}\n",
+        encoding="utf-8",
+    )
+    bench = tmp_path / "bench.yaml"
+    bench.write_text(
+        f"servos: {{port: {tmp_path}/ttyNOPE0}}\nboard: {{port: {tmp_path}/ttyNOPE1}}\n"
+        f"robot: {tmp_path}/robot.yaml\ntargets: {tmp_path}/targets.yaml\n"
+        f"log_dir: {tmp_path}/logs\n"
+        "campaign: {contact: tip, detector_threshold_ue: 131, max_travel_past_contact_mm: 6,\n"
+        "           approach_speed_mm_per_s: 1.0}\n"
+        "trials:\n  - {target: side, sample: F2, modulus_kpa: 14, poisson: 0.45}\n",
+        encoding="utf-8",
+    )
+    loaded = load_bench(bench)
+    surface = surface_at(quick.tube("bent30"), 0.5 * 3.141592653589793, 28.5e-3, 10e-3)
+    clock = VirtualClock()
+    with SimulatedBench(
+        loaded.stack, LUNG, sample="F2", surface=surface, tube="bent30", clock=clock, wire=True
+    ) as sim:
+        (o,) = run_session(
+            loaded,
+            plan_bench_trials(loaded),
+            tmp_path / "logs",
+            servo_port=sim.servo_port,
+            board_port=sim.board_port,
+            clock=clock,
+            sync_to_clock=True,
+        )
+    assert o.state == "done", o.reason
+    log = [json.loads(line) for line in Path(str(o.log_path)).read_text().splitlines()]
+    loading = [r for r in log if r["kind"] == "sample" and r["state"] in LOADING_STATES]
+    assert loading
+    assert all("tip_force" in r for r in loading)
+    assert o.joint is not None
+    assert o.joint.modulus == pytest.approx(14e3, rel=0.1)  # thickness and bonding unknown here
+    assert replay(Path(str(o.log_path)))["identical"] is True
+
+
+def test_palpate_emulate_streams_the_tip_grating_of_the_designed_sensor() -> None:
+    """`palpate emulate --config robot-lung.yaml`: the board's pty carries revision 1.1 frames
+    (reference and tip grating) that the configured reader takes."""
+    import subprocess
+    import sys
+
+    from sensor.parser import layout_from_config
+    from sensor.reader import FrameReader
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "palpate", "emulate", "--config", "robot-lung.yaml",
+         "--seconds", "60", "--json"],
+        stdout=subprocess.PIPE,
+        text=True,
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        ports = json.loads(proc.stdout.readline())
+        layout = layout_from_config(STACK.sensor, STACK.board)
+        with FrameReader(ports["board"], layout) as reader:
+            frames = reader.read_frames(5, timeout_s=30.0)
+        assert len(frames) >= 5
+        tip = STACK.sensor.tip_grating
+        assert tip is not None
+        assert all(f.tip == pytest.approx(tip.base_wavelength, abs=1e-15) for f in frames)
+        assert all(f.reference is not None for f in frames)
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=30)  # reaps it and closes its stdout

@@ -138,9 +138,11 @@ def test_description_names_the_table() -> None:
     assert describe(SAMPLE, FidelityConfig(tissue_model="closed-form"), R)["level"] == "closed-form"
 
 
-SCENES = sorted(Path(resolve("scenes/bench.yaml")).parent.glob("*.yaml")) + sorted(
-    Path(resolve("scenes/bench.yaml")).parent.glob("layers/*.yaml")
-)
+SCENES = [
+    p
+    for pattern in ("*.yaml", "layers/*.yaml", "lung/*.yaml")
+    for p in sorted(Path(resolve("scenes/bench.yaml")).parent.glob(pattern))
+]
 
 
 @pytest.mark.parametrize("path", SCENES, ids=lambda p: p.name)
