@@ -113,13 +113,16 @@ def designed_stack(
     stack: StackConfig,
     modulus_range: tuple[float, float],
     tip: TipGratingChoice | None,
+    tip_mass_g: float | None = None,
 ) -> StackConfig:
     """The robot configuration with the designed sensor (``stack``'s, from :func:`design_scene`):
-    its designed range (Pa) stated, and with ``tip`` a tip grating, temperature-compensated by a
-    strain-free reference grating the board sends."""
+    its designed range (Pa) stated, its beam's mass from the fiber and wires, the tip's mass
+    ``tip_mass_g`` (None: the configuration's), and with ``tip`` a tip grating,
+    temperature-compensated by a strain-free reference grating the board sends."""
     s = stack.sensor
     sensor = dataclasses.replace(
         s,
+        tip_mass_g=s.tip_mass_g if tip_mass_g is None else tip_mass_g,
         designed_range_kpa=(modulus_range[0] / 1e3, modulus_range[1] / 1e3),
         linear_mass_g_per_m=1e3
         * math.pi

@@ -24,6 +24,8 @@ from estimation.design import (
     design_sensor,
 )
 from estimation.design.tipgrating import TipGratingChoice, choose_tip_grating
+from estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
+from estimation.section import composite_section
 from palpate.argtypes import non_negative_int, positive_int
 from palpate.campaigns.campaign import campaign_trials, default_workers
 from palpate.campaigns.designcheck import (
@@ -148,6 +150,12 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
         "noise) and check the design with it",
     )
     parser.add_argument(
+        "--tip-mass-g",
+        type=float,
+        default=None,
+        help="the tip's mass for the weight check (default: sensor.tip_mass_g of --config)",
+    )
+    parser.add_argument(
         "--write",
         type=Path,
         metavar="YAML",
@@ -229,6 +237,8 @@ def _run_sim(
 
 def _written_note(args: argparse.Namespace) -> str:
     tip = " --tip-grating" if args.tip_grating else ""
+    if args.tip_mass_g is not None:
+        tip += f" --tip-mass-g {args.tip_mass_g:g}"
     return (
         f"Written by `palpate design --modulus-range {args.modulus_range} --unit {args.unit}"
         f"{tip}`:\nthe robot configuration ({args.config}) with the designed sensor."
@@ -239,12 +249,27 @@ def _tip_payload(tip: TipGratingChoice | None) -> dict[str, object]:
     return {} if tip is None else {"tip_grating": tip.as_dict()}
 
 
-def _print_tip(tip: TipGratingChoice | None, written: Path | None) -> None:
+def _print_tip(
+    tip: TipGratingChoice | None, weight: WeightCheck | None, written: Path | None
+) -> None:
     if tip is not None:
         print(
             f"\ntip grating: {tip.sensitivity_pm_per_mn:g} pm/mN, range {tip.range_mn:.3g} mN, "
             f"element {tip.compliance_mm_per_n:.3g} mm/N, resolution {tip.resolution_mn:.3g} mN "
             f"({tip.resolution_share:.2%} of P_cr at 1 sigma)"
+        )
+    if weight is not None:
+        verdict = "within" if weight.ok else "beyond"
+        print(
+            f"weight: held across, the tip sags {weight.sag * 1e3:.3g} mm "
+            f"({weight.sag_over_length:.1%} of L, {verdict} {SAG_LIMIT:.1%}; a tip under "
+            f"{weight.tip_mass_limit * 1e3:.2g} g would be within): "
+            + (
+                ""
+                if weight.ok
+                else "use it pointing vertically or with the fiber bending in a "
+                "horizontal plane (docs/lung.md)"
+            )
         )
     if written is not None:
         print(f"wrote {written}")
@@ -263,6 +288,7 @@ def run(args: argparse.Namespace) -> int:
     outcomes: list[TrialOutcome] = []
     wall = 0.0
     tip: TipGratingChoice | None = None
+    weight: WeightCheck | None = None
     if result.success:
         assert result.evaluation is not None
         assert result.length_window is not None
@@ -272,17 +298,23 @@ def run(args: argparse.Namespace) -> int:
         if args.tip_grating:
             noise = base.fidelity.fbg_noise_pm
             tip = choose_tip_grating(result.evaluation.critical_load, max(noise, 1e-3))
-        sim_stack = designed_stack(sim_stack, modulus_range, tip)
+        sim_stack = designed_stack(sim_stack, modulus_range, tip, args.tip_mass_g)
+        s = sim_stack.sensor
+        section = composite_section(
+            s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
+        )
+        weight = weight_check(s.tip_mass, s.linear_mass, section.EI, s.exposed_length)
         if args.write is not None:
             write_yaml(sim_stack, args.write, _written_note(args))
         if not args.no_sim:
             outcomes, wall = _run_sim(scene, sim_stack, args)
     run = CheckRun(outcomes, wall, args.unit, args.executor)
     if args.json:
-        print(json.dumps({**payload(result, constraints, run), **_tip_payload(tip)}, indent=2))
+        extra = {**_tip_payload(tip), **({} if weight is None else {"weight": weight.as_dict()})}
+        print(json.dumps({**payload(result, constraints, run), **extra}, indent=2))
     else:
         print_report(result, constraints, run)
-        _print_tip(tip, args.write)
+        _print_tip(tip, weight, args.write)
     if not result.success:
         return EXIT_NO_DESIGN
     if any(o.state != "done" for o in outcomes):  # a trial of the check faulted

@@ -199,3 +199,20 @@ def test_the_tip_grating_is_the_most_sensitive_whose_range_carries_twice_p_cr() 
     assert stiff.sensitivity_pm_per_mn == 1.0
     with pytest.raises(ValueError, match="carries"):
         choose_tip_grating(1.35, 1.0)  # the paper's sensor: 2.7 N needs a stiffer element
+
+
+def test_the_weight_check_is_the_cantilevers_sag_and_its_tip_budget() -> None:
+    from estimation.design.weight import SAG_LIMIT, STANDARD_GRAVITY, weight_check
+    from estimation.section import composite_section
+
+    EI = composite_section(40e-6, 67e9, 25e-6, 55e9, 2).EI  # the 1-20 kPa design's beam
+    L = 28.5e-3
+    check = weight_check(0.05e-3, 0.0, EI, L)
+    assert check.sag == pytest.approx(0.05e-3 * STANDARD_GRAVITY * L**3 / (3 * EI))
+    p_cr = 20.19 * EI / L**2
+    assert check.sag_over_length == pytest.approx(20.19 / 3 * 0.05e-3 * 9.80665 / p_cr, 1e-3)
+    assert not check.ok
+    at_limit = weight_check(check.tip_mass_limit, 0.0, EI, L)
+    assert at_limit.sag_over_length == pytest.approx(SAG_LIMIT)
+    with pytest.raises(ValueError, match="EI"):
+        weight_check(1e-4, 0.0, 0.0, L)
