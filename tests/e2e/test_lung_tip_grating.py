@@ -169,3 +169,24 @@ def test_palpate_emulate_streams_the_tip_grating_of_the_designed_sensor() -> Non
     finally:
         proc.terminate()
         proc.communicate(timeout=30)  # reaps it and closes its stdout
+
+
+def test_a_sample_stiffer_than_the_designed_range_gets_no_number(tmp_path: Path) -> None:
+    """60 kPa in front of the 1-20 kPa sensor: it buckles at 0.15 mm and the fit reads about
+    60 kPa, whose whole interval lies outside the designed range: `none`, saying so."""
+    import dataclasses
+
+    from config.sample import SampleConfig
+
+    stiff = SampleConfig(
+        name="S60", modulus_kpa=60.0, poisson=0.45, thickness_mm=20.0, material="neo-hookean",
+        lateral_radius_mm=60.0,
+    )  # fmt: skip
+    scene = dataclasses.replace(LUNG, samples=(stiff,))
+    spec = next(s for s in campaign_trials(scene, STACK, 0) if s.orientation == "sideways")
+    out = run_sim_trial(spec, scene, STACK, log_dir=tmp_path)
+    assert out.state == "done", out.reason
+    assert out.verdict is not None
+    assert out.verdict.status == "none"
+    assert "outside the sensor's designed range" in out.verdict.reasons[0]
+    assert "1-20 kPa" in out.verdict.reasons[0]
