@@ -11,8 +11,9 @@ import argparse
 import logging
 from pathlib import Path
 
+from robot.trial.export import export
 from robot.trial.log import TrialLogError
-from robot.trial.recording import export, read_recording
+from robot.trial.recording import read_recording
 
 log = logging.getLogger(__name__)
 

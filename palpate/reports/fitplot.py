@@ -24,8 +24,8 @@ import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
 from estimation.belief import Hypothesis
+from robot.trial.inputs import header_sensor
 from robot.trial.log import TrialLog, read_log
-from robot.trial.record import header_sensor
 from robot.trial.relaxed import HOLD_STATE, RECORD_STATES
 from robot.trial.states import record_states
 

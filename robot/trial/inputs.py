@@ -14,10 +14,12 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
+from config.loader import from_mapping
 from config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
-from config.schema import MM
+from config.schema import MM, SensorConfig
 from estimation.belief import Belief
 from estimation.corrections import ContactLaw
+from estimation.section import Section
 
 VERSION = 2
 DEFAULT_POISSON = 0.45  # the nominal value of an unknown Poisson ratio (the paper's)
@@ -184,3 +186,14 @@ def probe_inputs(probe: dict[str, Any]) -> dict[str, Any]:
         "orientation_verified": measured,
         "misalignment_sigma": sigma if measured and math.isfinite(sigma) else None,
     }
+
+
+def header_sensor(
+    header: dict[str, Any], source: str = "<log>"
+) -> tuple[SensorConfig, Section, EstimatorInputs]:
+    """The sensor, its section and the estimator's inputs a log header records (what the
+    record's strains are read with). Raises ``ConfigError``/``KeyError`` where it lacks them."""
+    raw = {k: tuple(v) if isinstance(v, list) else v for k, v in header["sensor"].items()}
+    sensor = from_mapping(SensorConfig, raw, source, "sensor")
+    section = Section(**{f.name: header["section"][f.name] for f in fields(Section)})
+    return sensor, section, EstimatorInputs.from_dict(header["estimator"])

@@ -16,7 +16,7 @@ written here, and read back here (:func:`recorded_verdict`), tolerant of logs th
 
 from __future__ import annotations
 
-from dataclasses import asdict, fields
+from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from config.schema import SensorConfig, TubeConfig
@@ -148,20 +148,6 @@ def relaxed_row(fit: RelaxationFit | None, verdict: Verdict | None) -> dict[str,
         "relaxed_verdict": None if verdict is None else verdict.status,
         "relaxed_reasons": [] if verdict is None else list(verdict.reasons),
     }
-
-
-def header_sensor(
-    header: dict[str, Any], source: str = "<log>"
-) -> tuple[SensorConfig, Section, EstimatorInputs]:
-    """The sensor, its section and the estimator's inputs a log header records (what the
-    record's strains are read with). Raises ``ConfigError``/``KeyError`` where it lacks them."""
-    from config.loader import from_mapping
-    from robot.trial.inputs import EstimatorInputs
-
-    raw = {k: tuple(v) if isinstance(v, list) else v for k, v in header["sensor"].items()}
-    sensor = from_mapping(SensorConfig, raw, source, "sensor")
-    section = Section(**{f.name: header["section"][f.name] for f in fields(Section)})
-    return sensor, section, EstimatorInputs.from_dict(header["estimator"])
 
 
 def recorded_verdict(record: dict[str, Any] | None, key: str = "verdict") -> Verdict | None:

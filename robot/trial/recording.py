@@ -10,7 +10,8 @@ the trial ends the tip force is derived from every sample's strains (the estimat
 states, ``robot.trial.states``) and written as ``/tip/wrench``, and on the robot each sample's
 tip pose as ``/tf``.
 
-:func:`export` converts an existing log; :func:`read_recording` reads one back without ROS,
+:func:`robot.trial.export.export` converts an existing log; :func:`read_recording` reads one
+back without ROS,
 through ``mcap``'s stream reader and ``mcap-ros2-support``'s CDR decoder, up to where a killed
 trial's file ends.
 """
@@ -229,20 +230,6 @@ def _take(
         out.complete = True
 
 
-def export(log_path: str | Path, out: str | Path | None = None) -> Path:
-    """The MCAP recording of an existing trial log (``<log>.mcap`` unless ``out``): the same
-    messages its trial would have recorded. Raises ``TrialLogError`` for an unreadable log."""
-    from robot.trial.log import read_log  # the log module records through this one
-
-    log = read_log(log_path)
-    target = Path(out) if out is not None else Path(log_path).with_suffix(".mcap")
-    recorder = McapRecorder(target, log.header)
-    for record in log.records:
-        recorder.write(record, json.dumps(record, separators=(",", ":"), allow_nan=False))
-    recorder.close(axial_loads)
-    return target
-
-
 def axial_loads(recorder: McapRecorder) -> list[float] | None:
     """The axial load (N) at every sample of ``recorder``: the tip grating's where the sensor
     has one, else from its strains (the estimator's beam states; NaN where a sample's strains are
@@ -251,7 +238,7 @@ def axial_loads(recorder: McapRecorder) -> list[float] | None:
     tips = [x.tip_force for x in recorder.samples]
     if any(math.isfinite(f) for f in tips):
         return tips
-    from robot.trial.record import header_sensor
+    from robot.trial.inputs import header_sensor
     from robot.trial.states import record_states
 
     try:

@@ -14,9 +14,10 @@ from config import load, load_stack, resolve
 from config.scene import SceneConfig
 from palpate.cli import main
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
+from robot.trial.export import export
+from robot.trial.inputs import header_sensor
 from robot.trial.log import TrialLog, read_log
-from robot.trial.record import header_sensor
-from robot.trial.recording import Recording, export, read_recording
+from robot.trial.recording import Recording, read_recording
 from robot.trial.states import record_states
 
 STACK = load_stack()
