@@ -83,12 +83,34 @@ def composite_section(
     )
 
 
+def across_rigidity(
+    fiber_radius: float,
+    fiber_modulus: float,
+    wire_radius: float,
+    wire_modulus: float,
+    wire_count: int,
+) -> float:
+    """EI (N m^2) for bending *across* the fiber's plane, about the axis through the fiber and
+    the row's middle: the wires side by side at x = (2i - (n - 1)) r_w, the fiber at x = 0. A beam
+    buckles about its softest axis; the gratings see only the bending in their own plane
+    (:class:`Section`'s EI), so a design must be stiffer across (``estimation.design``)."""
+    r_f = _positive("fiber_radius", fiber_radius)
+    r_w = _positive("wire_radius", wire_radius)
+    n = int(wire_count)
+    ei = _positive("fiber_modulus", fiber_modulus) * math.pi * r_f**4 / 4.0
+    e_w = _positive("wire_modulus", wire_modulus)
+    for i in range(n):
+        x = (2 * i - (n - 1)) * r_w
+        ei += e_w * (math.pi * r_w**4 / 4.0 + math.pi * r_w**2 * x * x)
+    return ei
+
+
 def euler_load(EI: float, L: float) -> float:
     """Critical load of the clamped-pinned column, P_cr = P_CRIT EI / L**2 (P_CRIT = 20.1907)."""
     return P_CRIT * _positive("EI", EI) / _positive("L", L) ** 2
 
 
-__all__ = ["P_CRIT", "Section", "composite_section", "euler_load"]
+__all__ = ["P_CRIT", "Section", "across_rigidity", "composite_section", "euler_load"]
 
 
 def sensor_section(sensor: SensorConfig) -> Section:

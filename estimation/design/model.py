@@ -110,6 +110,7 @@ def _peak_curvature(e_over_L: FloatArray) -> FloatArray:
 
 def assess(
     EI: FloatArray,
+    EI_across: FloatArray,
     EA: FloatArray,
     fiber_offset: FloatArray,
     fiber_radius: FloatArray,
@@ -118,8 +119,9 @@ def assess(
     modulus_range: tuple[float, float],
     c: DesignConstraints,
 ) -> Assessment:
-    """All checks for N candidates: EI (N m^2), EA (N), fiber offset and radius, tip radius R
-    and exposed length L (m), each (N,); L must reach past the gratings."""
+    """All checks for N candidates: EI in the fiber's plane and across it (N m^2), EA (N),
+    fiber offset and radius, tip radius R and exposed length L (m), each (N,); L must reach
+    past the gratings."""
     e_min, e_max = modulus_range
     p_cr = P_CRIT * EI / L**2
     preload = p_cr / EA  # the axial strain every grating carries at P_cr
@@ -135,6 +137,7 @@ def assess(
     _, e_imp = imperfection_state(c.imperfection, c.detect_load_fraction)
     bias = p_cr * L / EA + e_det + e_imp * L
     checks = _checks(depth_ratio, contact_ratio, d_stiff, detection, floor, bias, peak, c)
+    checks["plane"] = (EI_across / EI, np.full_like(EI, c.plane_margin), False)
     return Assessment(
         p_cr,
         d_soft,
@@ -291,6 +294,7 @@ def evaluate_design(
 
     arrays = assess(
         one(section.EI),
+        one(design.across_rigidity()),
         one(section.EA),
         one(section.fiber_offset),
         one(design.fiber_radius),

@@ -15,6 +15,7 @@ CHECKS: dict[str, str] = {
     "detection": "buckling detectable: grating strain norm at e_det >= pre-load norm + noise",
     "delta_bias": "stage travel that is not indentation <= max_bias_fraction x delta at E_max",
     "fiber_strain": "fiber survives: peak strain after e_det + post-buckling travel <= limit",
+    "plane": "buckles in the fiber's plane: EI across it >= plane_margin x EI in it",
 }
 """The design checks, by name, in the order they are reported."""
 

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from estimation.design.model import Assessment, assess, checked_range, evaluation
 from estimation.design.results import Check, DesignEvaluation, DesignResult
 from estimation.design.space import DesignConstraints, DesignSpace, SensorDesign
-from estimation.section import composite_section
+from estimation.section import across_rigidity, composite_section
 
 FloatArray = NDArray[np.float64]
 
@@ -120,8 +120,14 @@ class _Candidates:
             values = np.asarray([getattr(s, attr) for s in sections], dtype=np.float64)
             return np.asarray(values[self.hw], dtype=np.float64)
 
+        across = np.asarray(
+            [across_rigidity(r_f, sp.fiber_modulus, r_w, sp.wire_modulus, n)
+             for r_f, n, r_w in self.hardware],
+            dtype=np.float64,
+        )  # fmt: skip
         return assess(
             per_section("EI"),
+            np.asarray(across[self.hw], dtype=np.float64),
             per_section("EA"),
             per_section("fiber_offset"),
             np.asarray([h[0] for h in self.hardware], dtype=np.float64)[self.hw],

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from estimation.corrections import LAYER_STRAIN_MAX
-from estimation.section import Section, composite_section, euler_load
+from estimation.section import Section, across_rigidity, composite_section, euler_load
 
 FloatArray = NDArray[np.float64]
 
@@ -103,6 +103,10 @@ class DesignConstraints:
         post_buckling_travel: stage travel after detection (m), for the fiber-strain check.
         grating_centres_from_tip: distances (m) from the sensor tip to the used gratings.
         grating_length: grating length (m).
+        plane_margin: how much stiffer across the fiber's plane than in it the beam must be, so
+            that it buckles in the plane the gratings see (a beam buckles about its softest
+            axis): 2 keeps a bow across within twice its size at P_cr (1 / (1 - 1/2)); the
+            paper's sensor has 3.2.
     """
 
     poisson: float = 0.45
@@ -121,6 +125,7 @@ class DesignConstraints:
     post_buckling_travel: float = 0.3 * MM
     grating_centres_from_tip: tuple[float, ...] = (10 * MM, 18 * MM, 26 * MM)
     grating_length: float = 3 * MM
+    plane_margin: float = 2.0
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.poisson < 0.5 + 1e-12:
@@ -138,6 +143,7 @@ class DesignConstraints:
             "detection_fraction",
             "max_bias_fraction",
             "grating_length",
+            "plane_margin",
         )
         for name in positive:
             value = getattr(self, name)
@@ -185,3 +191,13 @@ class SensorDesign:
 
     def critical_load(self) -> float:
         return euler_load(self.section().EI, self.exposed_length)
+
+    def across_rigidity(self) -> float:
+        """EI across the fiber's plane (N m^2), :func:`estimation.section.across_rigidity`."""
+        return across_rigidity(
+            self.fiber_radius,
+            self.fiber_modulus,
+            self.wire_radius,
+            self.wire_modulus,
+            self.wire_count,
+        )

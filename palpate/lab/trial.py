@@ -35,7 +35,7 @@ from palpate.live import LiveView, Publisher
 from robot.indentation import PLANNED_ENDS
 from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
-from robot.trial.inputs import belief_fields
+from robot.trial.inputs import belief_fields, probe_inputs
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import estimate_record, header_common, relaxed_row
 from robot.trial.run import end_record, run_trial
@@ -240,6 +240,8 @@ def _run_one(
         result = run_trial(
             rig, hw.clock, trial.plan, guards, detector, log, prober=prober, on_tick=publisher
         )
+        if result.probe is not None:  # told what probing measured, as the replay of its log is
+            inputs = dataclasses.replace(inputs, **probe_inputs(result.probe.as_dict()))
         estimate = estimate_trial(
             result,
             kind=trial.kind,

@@ -95,14 +95,16 @@ def test_a_bench_rehearsal_on_the_twin_reads_the_tip_grating(tmp_path: Path) -> 
     from palpate.simulation.twin import SimulatedBench, surface_at
     from sim.clock import VirtualClock
 
+    contact_mm = STACK.sensor.exposed_length_mm  # the tube flush at 0: the contact's translation
     quick = dataclasses.replace(
         STACK,
-        drive=dataclasses.replace(STACK.drive, home_translation_mm=26.0),
+        drive=dataclasses.replace(STACK.drive, home_translation_mm=contact_mm - 2.5),
         servos=dataclasses.replace(STACK.servos, timeout_ms=2000.0),
     )
     write_yaml(quick, tmp_path / "robot.yaml")
     (tmp_path / "targets.yaml").write_text(
-        "targets:\n  - {name: side, tube: bent30, roll_deg: 90, translation_mm: 27.5}\n",
+        "targets:\n  - {name: side, tube: bent30, roll_deg: 90, "
+        f"translation_mm: {contact_mm - 1.0}}}\n",
         encoding="utf-8",
     )
     bench = tmp_path / "bench.yaml"
@@ -110,13 +112,13 @@ def test_a_bench_rehearsal_on_the_twin_reads_the_tip_grating(tmp_path: Path) -> 
         f"servos: {{port: {tmp_path}/ttyNOPE0}}\nboard: {{port: {tmp_path}/ttyNOPE1}}\n"
         f"robot: {tmp_path}/robot.yaml\ntargets: {tmp_path}/targets.yaml\n"
         f"log_dir: {tmp_path}/logs\n"
-        "campaign: {contact: tip, detector_threshold_ue: 131, max_travel_past_contact_mm: 6,\n"
+        "campaign: {contact: tip, detector_threshold_ue: 141, max_travel_past_contact_mm: 8,\n"
         "           approach_speed_mm_per_s: 1.0}\n"
         "trials:\n  - {target: side, sample: F2, modulus_kpa: 14, poisson: 0.45}\n",
         encoding="utf-8",
     )
     loaded = load_bench(bench)
-    surface = surface_at(quick.tube("bent30"), 0.5 * 3.141592653589793, 28.5e-3, 10e-3)
+    surface = surface_at(quick.tube("bent30"), 0.5 * 3.141592653589793, contact_mm * 1e-3, 10e-3)
     clock = VirtualClock()
     with SimulatedBench(
         loaded.stack, LUNG, sample="F2", surface=surface, tube="bent30", clock=clock, wire=True
