@@ -216,3 +216,21 @@ def test_the_weight_check_is_the_cantilevers_sag_and_its_tip_budget() -> None:
     assert at_limit.sag_over_length == pytest.approx(SAG_LIMIT)
     with pytest.raises(ValueError, match="EI"):
         weight_check(1e-4, 0.0, 0.0, L)
+
+
+def test_a_beam_softer_across_the_fibers_plane_fails_the_plane_check() -> None:
+    """A beam buckles about its softest axis: the gratings see only their own plane's bending."""
+    from estimation.section import across_rigidity, composite_section
+
+    paper = composite_section(115e-6, 67e9, 100e-6, 55e9, 4)
+    assert across_rigidity(115e-6, 67e9, 100e-6, 55e9, 4) / paper.EI == pytest.approx(
+        3.15, abs=0.01
+    )
+    bare = across_rigidity(40e-6, 67e9, 25e-6, 55e9, 0)
+    assert bare == pytest.approx(67e9 * math.pi * (40e-6) ** 4 / 4)
+    thin = SensorDesign(40e-6, 67e9, 2, 25e-6, 55e9, 10e-3, 28.5e-3)  # the first 1-20 kPa proposal
+    plane = next(c for c in evaluate_design(thin, (1e3, 20e3)).checks if c.name == "plane")
+    assert plane.value == pytest.approx(0.42, abs=0.01)
+    assert not plane.ok
+    wide = SensorDesign(40e-6, 67e9, 4, 37.5e-6, 55e9, 10e-3, 45e-3)  # the design it proposes now
+    assert next(c for c in evaluate_design(wide, (1e3, 20e3)).checks if c.name == "plane").ok
