@@ -59,7 +59,10 @@ class ProbeSettings:
 
     Attributes:
         offsets: the rolls of the touches after the first, relative to the plan's roll.
-        touch_strain: axial strain (compression) that is a touch.
+        touch_strain: axial strain (compression) that is a touch; also the unit of the bow a
+            touch or a free tip is judged by.
+        touch_force: with a tip force grating, the tip load (N) that is a touch instead of the
+            axial strain (a mN beam's axial strain is at the noise); None: the strain.
         speed: approach speed of the first touch; fast_speed for the moves between touches.
         decel: the stage's deceleration: once a touch has shown how deep the sample yields,
             later ones approach as fast as the stage stops within half that depth.
@@ -89,6 +92,7 @@ class ProbeSettings:
     replan: bool = True
     budget: float = math.inf
     search: float = 0.0
+    touch_force: float | None = None
 
 
 class ProbeGeometry:

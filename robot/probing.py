@@ -148,17 +148,31 @@ class ProbeRoutine:
         }[self.phase]
         return handler(obs)
 
-    def _seek(self, obs: Observation) -> Command | ProbeResult | str:
+    @property
+    def _threshold(self) -> float:
+        """The load that is a touch: ``touch_force`` (N) with a tip grating, else
+        ``touch_strain``."""
         s = self.settings
-        axial = self.geometry.axial(obs.strains, obs.advance)
+        return s.touch_strain if s.touch_force is None else s.touch_force
+
+    def _load(self, obs: Observation) -> float:
+        """The tick's load in the threshold's unit: the tip grating's (N) when the settings
+        read it, else the axial strain; NaN when the tick has none."""
+        if self.settings.touch_force is not None:
+            return math.nan if obs.tip_force is None else obs.tip_force
+        return self.geometry.axial(obs.strains, obs.advance)
+
+    def _seek(self, obs: Observation) -> Command | ProbeResult | str:
+        s, threshold = self.settings, self._threshold
+        axial = self._load(obs)
         if math.isfinite(axial):
             self._ramp.append((obs.advance, axial))
             self._ramp_strains.append(obs.strains)
         load = axial - self._baseline()
         bowed = max((abs(e) for e in obs.strains), default=0.0) >= TOUCH_BOW * s.touch_strain
-        if math.isfinite(load) and (load >= TOUCH_TOP * s.touch_strain or bowed):
+        if math.isfinite(load) and (load >= TOUCH_TOP * threshold or bowed):
             # a bow without the load is a slipping tip (the surface too steep for its friction)
-            slipped = bowed and load < s.touch_strain
+            slipped = bowed and load < threshold
             start, x = (obs.advance, obs.advance) if slipped else self._crossing()
             touch = self.geometry.touch(obs.roll, x)
             self.touches.append(dataclasses.replace(touch, slipped=slipped, depth=x - start))
@@ -183,8 +197,9 @@ class ProbeRoutine:
         return min(max(math.sqrt(s.decel * reach), s.speed), s.fast_speed)
 
     def _baseline(self) -> float:
-        """The axial strain of the free beam on this seek: the mean of its first ticks (the
-        seek starts ``clearance`` or more before the surface), 0 until there are enough."""
+        """The load of the free beam on this seek, in the threshold's unit: the mean of its
+        first ticks (the seek starts ``clearance`` or more before the surface), 0 until there
+        are enough."""
         if len(self._ramp) < BASELINE_TICKS // 2:
             return 0.0
         return float(np.mean([a for _, a in self._ramp[:BASELINE_TICKS]]))
@@ -196,9 +211,10 @@ class ProbeRoutine:
         fit fails."""
         xs = [x for x, _ in self._ramp]
         ys = [a for _, a in self._ramp]
-        if self.geometry.loads is not None and len(xs) >= 4:
-            ys = self.geometry.loads(np.array(xs), np.array(self._ramp_strains)).tolist()
-        found = load_crossing(xs, ys, self.settings.touch_strain) if len(xs) >= 4 else None
+        loads = self.geometry.loads
+        if self.settings.touch_force is None and loads is not None and len(xs) >= 4:
+            ys = loads(np.array(xs), np.array(self._ramp_strains)).tolist()
+        found = load_crossing(xs, ys, self._threshold) if len(xs) >= 4 else None
         last = self._ramp[-1][0]
         return (last, last) if found is None else found
 
@@ -238,7 +254,7 @@ class ProbeRoutine:
         bow = max((abs(e) for e in obs.strains), default=0.0)
         loaded = bow >= TOUCH_BOW * th
         if abs(obs.roll - self._zero_roll) < ON_RAY:  # rolled away, the weight moves the zero
-            loaded = loaded or self.geometry.axial(obs.strains, obs.advance) > TOUCH_FREE * th
+            loaded = loaded or self._load(obs) > TOUCH_FREE * self._threshold
         self._free_ticks = 0 if loaded else self._free_ticks + 1
         self._loaded_ticks = self._loaded_ticks + 1 if loaded else 0
         if self._free and self._loaded_ticks >= 2:

@@ -28,7 +28,7 @@ FloatArray = NDArray[np.float64]
 class TipZero:
     """The tip grating at rest: mean wavelength (m), the standard deviation of a compensated
     reading (m: the reference's noise is in it), the reference grating's mean (m, None without
-    one) and how many samples were averaged."""
+    one) and how many samples the standard deviation was taken on (the largest zero's)."""
 
     wavelength: float
     noise: float
@@ -68,8 +68,13 @@ class TipForceChain:
                 raise ValueError(f"reference has {r.size} samples, the tip grating {w.size}")
             ref = float(r.mean())
             read = w - self.thermal_ratio * (r - ref)
-        noise = float(read.std(ddof=1)) if w.size > 1 else 0.0
-        zero = TipZero(float(w.mean()), noise, ref, int(w.size))
+        noise, samples = (float(read.std(ddof=1)) if w.size > 1 else 0.0), int(w.size)
+        if self.zero is not None and self.zero.samples > samples:
+            # a zero taken again on a few frames (the rig's, in a trial) moves the offset, not
+            # the noise: 8 frames' standard deviation is below 0.6 sigma one time in twenty,
+            # and a contact threshold of 5 of them would trip on the noise
+            noise, samples = self.zero.noise, self.zero.samples
+        zero = TipZero(float(w.mean()), noise, ref, samples)
         return TipForceChain(self.sensitivity, self.thermal_ratio, self.compensated, zero)
 
     def force(self, tip: float, reference: float | None = None) -> float:

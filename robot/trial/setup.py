@@ -19,6 +19,7 @@ from config.scene import CampaignConfig
 from config.schema import MM, StackConfig, TubeConfig
 from estimation.beamstate import infer_states, onset_mode
 from estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
+from estimation.elastica.constants import P_CRIT
 from estimation.section import Section
 from estimation.section import sensor_section as section_of
 from robot.indentation import STATE_TIMEOUT, Guards, Prober, TrialPlan
@@ -37,6 +38,8 @@ def sensor_section(stack: StackConfig) -> Section:
 
 PROBE_SEARCH = 6e-3  # m the first touch looks past the approach window (samples 1-5 mm off)
 BUDGET_SHARE = 0.8  # probing's budget never exceeds this share of the state timeout
+TIP_TOUCH_SHARE = 0.1  # with a tip grating a touch is this share of P_cr (the paper's
+# sensor touches at 25 ue of axial strain, 18 % of its P_cr; a seek stops at twice it)
 SETTLE_ALLOWANCE = 0.4  # s per touch at rest for the strain zero (10 ticks at 25 Hz or more)
 
 
@@ -101,6 +104,7 @@ def prober_for(
         settings = ProbeSettings(
             offsets=probe_offsets(campaign.probe_points, step),
             touch_strain=campaign.probe_touch_ue * 1e-6,
+            touch_force=tip_touch_force(stack, plan.contact_advance - tube.flush_translation),
             speed=min(PROBE_SPEED, stack.drive.max_speed),
             fast_speed=stack.drive.max_speed,
             decel=stack.drive.max_accel,
@@ -123,6 +127,15 @@ def prober_for(
         return ProbeRoutine(geometry, settings, plan)
 
     return build
+
+
+def tip_touch_force(stack: StackConfig, length: float) -> float | None:
+    """The tip load (N) that is a probing touch for a sensor with a tip grating (its axial
+    strain may be at the noise): TIP_TOUCH_SHARE of P_cr at the contact's exposed ``length``
+    (m); None without a tip grating."""
+    if stack.sensor.tip_grating is None or length <= 0:
+        return None
+    return TIP_TOUCH_SHARE * P_CRIT * sensor_section(stack).EI / length**2
 
 
 def rig_settings(

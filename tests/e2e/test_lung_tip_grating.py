@@ -5,6 +5,7 @@ frame, the joint fit reading the load from it, the log and its replay."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -192,3 +193,26 @@ def test_a_sample_stiffer_than_the_designed_range_gets_no_number(tmp_path: Path)
     assert out.verdict.status == "none"
     assert "outside the sensor's designed range" in out.verdict.reasons[0]
     assert "1-20 kPa" in out.verdict.reasons[0]
+
+
+def test_probing_finds_a_tilted_soft_samples_normal_with_the_tip_grating() -> None:
+    """A 10 deg tilted fibrotic sample at an azimuth the plan does not know: the touches read
+    the tip grating's load (the beam's 15 ue of axial strain would not show them), the normal
+    is found, the re-planned pose is orthogonal within a degree and the estimate is `ok`."""
+    tilted = load(SceneConfig, resolve("scenes/lung/tilted.yaml"))
+    spec = next(
+        s
+        for s in campaign_trials(tilted, STACK, 0)
+        if s.sample == "F2-t10" and s.tube == "bent30" and s.orientation == "downward"
+    )
+    out = run_sim_trial(spec, tilted, STACK)
+    assert out.state == "done", out.reason
+    assert out.probe is not None
+    assert out.probe.normal is not None, out.probe.reason
+    assert not any(t.slipped for t in out.probe.touches)
+    assert out.misalignment is not None
+    assert abs(out.misalignment) < math.radians(1.0)
+    assert out.verdict is not None
+    assert out.verdict.status == "ok", out.verdict
+    assert out.joint is not None
+    assert out.joint.modulus == pytest.approx(14e3, rel=0.1)

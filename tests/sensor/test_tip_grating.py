@@ -117,3 +117,13 @@ def test_a_tip_grating_that_cannot_work_is_refused_naming_the_key(
     with pytest.raises(ConfigError, match=key) as err:
         from_mapping(StackConfig, {"sensor": sensor, "fbg": fbg, "board": board}, "lung.yaml")
     assert "lung.yaml" in str(err.value)
+
+
+def test_a_zero_taken_again_on_a_few_frames_keeps_the_larger_zeros_noise() -> None:
+    tip = tip_config(temperature_compensation="none")
+    chain = TipForceChain.from_config(tip, FbgConfig())
+    rng = np.random.default_rng(5)
+    first = chain.zeroed(1.56e-6 + rng.normal(0.0, 1e-12, 200))
+    again = first.zeroed(1.56e-6 + 3e-12 + rng.normal(0.0, 1e-12, 8))
+    assert again.noise() == first.noise()  # the noise of 200 frames, not of 8
+    assert again.force(1.56e-6 + 3e-12) == pytest.approx(0.0, abs=0.1e-3)  # the new offset
