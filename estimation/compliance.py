@@ -25,6 +25,7 @@ Pure functions, SI units; failure is a result with ``success`` False and a messa
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -65,6 +66,18 @@ class ComplianceFit:
             "n_points": self.n_points,
             "confidence": self.confidence,
         }
+
+
+def less(fit: ComplianceFit, compliance: float) -> ComplianceFit:
+    """``fit`` with a known compliance (m/N) in series taken out of the value and its interval:
+    what is left is the rest of the rig's (a tip grating's element is the sensor's own, and
+    ``config.schema.StackConfig.compliance`` adds it back to every estimate)."""
+    if compliance == 0.0 or fit.compliance is None:
+        return fit
+    shifted = [None if v is None else v - compliance for v in (fit.ci_low, fit.ci_high)]
+    return dataclasses.replace(
+        fit, compliance=fit.compliance - compliance, ci_low=shifted[0], ci_high=shifted[1]
+    )
 
 
 def fit_compliance(

@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from config.schema import SensorConfig, StackConfig
 from estimation.beam import Beam
 from estimation.beamstate import BeamStates
-from estimation.compliance import ComplianceFit, fit_compliance
+from estimation.compliance import ComplianceFit, fit_compliance, less
 from estimation.detect_contact import baseline_deviation
 from estimation.elastica.constants import P_CRIT
 from estimation.jointfit import MIN_POINTS, JointFit, joint_fit
@@ -112,8 +112,10 @@ def fit_record(
         return RecordEstimate(JointFit(False, msg, n_points=n, law=inputs.law().name))
     lengths = record_lengths(advance, inputs)
     states, k = states_at(strains, lengths, sensor, section)
-    if inputs.rigid:
-        return RecordEstimate(None, calibration=fit_compliance(advance, states.P, states.e))
+    if inputs.rigid:  # the tube's (stage's) compliance: a tip grating's element is the sensor's
+        element = 0.0 if sensor.tip_grating is None else sensor.tip_grating.compliance
+        fit = less(fit_compliance(advance, states.P, states.e), element)
+        return RecordEstimate(None, calibration=fit)
     force, sigma_force = states.P, k * states.sigma_P
     if tip_forces is not None:
         force, sigma_force = tip_forces, np.full(n, force_sigma(tip_forces))

@@ -84,3 +84,16 @@ def test_no_load_is_no_calibration_and_pooled_takes_the_envelope() -> None:
     assert pooled(fits) == (0.9e-4, 1.2e-4)
     assert pooled([ComplianceFit(True, "ok", 0.0, -1e-6, 1e-6)]) == (0.0, 1e-6)
     assert pooled([]) is None
+
+
+def test_a_known_compliance_in_series_comes_out_of_the_fit_and_its_interval() -> None:
+    from estimation.compliance import ComplianceFit, less
+
+    fit = ComplianceFit(True, "ok", 1e-4, 0.9e-4, 1.1e-4, 0.01, 50)
+    tube = less(fit, 2e-5)  # a tip grating's element, 0.02 mm/N
+    assert tube.compliance == pytest.approx(8e-5)
+    assert (tube.ci_low, tube.ci_high) == (pytest.approx(7e-5), pytest.approx(9e-5))
+    assert tube.contact == fit.contact
+    assert less(fit, 0.0) is fit
+    failed = ComplianceFit(False, "too few points")
+    assert less(failed, 2e-5) == failed
