@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from config.schema import FbgConfig, TipGratingConfig
+from estimation.detect_contact import MAD_TO_SIGMA
 
 FloatArray = NDArray[np.float64]
 
@@ -105,7 +106,7 @@ def force_sigma(forces: ArrayLike) -> float:
         return 1e-9
     d = np.diff(f)
     mad = float(np.median(np.abs(d - np.median(d))))
-    return max(1.4826 * mad / math.sqrt(2.0), 1e-9)
+    return max(MAD_TO_SIGMA * mad / math.sqrt(2.0), 1e-9)
 
 
 def tip_chain(tip: TipGratingConfig | None, fbg: FbgConfig) -> TipForceChain | None:

@@ -26,7 +26,6 @@ from robot.trial.estimate import (
     estimate_from_marks,
     exposed_length_at,
     fit_rows,
-    tip_bow,
     tip_load_at_buckling,
     verdict_for,
 )
@@ -155,7 +154,7 @@ def _replay_joint(
             fitted.lean,
             fitted.relaxation,
             tip_load_at_buckling(rows, tips),
-            tip_bow(fitted.southwell, tips),
+            fitted.tip_bow,
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

@@ -65,7 +65,6 @@ __all__ = [
     "fit_record",
     "fit_rows",
     "loading_rows",
-    "tip_bow",
     "tip_load_at_buckling",
     "verdict_for",
 ]
@@ -83,13 +82,24 @@ def loading_rows(
 @dataclass(frozen=True)
 class RecordEstimate:
     """What the record gives: the joint fit and the Southwell fit of the beam's bow (None when
-    the record is too short for either); on a rigid reference, the compliance instead."""
+    the record is too short for either); on a rigid reference, the compliance instead.
+    ``tip_load``: the fits read the load from a tip grating."""
 
     joint: JointFit | None
     southwell: SouthwellFit | None = None
     calibration: ComplianceFit | None = None
     lean: Lean | None = None
     relaxation: RelaxationFit | None = None
+    tip_load: bool = False
+
+    @property
+    def tip_bow(self) -> float | None:
+        """The bow w0/L fitted against a tip grating's load, None without one (a bow fitted
+        against the strains' own load is not independent of them)."""
+        bow = self.southwell
+        if not self.tip_load or bow is None or not bow.success:
+            return None
+        return bow.w0_over_l
 
 
 def fit_record(
@@ -132,7 +142,8 @@ def fit_record(
         misalignment=inputs.misalignment,
     )
     # the bow against the load the fit read: the tip grating's, independent of the strains
-    return RecordEstimate(joint, _bow(force, states, lengths, section))
+    bow = _bow(force, states, lengths, section)
+    return RecordEstimate(joint, bow, tip_load=tip_forces is not None)
 
 
 def critical_load(section: Section, length: float) -> float:
@@ -184,15 +195,6 @@ def fit_rows(
     return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
 
 
-def tip_bow(
-    southwell: SouthwellFit | None, tip_forces: Sequence[float | None] | None
-) -> float | None:
-    """The bow w0/L of a record whose Southwell fit read the tip grating's load, else None."""
-    if not tip_forces or southwell is None or not southwell.success:
-        return None
-    return southwell.w0_over_l
-
-
 def tip_load_at_buckling(
     rows: Sequence[tuple[str, float, Sequence[float]]],
     tip_forces: Sequence[float | None] | None,
@@ -238,7 +240,7 @@ def verdict_for(
     """The trial's verdicts (``estimation.verdict``) from its fit, its inputs and how it ended:
     on the elastic estimate, and on the relaxed modulus when the trial held (else None).
     ``buckling_tip_load``: the tip grating's load at the buckling mark (N), None without one;
-    ``bow``: w0/L fitted against the tip grating's load (:func:`tip_bow`)."""
+    ``bow``: w0/L fitted against the tip grating's load (``RecordEstimate.tip_bow``)."""
     length = inputs.exposed_length
     if inputs.kind == "robot" and joint is not None and joint.contact is not None:
         length = joint.contact - inputs.flush_translation
@@ -361,7 +363,7 @@ def estimate_trial(
             fitted.lean,
             fitted.relaxation,
             tip_load_at_buckling(result.record, result.tip_forces),
-            tip_bow(fitted.southwell, result.tip_forces),
+            fitted.tip_bow,
         )
     return TrialEstimate(
         paper,
