@@ -260,19 +260,27 @@ def _print_tip(
         )
     if weight is not None:
         verdict = "within" if weight.ok else "beyond"
+        advice = (
+            ""
+            if weight.ok
+            else (
+                ": use it pointing vertically or with the fiber bending in a horizontal plane "
+                "(docs/lung.md)"
+            )
+        )
         print(
             f"weight: held across, the tip sags {weight.sag * 1e3:.3g} mm "
             f"({weight.sag_over_length:.1%} of L, {verdict} {SAG_LIMIT:.1%}; a tip under "
-            f"{weight.tip_mass_limit * 1e3:.2g} g would be within): "
-            + (
-                ""
-                if weight.ok
-                else "use it pointing vertically or with the fiber bending in a "
-                "horizontal plane (docs/lung.md)"
-            )
+            f"{_two_digits_down(weight.tip_mass_limit * 1e3):g} g would be within){advice}"
         )
     if written is not None:
         print(f"wrote {written}")
+
+
+def _two_digits_down(x: float) -> float:
+    """``x`` > 0 to two significant digits, rounded down (a limit printed is one that holds)."""
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.floor(x / scale) * scale
 
 
 def run(args: argparse.Namespace) -> int:
