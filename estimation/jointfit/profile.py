@@ -5,9 +5,15 @@ With the weights frozen at the solution (``noise``), for each candidate (a hypot
 belief, ``estimation.belief``, in one model form) and each x0 on a fine grid, E has a closed form
 Ê(x0) (P0 profiled out too), the weighted residual RSS(x0) and curvature S(x0) (the Schur
 complement of the (E, P0) normal matrix; ``grid.closed_form``). A *family* is the candidates of
-one model form: its region ``RSS + S (E - Ê)^2 <= RSS_min + threshold``, with RSS_min the
-family's minimum over every candidate and x0, projected on E is E's interval (the profile over
-x0 and the nuisances together), and projected on x0 the contact interval. The grid starts at
+one model form. Each candidate's region ``RSS + S (E - Ê)^2 <= RSS_min + threshold``, with
+RSS_min *that candidate's* minimum over x0, is the profile over x0 and the load offset; the
+family's interval of E is the union of its candidates' regions projected on E, and of x0 on
+x0. The record is not let choose between the belief's values (a thickness, a Poisson ratio, a
+compliance within the stated ranges): the closed forms' own error can make it prefer the wrong
+one by more than the noise (a neo-Hookean layer's stiffening reads as a Poisson ratio of 0.5,
+docs/lung.md), so the interval holds E for every value the operator left open. The point
+estimate still weighs them (``Profile.center``, the family's 50 % region over all candidates
+together). The grid starts at
 ``x0_hat +- span`` and widens (x3) until every family's region closes inside it, or reaches the
 search window's edge (then flagged).
 
@@ -168,7 +174,7 @@ def read_family(
     j = min(range(len(usable)), key=lambda m: float(np.min(masked[m])))
     best_k = int(np.argmin(masked[j]))
     best = float(masked[j][best_k])
-    lo, hi, first, last = _projection(usable, best + threshold)
+    lo, hi, first, last = _union(usable, [float(np.min(m)) + threshold for m in masked])
     c_lo, c_hi, _, _ = _projection(usable, best + CENTER_LEVEL * scale2)
     window_edge = (first == 0 and at_low_end) or (last == grid.size - 1 and at_high_end)
     open_grid = (first == 0 or last == grid.size - 1) and not window_edge
@@ -186,6 +192,18 @@ def read_family(
         center=float(np.sqrt(c_lo * c_hi)) if c_lo > 0 else float(E_best),
     )
     return profile, open_grid
+
+
+def _union(fits: Sequence[GridFit], levels: Sequence[float]) -> tuple[float, float, int, int]:
+    """The union of each fit's region ``RSS + S (E - Ê)^2 <= level`` at its own level,
+    projected on E (lo, hi, Pa) and on the grid (first and last index inside)."""
+    parts = [_projection([fit], level) for fit, level in zip(fits, levels, strict=True)]
+    return (
+        min(p[0] for p in parts),
+        max(p[1] for p in parts),
+        min(p[2] for p in parts),
+        max(p[3] for p in parts),
+    )
 
 
 def _projection(fits: Sequence[GridFit], level: float) -> tuple[float, float, int, int]:
