@@ -146,3 +146,25 @@ def test_coverage_with_open_thickness_and_bonding_is_at_least_90_percent() -> No
         u, P, e = record(E, 20e-3, rng, law=law, n=300)
         covered += fit(u, P, e, belief).covers(E)
     assert covered >= 0.9 * trials
+
+
+def test_every_value_the_belief_leaves_open_keeps_its_own_region() -> None:
+    """Two hypotheses (two Poisson ratios of the belief) on one contact grid: the record fits the
+    first far better (its RSS 100 below), yet the interval holds the second's E too: the
+    closed forms' own error can make the record prefer a wrong value (docs/lung.md)."""
+    import numpy as np
+
+    from estimation.jointfit.profile import read_family
+
+    grid = np.linspace(0.0, 1e-3, 11)
+    bowl = (grid - 5e-4) ** 2 * 1e8  # RSS rising away from the grid's middle
+    near = (np.full(11, 10e3), np.zeros(11), bowl, np.full(11, 1e-4))  # E 10 kPa, best fit
+    far = (np.full(11, 11e3), np.zeros(11), bowl + 100.0, np.full(11, 1e-4))  # 11 kPa, worse
+    profile, _ = read_family([near, far], [0, 1], grid, (4.0, 1.0), False, False)
+    assert profile is not None
+    assert profile.modulus == 10e3  # the best point is still the record's preference
+    assert profile.ci_low < 10e3
+    assert profile.ci_high > 11e3  # the second hypothesis's E, 5 sigma of its own away
+    alone, _ = read_family([near], [0], grid, (4.0, 1.0), False, False)
+    assert alone is not None
+    assert alone.ci_high < 11e3  # the first hypothesis alone does not reach the second's E
