@@ -12,7 +12,8 @@ only while a client listens:
 - ``/joint_states`` and ``/fbg/strains`` (JSON): the stage translation and roll, the state, the
   used gratings' strains, the contact event;
 - ``/tip/force`` (JSON): the axial load and the beam's end shortening from the strains (the
-  estimator's beam state of that tick, ``estimation.beamstate``);
+  estimator's beam state of that tick, ``estimation.beamstate``); the load is the tip force
+  grating's where the sensor has one;
 - ``/tf`` (``foxglove.FrameTransforms``): ``base`` -> ``tube_tip`` -> ``sensor_tip`` from the
   tube's forward kinematics (``robot.kinematics``);
 - ``/scene`` (``foxglove.SceneUpdate``): the tube's centreline (straight part and arc) and the
@@ -179,6 +180,8 @@ class _Feed:
             return
         length = self._length(obs.advance)
         load, shortening = self._beam(obs.strains, length)
+        if obs.tip_force is not None:  # a tip force grating reads the load itself
+            load = obs.tip_force
         if v.force.has_sinks():
             v.force.log({"axial_load": load, "end_shortening": shortening}, log_time=stamp)
         if now - self._last_scene >= 1.0 / SCENE_HZ:

@@ -119,3 +119,4 @@ class TeleopView:
     fault: str | None
     message: str
     prompt: str | None
+    tip_force: float | None = None  # N, the tip force grating's load (None: no tip grating)

@@ -382,6 +382,7 @@ class Teleop:
             fault=self.fault,
             message=self.message,
             prompt=self.prompt,
+            tip_force=None if obs is None else obs.tip_force,
         )
 
 

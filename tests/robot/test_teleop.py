@@ -318,3 +318,11 @@ def test_render_before_any_reading() -> None:
     text = "\n".join(render(make().view()))
     assert "advance            - mm" in text
     assert "tube tip   -" in text
+
+
+def test_render_shows_a_tip_gratings_load_when_the_sensor_has_one() -> None:
+    m = make(tube_name="bent30")
+    m.step(dataclasses.replace(obs(42.0), tip_force=3.25e-3))
+    assert "tip load      3.250 mN" in "\n".join(render(m.view()))
+    m.step(obs(42.0))
+    assert "tip load" not in "\n".join(render(m.view()))  # the paper's sensor has none
