@@ -94,6 +94,7 @@ class TrialFacts:
         buckling_tip_load: the tip grating's load at the buckling mark (N), None without one.
         bow: the beam's bow w0/L fitted against the tip grating's load (Southwell), None
             without one (a bow fitted against the strains' own load is not independent).
+        probe_reason: what probing said when it measured no normal, None if not known.
     """
 
     state: str = "done"
@@ -110,6 +111,7 @@ class TrialFacts:
     designed_range: tuple[float, float] | None = None
     buckling_tip_load: float | None = None
     bow: float | None = None
+    probe_reason: str | None = None
 
 
 EARLY_BUCKLING = 0.5
@@ -215,10 +217,14 @@ def _orientation(facts: TrialFacts) -> list[str]:
     if facts.orientation_verified:
         return _within_tolerance(facts)
     seen = "not measured" if lean is None or not lean.success else "none"
+    why = "a straight tube's touches all lie on one line"
+    reason = facts.probe_reason
+    if reason is not None and "straight tube" not in reason:
+        why = f"probing: {reason}"
     return [
-        f"orientation unverified: no normal was measured (a straight tube's touches all lie on "
-        f"one line) and the strains show no lateral load ({seen}), which a sticking contact "
-        f"gives at any tilt within its friction angle"
+        f"orientation unverified: no normal was measured ({why}) and the strains show no "
+        f"lateral load ({seen}), which a sticking contact gives at any tilt within its friction "
+        f"angle"
     ]
 
 

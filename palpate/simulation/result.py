@@ -220,5 +220,6 @@ def estimator_inputs(
         rigid=sample.rigid,
         orientation_verified=probe is None or probe.normal is not None,
         misalignment_sigma=_sigma(probe),
+        probe_reason=None if probe is None or probe.normal is not None else probe.reason,
         **belief,
     )

@@ -257,6 +257,7 @@ def verdict_for(
         misalignment_sigma=inputs.misalignment_sigma,
         relaxation=relaxation,
         designed_range=inputs.designed_range,
+        probe_reason=inputs.probe_reason,
         buckling_tip_load=buckling_tip_load,
         bow=bow,
     )

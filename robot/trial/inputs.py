@@ -51,6 +51,7 @@ class EstimatorInputs:
         misalignment_sigma: the measured normal's 1-sigma angle (rad), None when no normal was
             measured (no probing, or none found).
         designed_range: the moduli (Pa) the sensor was designed for (None: not stated).
+        probe_reason: what probing said when it measured no normal (None: it did, or none ran).
         rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
             (``estimation.compliance``) instead of estimating a modulus.
         version: the inputs' format (VERSION; 1 for logs that predate it).
@@ -76,6 +77,7 @@ class EstimatorInputs:
     orientation_verified: bool = True
     misalignment_sigma: float | None = None
     designed_range: Range | None = None
+    probe_reason: str | None = None
     version: int = VERSION
 
     def as_dict(self) -> dict[str, Any]:
@@ -181,8 +183,10 @@ def probe_inputs(probe: dict[str, Any]) -> dict[str, Any]:
     raw = probe.get("normal_sigma")
     measured = probe.get("normal") is not None
     sigma = float(raw) if isinstance(raw, int | float) else math.nan
+    reason = probe.get("reason")
     return {
         "misalignment": probe["misalignment"],
+        "probe_reason": None if measured or not isinstance(reason, str) else reason,
         "orientation_verified": measured,
         "misalignment_sigma": sigma if measured and math.isfinite(sigma) else None,
     }

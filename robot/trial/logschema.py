@@ -194,6 +194,7 @@ ESTIMATOR = {  # robot.trial.estimate.EstimatorInputs
     "orientation_verified": opt(boolean),  # absent before issue 25: verified
     "misalignment_sigma": opt(number(null=True, ge=0, le=math.pi)),
     "designed_range": opt(numbers(null=True)),  # absent before issue 28: not stated
+    "probe_reason": opt(string(null=True)),
     "version": opt(integer(ge=1)),
 }
 PROBE = {  # robot.probe_plan.ProbeResult: what probing found (robot trials that probe)

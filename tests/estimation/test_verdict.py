@@ -132,3 +132,14 @@ def test_a_bow_measured_against_the_tip_load_beyond_one_percent_is_suspect() -> 
     assert "w0/L = 4.4%" in bowed.reasons[0]
     straight = dataclasses.replace(LUNG, bow=5e-4)
     assert judge(fit(E=15e3), straight, 10e-3).status == "ok"
+
+
+def test_an_unverified_orientation_says_what_probing_said() -> None:
+    base = dataclasses.replace(FACTS, orientation_verified=False)
+    straight = judge(fit(), dataclasses.replace(base, probe_reason=None), R)
+    assert "(a straight tube's touches all lie on one line)" in straight.reasons[0]
+    slipped = dataclasses.replace(base, probe_reason="normal not measured: 4 of 4 touches slipped")
+    v = judge(fit(), slipped, R)
+    assert v.status == "suspect"
+    assert "(probing: normal not measured: 4 of 4 touches slipped)" in v.reasons[0]
+    assert "straight tube" not in v.reasons[0]
