@@ -24,6 +24,7 @@ import numpy as np
 
 from config.schema import StackConfig
 from sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
+from sensor.tipforce import TipForceChain
 from wire.frame import Status
 from wire.frameblock import FrameBlock
 
@@ -93,7 +94,7 @@ def fit_tip_frames(
         ref = block.reference
         if ref is None:
             raise ValueError("a compensated tip grating needs the reference grating in the frames")
-        ratio = tip.temperature_coefficient / stack.fbg.temperature_coefficient
+        ratio = TipForceChain.from_config(tip, stack.fbg).thermal_ratio
         shift = shift - ratio * (ref - ref[:rest_frames].mean())
     force = block.force_un.astype(np.float64) * 1e-6
     fresh = (block.flags & int(Status.FORCE_VALID)) != 0

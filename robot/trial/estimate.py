@@ -48,7 +48,7 @@ from estimation.stiffness import StiffnessEstimate, paper_estimate
 from estimation.strain_fit import fit_strains
 from estimation.verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from robot.trial.inputs import EstimatorInputs
-from robot.trial.lean import lean_of_rows, rows_in
+from robot.trial.lean import lean_of_rows, row_in, rows_in
 from robot.trial.relaxed import relaxation_of
 from robot.trial.run import TrialResult
 from robot.trial.states import LOADING_STATES, record_lengths, states_at
@@ -220,7 +220,7 @@ def _loading_tip(
     picked = [
         math.nan if f is None else float(f)
         for (state, _, strains), f in zip(rows, tip_forces, strict=True)
-        if state in LOADING_STATES and len(strains) == gratings
+        if row_in(state, strains, LOADING_STATES, gratings)
     ]
     tip = np.asarray(picked, dtype=np.float64)
     return tip if tip.size and np.all(np.isfinite(tip)) else None

@@ -20,6 +20,11 @@ from sensor.strain import grating_intervals
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
 
 
+def row_in(state: str, strains: Sequence[float], states: frozenset[str], gratings: int) -> bool:
+    """Whether a (state, advance, strains) row is one :func:`rows_in` picks."""
+    return state in states and len(strains) == gratings
+
+
 def rows_in(
     rows: Iterable[tuple[str, float, Sequence[float]]], states: frozenset[str], gratings: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -28,7 +33,7 @@ def rows_in(
     adv: list[float] = []
     eps: list[Sequence[float]] = []
     for state, advance, strains in rows:
-        if state in states and len(strains) == gratings:
+        if row_in(state, strains, states, gratings):
             adv.append(advance)
             eps.append(strains)
     x = np.asarray(adv, dtype=np.float64)
