@@ -2,7 +2,10 @@
 leaving out what depends on the clock or on where the run wrote (wall and CPU times, speed-ups,
 run folders and log paths). Prints each difference and exits 1 when there is one.
 
-    python3 bench/same_results.py BEFORE.json AFTER.json
+    python3 bench/same_results.py BEFORE.json AFTER.json [--new-keys]
+
+``--new-keys``: a key only in AFTER is not a difference (a change that adds an output and
+leaves every earlier one as it was).
 
 Used to show that a restructure moved code only: run the seeded campaign on both commits (e.g.
 ``palpate sim --campaign paper --no-plots --json`` and ``palpate sim --faults --no-plots
@@ -21,17 +24,20 @@ CLOCK_OR_PLACE = frozenset(
 )
 
 
-def differences(a: Any, b: Any, path: str = "") -> list[str]:
-    """Every place where ``a`` and ``b`` differ, outside the clock's and the folders' fields."""
+def differences(a: Any, b: Any, path: str = "", new_keys: bool = False) -> list[str]:
+    """Every place where ``a`` and ``b`` differ, outside the clock's and the folders' fields
+    (and, with ``new_keys``, the keys only ``b`` has)."""
     if isinstance(a, dict) and isinstance(b, dict):
         out: list[str] = []
         for key in sorted(set(a) | set(b)):
             if key in CLOCK_OR_PLACE:
                 continue
+            if new_keys and key not in a:
+                continue
             if key not in a or key not in b:
                 out.append(f"{path}/{key}: only in {'after' if key in b else 'before'}")
             else:
-                out += differences(a[key], b[key], f"{path}/{key}")
+                out += differences(a[key], b[key], f"{path}/{key}", new_keys)
         return out
     if isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
@@ -39,17 +45,19 @@ def differences(a: Any, b: Any, path: str = "") -> list[str]:
         return [
             d
             for i, (x, y) in enumerate(zip(a, b, strict=True))
-            for d in differences(x, y, f"{path}[{i}]")
+            for d in differences(x, y, f"{path}[{i}]", new_keys)
         ]
     return [] if a == b else [f"{path}: {a!r} before, {b!r} after"]
 
 
 def main(argv: list[str]) -> int:
-    if len(argv) != 2:
+    new_keys = "--new-keys" in argv
+    paths = [a for a in argv if a != "--new-keys"]
+    if len(paths) != 2:
         print(__doc__, file=sys.stderr)
         return 2
-    before, after = (json.loads(Path(p).read_text(encoding="utf-8")) for p in argv)
-    found = differences(before, after)
+    before, after = (json.loads(Path(p).read_text(encoding="utf-8")) for p in paths)
+    found = differences(before, after, new_keys=new_keys)
     for line in found:
         print(line)
     print(f"{len(found)} differences" if found else "identical (clock and folder fields left out)")

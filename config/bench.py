@@ -46,8 +46,10 @@ class BenchTrialConfig:
     """One trial of the bench campaign: a stored pose and what is under it.
 
     ``assumed``: what the operator believes about the sample (``config.sample.AssumedConfig``:
-    thickness, bonding, Poisson's ratio, each a value, a range or ``unknown``); a key left out
-    is ``unknown`` for the thickness and the bonding, and ``poisson`` for the Poisson ratio.
+    thickness, bonding, Poisson's ratio, a convex surface's radius, each a value, a range or
+    ``unknown``); a key left out is ``unknown`` for the thickness, the bonding and the radius
+    (a flat surface is fitted unless the touches show a sphere), and ``poisson`` for the
+    Poisson ratio.
     ``rigid``: the pose faces a rigid reference; the trial calibrates the tube's (the stage's)
     compliance for the session's later trials instead of estimating a modulus.
     """

@@ -39,10 +39,13 @@ class AssumedConfig:
     """What the operator believes about a sample; the estimator is told this.
 
     Each key is a value, a ``[min, max]`` range or ``unknown``; ``thickness_mm`` may also be
-    ``half-space``. A key left out (null) means, in a scene, the sample's own value (the
-    operator knows it), and on the bench: thickness and bonding ``unknown``, Poisson's ratio
-    the trial's ``poisson``. The estimate's interval carries what a range or ``unknown``
-    leaves open (profiled or marginalised), not only the FBG noise.
+    ``half-space``; ``curvature_radius_mm`` is a convex surface's radius (probing fits a sphere
+    of it, the contact law takes the effective radius; ``unknown``: a plane is fitted unless
+    the touches show a sphere, as for a flat sample). A key left out (null) means, in a scene,
+    the sample's own value (the operator knows it), and on the bench: thickness, bonding and
+    radius ``unknown``, Poisson's ratio the trial's ``poisson``. The estimate's interval
+    carries what a range or ``unknown`` leaves open (profiled or marginalised), not only the
+    FBG noise.
     """
 
     thickness_mm: float | Range | Literal["unknown", "half-space"] | None = field(
@@ -52,10 +55,27 @@ class AssumedConfig:
     poisson: float | Range | Literal["unknown"] | None = field(
         default=None, metadata=limits(ge=0, le=0.5)
     )
+    curvature_radius_mm: float | Range | Literal["unknown"] | None = field(
+        default=None, metadata=limits(gt=0, le=1e4)
+    )
 
     def validate(self) -> None:
         _check_range("thickness_mm", self.thickness_mm, 0.0, 1000.0)
         _check_range("poisson", self.poisson, 0.0, 0.5)
+        _check_range("curvature_radius_mm", self.curvature_radius_mm, 1e-9, 1e4)
+
+    def surface_radius(self, own: float | None) -> tuple[float, float] | None:
+        """The convex surface's radius the operator believes, (min, max) in m, or None (a flat
+        or an unknown surface: probing fits a plane, a sphere only where the touches show one).
+        ``own``: the radius (m) a left-out key stands for (a scene's sample's own)."""
+        r = self.curvature_radius_mm
+        if r is None:
+            return None if own is None else (own, own)
+        if isinstance(r, tuple):
+            return (r[0] * MM, r[1] * MM)
+        if isinstance(r, int | float):
+            return (r * MM, r * MM)
+        return None
 
 
 @dataclass(frozen=True)

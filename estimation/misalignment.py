@@ -26,7 +26,9 @@ the beam by ``c P d / EI``, so the strains give the product cP; P itself comes o
 axial strain P/EA, at most ~17 ue below the free tip's capacity and ~0.3 % of the lateral
 bending's own uniform part at a 7 deg lean, and from the shape's slow change with kL. Measured
 on the world's slipping contacts (``docs/orientation.md``, section 7) the fitted size misses
-the truth by more than its profile interval: it is reported, never used as a measurement.
+the truth by more than its profile interval: it is reported, never used as a measurement. The
+misalignment of a sliding tip is measured from its path instead (``estimation.slip_path``:
+strains and stage, no friction needed), and carried in :class:`Lean` beside the detection.
 
 What it measures is the lean of the *load*, not the misalignment psi of the axis to the normal:
 
@@ -84,6 +86,9 @@ class Lean:
         load_share: the largest load of the better fit (free or pinned tip) over the free
             tip's capacity (a pinned tip's record goes past 1; a slipping tip's stays below).
         aligned_chi2: how much worse no lean at all fits, in units of the noise variance.
+        misalignment: psi (rad), the axis's angle to the surface normal measured from the
+            slipping tip's path (``estimation.slip_path``), nan where not measured (no lateral
+            load: a sticking or square contact); misalignment_sigma: its 1-sigma (rad).
     """
 
     success: bool
@@ -93,6 +98,13 @@ class Lean:
     rows: int = 0
     load_share: float = 0.0
     aligned_chi2: float = 0.0
+    misalignment: float = math.nan
+    misalignment_sigma: float = math.inf
+
+    @property
+    def measured(self) -> bool:
+        """The slipping tip's path gave the misalignment."""
+        return math.isfinite(self.misalignment) and math.isfinite(self.misalignment_sigma)
 
     @property
     def lateral(self) -> bool:
@@ -101,9 +113,12 @@ class Lean:
         return self.success and self.aligned_chi2 > DETECT_CHI2
 
     def record(self) -> dict[str, object]:
-        """The fields as JSON values (a trial log's estimate record; inf sigma as null)."""
+        """The fields as JSON values (a trial log's estimate record; inf sigma as null; the
+        misalignment's two only where it was measured, as a log before it has them)."""
         d: dict[str, object] = dataclasses.asdict(self)
         d["sigma"] = self.sigma if math.isfinite(self.sigma) else None
+        if not self.measured:
+            del d["misalignment"], d["misalignment_sigma"]
         return d
 
     @classmethod
@@ -119,6 +134,8 @@ class Lean:
                 int(d["rows"]),  # type: ignore[call-overload]
                 float(d["load_share"]),  # type: ignore[arg-type]
                 float(d["aligned_chi2"]),  # type: ignore[arg-type]
+                float(d.get("misalignment", math.nan)),  # type: ignore[arg-type]
+                float(d.get("misalignment_sigma", math.inf)),  # type: ignore[arg-type]
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"a lean record needs the fields of Lean: {exc}") from exc
@@ -133,6 +150,10 @@ class Lean:
             "load_share": self.load_share,
             "aligned_chi2": self.aligned_chi2,
             "lateral": self.lateral,
+            "misalignment_deg": math.degrees(self.misalignment) if self.measured else None,
+            "misalignment_sigma_deg": (
+                math.degrees(self.misalignment_sigma) if self.measured else None
+            ),
         }
 
 

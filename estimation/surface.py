@@ -138,6 +138,7 @@ class SurfaceFit:
         rms: rms distance (m) of the centres from it.
         normal_sigma: 1-sigma angle (rad) of the outward normal at the reference point.
         points: the number of touches used.
+        params: the model's free parameters (a sphere of known radius 3; 0: the model's own).
     """
 
     success: bool
@@ -147,12 +148,21 @@ class SurfaceFit:
     rms: float = math.nan
     normal_sigma: float = math.nan
     points: int = 0
+    params: int = 0
+
+    @property
+    def free_parameters(self) -> int:
+        """The model's free parameters: ``params``, or 0 for the model's own (plane 3, sphere 4)."""
+        return self.params or (3 if self.model == "plane" else 4)
 
     def surface(self, tip_radius: float) -> SurfaceGeometry:
         """The tissue's surface: the fitted centres' surface moved in by ``tip_radius`` (m)."""
         if self.centres is None:
             raise ValueError(f"no surface: {self.message}")
         return self.centres.offset(-tip_radius)
+
+
+Fitter = Callable[[NDArray[np.float64], Vector], SurfaceGeometry | None]
 
 
 def _points(points: ArrayLike, need: int) -> NDArray[np.float64]:
@@ -197,8 +207,7 @@ def _sphere(p: NDArray[np.float64], hint: Vector) -> SurfaceGeometry | None:
     return SurfaceGeometry(c + r * hint, hint, r)
 
 
-_FITTERS: dict[Model, tuple[int, Callable[[NDArray[np.float64], Vector], SurfaceGeometry | None]]]
-_FITTERS = {"plane": (3, _plane), "sphere": (4, _sphere)}
+_FITTERS: dict[Model, tuple[int, Fitter]] = {"plane": (3, _plane), "sphere": (4, _sphere)}
 
 
 def _fit(
@@ -210,6 +219,23 @@ def _fit(
     hint: ArrayLike,
 ) -> SurfaceFit:
     need, fitter = _FITTERS[model]
+    return fit_with(fitter, model, need, points, sigma, directions, reference, hint)
+
+
+def fit_with(
+    fitter: Fitter,
+    model: Model,
+    need: int,
+    points: ArrayLike,
+    sigma: float,
+    directions: ArrayLike | None,
+    reference: ArrayLike | None,
+    hint: ArrayLike,
+    label: str | None = None,
+) -> SurfaceFit:
+    """A fit by ``fitter`` (points (N, 3), outward hint -> geometry or None) of ``need``
+    parameters, with the normal's uncertainty propagated (module docstring); ``label`` names
+    the model in the message (the model's name by default)."""
     p = _points(points, need)
     h = unit(hint, "outward hint")
     rays = _rays(p, directions)
@@ -224,13 +250,15 @@ def _fit(
     geo = fitter(p, h)
     if geo is None:
         why = "collinear" if model == "plane" else "coplanar or degenerate"
-        return SurfaceFit(False, f"{len(p)} touches are {why}: no {model}", model, points=len(p))
+        return SurfaceFit(
+            False, f"{len(p)} touches are {why}: no {label or model}", model, points=len(p)
+        )
     if geo.radius is not None:  # the point nearest the reference, normal outward there
         n_ref = unit(ref - geo.centre, "reference")
         geo = SurfaceGeometry(geo.centre + geo.radius * n_ref, n_ref, geo.radius)
     resid = np.array([geo.distance(q) for q in p])
     rms = float(np.sqrt(np.mean(resid**2)))
-    dof = len(p) - (3 if model == "plane" else 4)
+    dof = len(p) - need
     noise = max(sigma, rms * math.sqrt(len(p) / dof)) if dof > 0 else sigma
     n0 = normal(p)
     assert n0 is not None  # the fit succeeded on p
@@ -241,8 +269,8 @@ def _fit(
         ni = normal(q)
         jac[:, i] = 0.0 if ni is None else (ni - n0) / _STEP
     spread = float(np.sqrt(np.sum(jac**2))) * noise
-    message = f"{model} through {len(p)} touches, rms {rms * 1e6:.1f} um"
-    return SurfaceFit(True, message, model, geo, rms, spread, len(p))
+    message = f"{label or model} through {len(p)} touches, rms {rms * 1e6:.1f} um"
+    return SurfaceFit(True, message, model, geo, rms, spread, len(p), need)
 
 
 def _rays(p: NDArray[np.float64], directions: ArrayLike | None) -> NDArray[np.float64]:

@@ -127,12 +127,12 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
     (m) is the sensor's, for the depth buckling needs."""
     soft = _too_soft(fit, facts, tip_radius)
     if soft is not None:
-        return Verdict("none", (soft,))
+        return _none(soft, facts)
     if fit is None or not fit.success or fit.modulus is None:
-        return Verdict("none", ("no estimate: " + ("no fit" if fit is None else fit.message),))
+        return _none("no estimate: " + ("no fit" if fit is None else fit.message), facts)
     outside = _outside_range(fit, facts.designed_range)
     if outside is not None:
-        return Verdict("none", (outside,))
+        return _none(outside, facts)
     reasons = [w for w in fit.warnings if _is_suspect(w)]
     imprecise = _imprecise(fit)
     if imprecise is not None:
@@ -144,6 +144,14 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
             "indentation speed, between the two; the relaxed modulus is the tissue's long-time one"
         )
     return Verdict("suspect", tuple(reasons)) if reasons else Verdict("ok")
+
+
+def _none(reason: str, facts: TrialFacts) -> Verdict:
+    """No number, for ``reason``; a tip that slid says so too (its load never reached the
+    pinned beam's, which may be why)."""
+    lean = facts.lean
+    slid = tuple(_orientation(facts)) if lean is not None and lean.lateral else ()
+    return Verdict("none", (reason, *slid))
 
 
 def _outside_range(fit: JointFit, designed: tuple[float, float] | None) -> str | None:
@@ -208,11 +216,17 @@ def _orientation(facts: TrialFacts) -> list[str]:
     """Why the sensor's orientation to the surface is not known to be square (empty if it is)."""
     lean = facts.lean
     if lean is not None and lean.lateral:
+        slid = (
+            f"the strains show a lateral load from the first touch (the tip slid on a surface "
+            f"oblique beyond its friction angle; a pinned tip fits {lean.aligned_chi2:.0f} noise "
+            f"variances worse)"
+        )
+        if not lean.measured:
+            return [f"misaligned: {slid}; its angle was not measured ({lean.message})"]
         return [
-            f"misaligned: the strains show a lateral load from the first touch (the tip slid on "
-            f"a surface oblique beyond its friction angle; a pinned tip fits "
-            f"{lean.aligned_chi2:.0f} noise variances worse); the angle's size is not "
-            f"measurable from three gratings"
+            f"misaligned: misalignment {math.degrees(lean.misalignment):.1f} +- "
+            f"{math.degrees(lean.misalignment_sigma):.1f} deg measured from the strains and the "
+            f"stage (the slipping tip's path; a slide off the fiber's plane reads high); {slid}"
         ]
     if facts.orientation_verified:
         return _within_tolerance(facts)

@@ -33,9 +33,10 @@ from numpy.typing import NDArray
 from config.schema import TubeConfig
 from estimation.beamstate import axial_strain
 from estimation.corrections import MAX_MISALIGNMENT
-from estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane, fit_surface
+from estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane
 from robot import kinematics
 from robot.indentation import TrialPlan
+from robot.probe_fit import NORMAL_SIGMAS, allowed_residual, scaled_sigma, touch_surface
 from robot.probe_result import ProbeResult, Touch
 
 Vector = NDArray[np.float64]
@@ -44,13 +45,6 @@ SWEEP_STEPS = 8  # rays checked along a roll for the retract before it
 ROLL_MARGIN = math.radians(1.0)  # probe rolls stay this far inside the roll limits
 SPREAD_STEP = 1e-6  # m, a touch moved along its ray for the spread of a prediction
 MODE_STEP = 50e-6  # m of exposed length between the bending shapes the load is read with
-# A pose this many of the measured normal's 1-sigma angles past the angle tolerance cannot be
-# told from one within it: it is indented, and the verdict reads its residual (suspect beyond
-# the tolerance) instead of the trial ending unreachable on a noisy normal.
-NORMAL_SIGMAS = 2.0
-# ... but never past MAX_MISALIGNMENT (5 deg), where the indentation is no longer normal (the
-# estimator's validity flag): a normal so uncertain that a pose 30 deg off "cannot be told" from
-# square is not measured well enough to indent on, and the trial says so before it indents.
 
 
 @dataclass(frozen=True)
@@ -76,6 +70,10 @@ class ProbeSettings:
             not where the plan says (m).
         budget: simulated or real seconds probing may take (:func:`probe_budget`, from the
             drive's limits); past it the trial ends ``unreachable`` (inf: no budget).
+        surface_radius: the radius (min, max; m) the operator believes a convex sample's
+            surface has: the touches are fitted by a sphere of that radius
+            (``estimation.surface_belief``); None: a plane, or a sphere where the touches show
+            one (the tilt across a tube's cone is not observable on a sphere of unknown radius).
     """
 
     offsets: tuple[float, ...]
@@ -93,6 +91,7 @@ class ProbeSettings:
     budget: float = math.inf
     search: float = 0.0
     touch_force: float | None = None
+    surface_radius: tuple[float, float] | None = None
 
 
 class ProbeGeometry:
@@ -246,14 +245,11 @@ class ProbeGeometry:
             return self._unmeasured(touches, plan, settings, why)
         centres = np.array([t.centre for t in held])
         rays = np.array([t.tangent for t in held])
-        fit = fit_surface(
-            centres, sigma=settings.sigma, hint=-rays.mean(axis=0), directions=rays,
-            reference=centres[0],
-        )  # fmt: skip
+        fit = touch_surface(centres, rays, settings.sigma, settings.surface_radius, self.tip_radius)
         if not fit.success:
             return self._unmeasured(touches, plan, settings, fit.message)
         surface = fit.surface(self.tip_radius)
-        normal_sigma = _scaled_sigma(fit, settings.sigma)
+        normal_sigma = scaled_sigma(fit, settings.sigma)
         n0 = surface.normal_at(centres[0])
         target = centres[0] - self.tip_radius * n0
         ik = kinematics.solve_for_tube(
@@ -274,7 +270,7 @@ class ProbeGeometry:
         n = surface.normal
         return ProbeResult(
             ik.reachable or not settings.replan,
-            _reason(ik, settings, normal_sigma),
+            _reason(ik, settings, normal_sigma) + _curved_hint(ik, fit, settings),
             roll,
             advance,
             ik.residual,
@@ -336,24 +332,6 @@ def _plan_pose(
     return kinematics.IKSolution(geo.tube.name, plan.roll, advance, hit, residual, 0, centre, miss)
 
 
-def allowed_residual(tolerance: float, normal_sigma: float) -> float:
-    """The residual angle (rad) a probed pose may have: the tolerance plus NORMAL_SIGMAS of the
-    measured normal's 1-sigma, capped at the larger of the tolerance and MAX_MISALIGNMENT."""
-    return min(tolerance + NORMAL_SIGMAS * normal_sigma, max(tolerance, MAX_MISALIGNMENT))
-
-
-def _scaled_sigma(fit: SurfaceFit, sigma: float) -> float:
-    """The normal's 1-sigma angle, scaled up when the touches scatter about the fitted surface
-    more than their assumed ``sigma`` (m) says (the square root of chi^2 per degree of freedom,
-    as a weighted fit's uncertainty is when the a-priori sigma is in doubt; never scaled down).
-    A plane has 3 parameters, a sphere 4; with no spare touch the assumed sigma stands."""
-    dof = fit.points - (3 if fit.model == "plane" else 4)
-    if dof < 1 or not math.isfinite(fit.rms) or sigma <= 0.0:
-        return fit.normal_sigma
-    ratio = math.sqrt(fit.points / dof) * fit.rms / sigma
-    return fit.normal_sigma * max(1.0, ratio)
-
-
 def _reason(ik: kinematics.IKSolution, settings: ProbeSettings, normal_sigma: float) -> str:
     found = f"residual {math.degrees(ik.residual):.2f} deg, miss {ik.miss * 1e3:.1f} mm"
     if ik.reachable and ik.residual > settings.max_residual:
@@ -369,6 +347,18 @@ def _reason(ik: kinematics.IKSolution, settings: ProbeSettings, normal_sigma: fl
         f"{capped}, {settings.max_miss * 1e3:.0f} mm"
     )
     return f"no orthogonal pose of tube {ik.tube}: {ik.reason} ({found}; {limits})"
+
+
+def _curved_hint(ik: kinematics.IKSolution, fit: SurfaceFit, settings: ProbeSettings) -> str:
+    """What else the touches may be: one tube's touches on a convex sphere fit a plane to a few
+    micrometres, tilted across the tube's cone (``estimation.surface_belief``)."""
+    if ik.reachable or fit.model != "plane" or settings.surface_radius is not None:
+        return ""
+    return (
+        "; a convex surface gives such touches too (its tilt across the tube's cone is not "
+        "observable from one tube): with its radius believed (assumed.curvature_radius_mm) "
+        "the touches are fitted by that sphere"
+    )
 
 
 def _model(

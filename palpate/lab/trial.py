@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from config.bench import LoadedBench
-from config.sample import UNKNOWN
+from config.sample import UNKNOWN, AssumedConfig
 from config.schema import MM, StackConfig, TubeConfig
 from estimation.compliance import ComplianceFit
 from estimation.jointfit import JointFit
@@ -235,7 +235,8 @@ def _run_one(
     with TrialLogWriter(path, _header(trial, loaded, section, inputs), mcap=True) as log:
         guards = guards_for(c, stack, rig.tick)
         # the robot probes the surface first when the campaign says so (null: it does)
-        prober = prober_for(c, stack, trial.tube) if trial.kind == "robot" else None
+        radius = (trial.assumed or AssumedConfig()).surface_radius(None)
+        prober = prober_for(c, stack, trial.tube, radius) if trial.kind == "robot" else None
         detector = detector_for(c, chain)
         result = run_trial(
             rig, hw.clock, trial.plan, guards, detector, log, prober=prober, on_tick=publisher

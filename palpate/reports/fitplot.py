@@ -46,7 +46,7 @@ def record_fit(log: TrialLog, path: Path) -> Path:
     advance = np.array([r["advance"] for r in rows], dtype=np.float64)
     strains = np.array([r["strains"] for r in rows], dtype=np.float64).reshape(-1, gratings)
     states, _ = record_states(advance, strains, inputs, sensor, section)
-    best = Hypothesis.described(joint["best"], inputs.tip_radius, inputs.belief().layer_law)
+    best = Hypothesis.described(joint["best"], inputs.contact_radius, inputs.belief().layer_law)
     law, compliance = best.law, best.compliance
     x0, offset = float(joint["contact"]), float(joint.get("load_offset") or 0.0)
     depth = advance - states.e - compliance * states.P - x0

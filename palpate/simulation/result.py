@@ -203,7 +203,11 @@ def estimator_inputs(
     robot = spec.kind == "robot"
     compliance, calibrated = stack.compliance(geo.tube if robot else None)
     belief = belief_fields(
-        sample.assumed, thickness=sample.thickness, bonded=sample.bonded, poisson=sample.poisson
+        sample.assumed,
+        thickness=sample.thickness,
+        bonded=sample.bonded,
+        poisson=sample.poisson,
+        surface_radius=sample.curvature_radius,
     )
     return EstimatorInputs(
         kind=spec.kind,

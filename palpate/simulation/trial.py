@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
+from config.sample import AssumedConfig
 from config.scene import CampaignConfig, FidelityConfig, SceneConfig
 from config.schema import ServoBusConfig, StackConfig
 from palpate.live import LiveView
@@ -35,7 +36,7 @@ from palpate.simulation.world import (
 )
 from robot.drive import DriveController
 from robot.dynamixel.driver import DynamixelBus
-from robot.indentation import Observation, State, TrialPlan
+from robot.indentation import Observation, Prober, State, TrialPlan
 from robot.rig import RigSettings, ServoFbgRig
 from robot.trial.log import TrialLogWriter
 from robot.trial.record import estimate_record, header_common
@@ -194,9 +195,7 @@ def run_sim_trial(
             with _trial_log(log_dir, spec, scene, stack, plan, geo, hook) as log:
                 guards = guards_for(c, stack, rig.tick)
                 detector = detector_for(c, chain)
-                prober = (
-                    prober_for(c, stack, stack.tube(geo.tube)) if spec.kind == "robot" else None
-                )
+                prober = _prober(spec, scene, stack, geo.tube)
                 result = run_trial(
                     rig, clock, plan, guards, detector, log, on_tick=on_tick, prober=prober
                 )
@@ -341,3 +340,15 @@ def _header(
         "scene": scene.name,
         **header_common(plan, sensor_section(stack), stack.sensor, tube, inputs.poisson, inputs),
     }
+
+
+def _prober(
+    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, tube: str
+) -> Callable[[TrialPlan], Prober] | None:
+    """A robot trial's probing step, told the convex surface's radius the operator believes
+    for its sample (its ``assumed:``, else its own); None on the bench or without probing."""
+    if spec.kind != "robot":
+        return None
+    sample = trial_sample(scene, spec)
+    radius = (sample.assumed or AssumedConfig()).surface_radius(sample.curvature_radius)
+    return prober_for(trial_campaign(spec, scene), stack, stack.tube(tube), radius)

@@ -261,7 +261,7 @@ def verdict_for(
         buckling_tip_load=buckling_tip_load,
         bow=bow,
     )
-    elastic = judge(joint, facts, inputs.tip_radius)
+    elastic = judge(joint, facts, inputs.contact_radius)
     return elastic, relaxed_verdict(relaxation, elastic, facts)
 
 

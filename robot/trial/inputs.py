@@ -52,6 +52,8 @@ class EstimatorInputs:
             measured (no probing, or none found).
         designed_range: the moduli (Pa) the sensor was designed for (None: not stated).
         probe_reason: what probing said when it measured no normal (None: it did, or none ran).
+        surface_radius: the convex surface's believed radius (m; the middle of a believed
+            range), None: flat or unknown; the contact law takes :attr:`contact_radius`.
         rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
             (``estimation.compliance``) instead of estimating a modulus.
         version: the inputs' format (VERSION; 1 for logs that predate it).
@@ -78,7 +80,16 @@ class EstimatorInputs:
     misalignment_sigma: float | None = None
     designed_range: Range | None = None
     probe_reason: str | None = None
+    surface_radius: float | None = None
     version: int = VERSION
+
+    @property
+    def contact_radius(self) -> float:
+        """The contact's effective radius (m): the tip's, or with a convex surface of believed
+        radius R_s, Hertz's 1 / (1 / R_tip + 1 / R_s)."""
+        if self.surface_radius is None:
+            return self.tip_radius
+        return 1.0 / (1.0 / self.tip_radius + 1.0 / self.surface_radius)
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -97,7 +108,7 @@ class EstimatorInputs:
 
     def law(self) -> ContactLaw:
         """The nominal contact law."""
-        return ContactLaw(self.tip_radius, self.poisson, self.thickness, self.bonded, True)
+        return ContactLaw(self.contact_radius, self.poisson, self.thickness, self.bonded, True)
 
     def belief(self) -> Belief:
         """What the joint fit profiles over (``estimation.belief``)."""
@@ -107,7 +118,7 @@ class EstimatorInputs:
             lo, hi = self.thickness_range
             thickness = (lo, math.inf if hi is None else hi)
         return Belief(
-            self.tip_radius,
+            self.contact_radius,
             self.poisson_range or (self.poisson, self.poisson),
             thickness,
             self.bonded_options or (self.bonded,),
@@ -121,13 +132,14 @@ def belief_fields(
     thickness: float | str | None,
     bonded: bool | str,
     poisson: float,
+    surface_radius: float | None = None,
 ) -> dict[str, Any]:
     """The :class:`EstimatorInputs` fields of an operator's belief (``poisson``, ``thickness``,
     ``bonded`` and their ranges): each key of ``assumed`` (``config.sample.AssumedConfig``)
     that is left out takes the default given here, in the same forms: ``thickness`` in m (None
     or ``"half-space"``: a half-space; ``"unknown"``), ``bonded`` (or ``"unknown"``),
-    ``poisson``. A scene gives the sample's own values; the bench gives thickness and bonding
-    ``"unknown"`` and the trial's Poisson ratio."""
+    ``poisson``, ``surface_radius`` (m, None: flat). A scene gives the sample's own values; the
+    bench gives thickness and bonding ``"unknown"``, the trial's Poisson ratio and no radius."""
     a = assumed or AssumedConfig()
     h = thickness if a.thickness_mm is None else _thickness_m(a.thickness_mm)
     b = bonded if a.bonded is None else a.bonded
@@ -160,6 +172,9 @@ def belief_fields(
         out["poisson"] = float(nu)
     else:
         raise ValueError(f"poisson: expected a value, a range or 'unknown', got {nu!r}")
+    radii = a.surface_radius(surface_radius)
+    if radii is not None:
+        out["surface_radius"] = 0.5 * (radii[0] + radii[1])
     return out
 
 

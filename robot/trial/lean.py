@@ -2,11 +2,14 @@
 
 The rows before buckling (states approach, contact, indenting) with their exposed lengths go to
 :func:`estimation.misalignment.measure_lean`; the rows after (``buckled``) are the elastica's,
-which the lateral load's linear shape does not describe.
+which the lateral load's linear shape does not describe. Where the lean shows the tip slid,
+every loading row (the slide goes on past the detector's mark: nothing buckled) goes with its
+advance to :func:`estimation.slip_path.measure_slip_path`, the misalignment from the tip's path.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable, Sequence
 
 import numpy as np
@@ -15,6 +18,8 @@ from numpy.typing import NDArray
 from config.schema import SensorConfig
 from estimation.misalignment import Lean, measure_lean
 from estimation.section import Section
+from estimation.slip_path import measure_slip_path
+from robot.trial.states import LOADING_STATES
 from sensor.strain import grating_intervals
 
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
@@ -62,15 +67,25 @@ def lean_of_rows(
     x, strains = rows_in(rows, PRE_BUCKLING, gratings)
     if not x.size:
         return Lean(False, "no rows before buckling")
-    lengths = np.asarray(
-        x - flush_translation if kind == "robot" else np.full(x.size, exposed_length),
-        dtype=np.float64,
+    lengths = _lengths(x, kind, exposed_length, flush_translation)
+    from_tip = grating_spans_from_tip(sensor)
+    lean = measure_lean(strains, lengths, from_tip, section.EA, section.EI, section.fiber_offset)
+    if not lean.lateral:
+        return lean
+    x, strains = rows_in(rows, LOADING_STATES, gratings)  # the slide goes on past the detector
+    lengths = _lengths(x, kind, exposed_length, flush_translation)
+    path = measure_slip_path(
+        strains, x, lengths, from_tip, section.EA, section.EI, section.fiber_offset
     )
-    return measure_lean(
-        strains,
-        lengths,
-        grating_spans_from_tip(sensor),
-        section.EA,
-        section.EI,
-        section.fiber_offset,
-    )
+    if not path.success:
+        return dataclasses.replace(lean, message=f"no misalignment from the path: {path.message}")
+    return dataclasses.replace(lean, misalignment=path.angle, misalignment_sigma=path.sigma)
+
+
+def _lengths(
+    x: NDArray[np.float64], kind: str, exposed_length: float, flush_translation: float
+) -> NDArray[np.float64]:
+    """The exposed length at each advance: on the robot advance - flush translation."""
+    if kind == "robot":
+        return np.asarray(x - flush_translation, dtype=np.float64)
+    return np.full(x.size, exposed_length)

@@ -195,6 +195,7 @@ ESTIMATOR = {  # robot.trial.estimate.EstimatorInputs
     "misalignment_sigma": opt(number(null=True, ge=0, le=math.pi)),
     "designed_range": opt(numbers(null=True)),  # absent before issue 28: not stated
     "probe_reason": opt(string(null=True)),
+    "surface_radius": opt(number(null=True, gt=0)),  # absent before: flat or unknown
     "version": opt(integer(ge=1)),
 }
 PROBE = {  # robot.probe_plan.ProbeResult: what probing found (robot trials that probe)

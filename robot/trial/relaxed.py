@@ -59,7 +59,7 @@ def relaxation_of(
     )
     states, _ = record_states(advance, strains, inputs, sensor, section)
     thin = 1.0 / np.sqrt(counts)  # a block's mean has 1/sqrt(n) of a row's noise
-    best = Hypothesis.described(joint.best, inputs.tip_radius, inputs.belief().layer_law)
+    best = Hypothesis.described(joint.best, inputs.contact_radius, inputs.belief().layer_law)
     law, compliance = best.law, best.compliance
     record = RelaxationRecord(
         times=t,

@@ -68,36 +68,21 @@ def probe_offsets(points: int, step: float) -> tuple[float, ...]:
 
 
 def prober_for(
-    campaign: CampaignConfig, stack: StackConfig, tube: TubeConfig
+    campaign: CampaignConfig,
+    stack: StackConfig,
+    tube: TubeConfig,
+    surface_radius: tuple[float, float] | None = None,
 ) -> Callable[[TrialPlan], Prober] | None:
     """The probing step of a campaign's trials with ``tube`` (``robot.probing``), None when
     the campaign does not probe. Touches are approached at ``PROBE_SPEED``: the stage stops
     v^2 / 2a past the touch (0.06 mm at 2.5 mm/s and 50 mm/s^2, 0.25 mm at 5 mm/s, which on
-    a 1 MPa sample is the whole way to buckling); the moves between them at the top speed."""
+    a 1 MPa sample is the whole way to buckling); the moves between them at the top speed.
+    ``surface_radius``: the convex surface's believed radius (min, max; m), None: flat or
+    unknown (``config.sample.AssumedConfig.surface_radius``)."""
     probing = campaign.probing()
     if probing is False:
         return None
-    section = sensor_section(stack)
-    fiber_offset = section.fiber_offset
-
-    def bending(length: float) -> tuple[float, ...]:
-        intervals = grating_intervals(stack.sensor, length)
-        return tuple(onset_mode(intervals, length, fiber_offset).tolist())
-
-    def loads(advance: FloatArray, strains: FloatArray) -> FloatArray:
-        lengths = advance - tube.flush_translation
-        intervals = grating_intervals(stack.sensor, 0.0)[None, :, :] + lengths[:, None, None]
-        states = infer_states(strains, intervals, lengths, section.EA, fiber_offset, 1e-6)
-        return np.asarray(states.P / section.EA)
-
-    geometry = ProbeGeometry(
-        tube,
-        tip_radius=stack.sensor.tip_radius,
-        translation_limits=stack.drive.translation_limits,
-        roll_limits=stack.drive.roll_limits,
-        bending_mode=bending,
-        loads=loads,
-    )
+    geometry = probe_geometry(stack, tube)
 
     def build(plan: TrialPlan) -> Prober:
         step = geometry.roll_step(campaign.probe_sagitta_mm * MM, plan.roll, plan.contact_advance)
@@ -113,6 +98,7 @@ def prober_for(
             standoff=plan.standoff,
             replan=probing is True,
             search=PROBE_SEARCH,
+            surface_radius=surface_radius,
         )
         budget = probe_budget(
             settings.offsets,
@@ -127,6 +113,32 @@ def prober_for(
         return ProbeRoutine(geometry, settings, plan)
 
     return build
+
+
+def probe_geometry(stack: StackConfig, tube: TubeConfig) -> ProbeGeometry:
+    """Probing's view of ``tube``: its kinematics, the tip, the drive's limits, the beam's
+    bending shape at an exposed length and the loads a record's strains show."""
+    section = sensor_section(stack)
+    fiber_offset = section.fiber_offset
+
+    def bending(length: float) -> tuple[float, ...]:
+        intervals = grating_intervals(stack.sensor, length)
+        return tuple(onset_mode(intervals, length, fiber_offset).tolist())
+
+    def loads(advance: FloatArray, strains: FloatArray) -> FloatArray:
+        lengths = advance - tube.flush_translation
+        intervals = grating_intervals(stack.sensor, 0.0)[None, :, :] + lengths[:, None, None]
+        states = infer_states(strains, intervals, lengths, section.EA, fiber_offset, 1e-6)
+        return np.asarray(states.P / section.EA)
+
+    return ProbeGeometry(
+        tube,
+        tip_radius=stack.sensor.tip_radius,
+        translation_limits=stack.drive.translation_limits,
+        roll_limits=stack.drive.roll_limits,
+        bending_mode=bending,
+        loads=loads,
+    )
 
 
 def tip_touch_force(stack: StackConfig, length: float) -> float | None:

@@ -38,6 +38,8 @@ def test_assumed_takes_a_value_a_range_or_unknown() -> None:
         ({"poisson": [0.4, 0.6]}, "samples[0].assumed.poisson"),
         ({"bonded": "maybe"}, "samples[0].assumed.bonded"),
         ({"thickness_mm": -3}, "samples[0].assumed.thickness_mm"),
+        ({"curvature_radius_mm": [40, 30]}, "samples[0].assumed"),
+        ({"curvature_radius_mm": 0}, "samples[0].assumed.curvature_radius_mm"),
     ],
 )
 def test_bad_beliefs_name_the_key(assumed: dict[str, object], key: str) -> None:
@@ -54,6 +56,19 @@ def test_surface_pose_in_si() -> None:
     assert s.curvature_radius == pytest.approx(25e-3)
     assert s.offset == pytest.approx((1e-3, -2e-3, 3e-3))
     assert SampleConfig(name="F", modulus_kpa=300).curvature_radius is None
+
+
+def test_a_believed_surface_radius_is_the_samples_own_a_value_a_range_or_unknown() -> None:
+    """Probing fits a sphere of the believed radius (m); None: flat or unknown (a plane)."""
+    assert AssumedConfig().surface_radius(None) is None
+    assert AssumedConfig().surface_radius(30e-3) == (30e-3, 30e-3)  # a scene: the sample's own
+    assert AssumedConfig(curvature_radius_mm=60).surface_radius(30e-3) == pytest.approx(
+        (60e-3, 60e-3)
+    )
+    assert AssumedConfig(curvature_radius_mm=(27, 33)).surface_radius(None) == pytest.approx(
+        (27e-3, 33e-3)
+    )
+    assert AssumedConfig(curvature_radius_mm="unknown").surface_radius(30e-3) is None
 
 
 def test_scene_defaults_are_the_papers_phantoms() -> None:

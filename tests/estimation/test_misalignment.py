@@ -107,6 +107,25 @@ def test_ok_requires_a_verified_orientation() -> None:
         assert any(r.startswith("misaligned: the strains show a lateral load") for r in v.reasons)
 
 
+def test_a_slide_names_the_angle_its_path_shows_even_without_a_number() -> None:
+    """The verdict reads the slipping tip's misalignment (``estimation.slip_path``); a trial
+    with no modulus (its load never reached the pinned beam's) says it slid as well."""
+    slid = Lean(True, "", math.radians(2.0), math.radians(1.0), 200, 0.5, 2e4,
+                math.radians(12.2), math.radians(0.5))  # fmt: skip
+    assert slid.measured
+    v = judge(_ok_fit(), TrialFacts(lean=slid), 3.5e-3)
+    assert v.status == "suspect"
+    assert any(r.startswith("misaligned: misalignment 12.2 +- 0.5 deg") for r in v.reasons)
+    none = judge(None, TrialFacts(lean=slid), 3.5e-3)
+    assert none.status == "none"
+    assert none.reasons[0].startswith("no estimate")
+    assert any(r.startswith("misaligned: misalignment 12.2") for r in none.reasons)
+    assert Lean.from_record(slid.record()) == slid
+    quiet = Lean(True, "", 0.0, math.radians(0.3), 200, 5.0, 1.0)
+    assert judge(None, TrialFacts(lean=quiet), 3.5e-3).reasons == ("no estimate: no fit",)
+    assert "misalignment" not in quiet.record()
+
+
 def test_a_measured_misalignment_is_verified_within_the_tolerance_at_two_sigmas() -> None:
     tol = math.radians(2.0)
 

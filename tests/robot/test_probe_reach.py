@@ -9,7 +9,8 @@ import math
 import pytest
 
 from estimation.surface import SurfaceFit
-from robot.probe_plan import _scaled_sigma, allowed_residual
+from robot.probe_fit import allowed_residual
+from robot.probe_fit import scaled_sigma as _scaled_sigma
 
 SIGMA = 10e-6  # m, the touches' assumed uncertainty
 
