@@ -140,7 +140,13 @@ def test_description_names_the_table() -> None:
 
 SCENES = [
     p
-    for pattern in ("*.yaml", "layers/*.yaml", "lung/*.yaml")
+    for pattern in (
+        "*.yaml",
+        "layers/*.yaml",
+        "lung/*.yaml",
+        "oblique/*.yaml",
+        "viscoelastic/*.yaml",
+    )
     for p in sorted(Path(resolve("scenes/bench.yaml")).parent.glob(pattern))
 ]
 
