@@ -24,9 +24,11 @@ angle's 1-sigma: the least squares' own, widened by the residual's scatter, the 
 tan(psi) over the leans within one unit of chi^2, and ``MODEL_FLOOR`` in quadrature.
 
 One fiber sees one component: ``w`` is the deflection in the fiber's bending plane, ``s w`` of
-a slide at an angle acos(s) to it, so the angle read is ``atan(tan(psi) / |s|)``: exact when the
-slide lies in the fiber's plane (a straight tube rolled to the tilt, any bent tube's roll on a
-tilt along its cone), an upper bound otherwise. Shapes: N rows, G gratings.
+a slide at an angle acos(s) to it, so the angle read is at least ``atan(tan(psi) / |s|)`` (the
+bow, from the lean seen, falls short too): exact when the slide lies in the fiber's plane (a
+straight tube rolled to the tilt, any bent tube's roll on a tilt along its cone), an upper bound
+otherwise (8 and 16 deg read 15 and 25 deg at 45 deg off the plane). Shapes: N rows, G
+gratings.
 """
 
 from __future__ import annotations
