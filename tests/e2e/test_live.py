@@ -100,6 +100,8 @@ def _refused_within(host: str, port: int, bound: float) -> bool:
             socket.create_connection((host, port), timeout=5).close()
         except ConnectionRefusedError:
             return True
+        except ConnectionResetError:
+            pass  # the listener closed with this connection in its backlog: closing, poll on
         threading.Event().wait(0.05)  # the condition is polled, not a timed expectation
     return False
 
