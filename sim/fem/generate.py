@@ -50,13 +50,27 @@ for _h in (10e-3, 20e-3, 40e-3):
         SHIPPED[f"lung-{_h * 1e3:g}mm-nu{_nu:g}"] = LayerProblem.from_dimensions(
             10e-3, _h, 60e-3, poisson=_nu, material="neo-hookean", contact="stick"
         )
+# the mismatch scenes (``config/scenes/mismatch/``): the paper's layer at other nu, sliding,
+# and at other thicknesses
+for _nu in (0.40, 0.42, 0.47, 0.49):
+    SHIPPED[f"mismatch-nu{_nu:g}"] = LayerProblem.from_dimensions(
+        **{**_PAPER, "poisson": _nu}, contact="stick"
+    )
+SHIPPED["mismatch-sliding"] = LayerProblem.from_dimensions(
+    **_PAPER, base="sliding", contact="stick"
+)
+for _h in (5e-3, 6e-3, 8e-3, 12e-3, 16e-3, 20e-3, 30e-3):
+    SHIPPED[f"mismatch-{_h * 1e3:g}mm"] = LayerProblem.from_dimensions(
+        **{**_PAPER, "thickness": _h}, contact="stick"
+    )
 # wet tissue's friction (0.05) slides: ``config/scenes/lung/slip.yaml``
 SHIPPED["lung-20mm-nu0.45-frictionless"] = LayerProblem.from_dimensions(
     10e-3, 20e-3, 60e-3, poisson=0.45, material="neo-hookean", contact="frictionless"
 )
 """The problems whose tables ship in ``sim/fem/tables``, by name: the paper's and the soft
 designs' phantoms, the half-space stand-in, the thin and deep layers of
-``config/scenes/layers/`` (R = 3.5 mm, frictionless tip) and the lung scene's neo-Hookean layers
+``config/scenes/layers/`` (R = 3.5 mm, frictionless tip), the mismatch scenes' layers (other nu,
+sliding, 5-30 mm) and the lung scene's neo-Hookean layers
 (R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung/``, its slip scene frictionless)."""
 
 
