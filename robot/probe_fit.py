@@ -1,4 +1,4 @@
-"""The surface probing's touches show, and how far a pose may be from it.
+"""The surface that probing's touches show, and how far a pose may be from its normal.
 
 :func:`touch_surface` fits the touches' tip centres (``estimation.surface``, or a sphere of the
 radius the operator believes, ``estimation.surface_belief``); :func:`scaled_sigma` is the
@@ -9,7 +9,6 @@ probed pose may have from it.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,12 +37,13 @@ def touch_surface(
 ) -> SurfaceFit:
     """The surface through the touches' tip centres: a sphere of the believed radius (the
     centres' radius is the tip radius larger), else a plane or a sphere (``fit_surface``)."""
-    common: dict[str, Any] = {"sigma": sigma, "hint": -rays.mean(axis=0), "directions": rays,
-                              "reference": centres[0]}  # fmt: skip
+    hint, reference = -rays.mean(axis=0), centres[0]
     if surface_radius is None:
-        return fit_surface(centres, **common)
-    lo, hi = surface_radius
-    return fit_sphere_of_radius(centres, (lo + tip_radius, hi + tip_radius), **common)
+        return fit_surface(centres, sigma=sigma, hint=hint, directions=rays, reference=reference)
+    radii = (surface_radius[0] + tip_radius, surface_radius[1] + tip_radius)
+    return fit_sphere_of_radius(
+        centres, radii, sigma=sigma, hint=hint, directions=rays, reference=reference
+    )
 
 
 def allowed_residual(tolerance: float, normal_sigma: float) -> float:

@@ -62,7 +62,9 @@ def lean_of_rows(
     flush_translation: float,
 ) -> Lean:
     """The lean from (state, advance, strains) rows: on the robot L = advance - flush
-    translation, on the bench ``exposed_length``."""
+    translation, on the bench ``exposed_length``; where the tip slid, the misalignment from its
+    path beside it."""
+    rows = list(rows)  # read twice: the rows before buckling, then all the loading rows
     gratings = len(sensor.used_gratings)
     x, strains = rows_in(rows, PRE_BUCKLING, gratings)
     if not x.size:
