@@ -99,7 +99,7 @@ def fit_sphere_of_radius(
     ref = np.asarray(points, dtype=np.float64).mean(axis=0) if reference is None else reference
 
     def fit(radius: float) -> SurfaceFit:
-        label = f"sphere of radius {radius * 1e3:.1f} mm (believed)"
+        label = f"sphere of the believed radius (the tip centres' {radius * 1e3:.1f} mm)"
         return fit_with(
             sphere_of_radius(radius), "sphere", 3, points, sigma, directions, ref, hint, label
         )
@@ -114,13 +114,14 @@ def fit_sphere_of_radius(
         if not other.success or other.centres is None:
             return dataclasses.replace(
                 best, success=False, centres=None,
-                message=f"the believed radius {end * 1e3:.1f} mm does not fit: {other.message}",
+                message=f"the believed radius's end (the tip centres' {end * 1e3:.1f} mm) does "
+                f"not fit: {other.message}",
             )  # fmt: skip
         cos = float(np.clip(n_mid @ _normal(other.centres, ref), -1.0, 1.0))
         turned = max(turned, math.acos(cos))
     message = (
-        f"{best.message}; the believed radii {lo * 1e3:.1f}-{hi * 1e3:.1f} mm turn the normal "
-        f"by {math.degrees(turned):.2f} deg"
+        f"{best.message}; the believed radius's range turns the normal by "
+        f"{math.degrees(turned):.2f} deg"
     )
     return dataclasses.replace(
         best, message=message, normal_sigma=math.hypot(best.normal_sigma, turned)

@@ -64,7 +64,7 @@ def test_a_believed_range_widens_the_normals_doubt_by_what_it_leaves_open() -> N
     ranged = fit_sphere_of_radius(p, (54e-3, 66e-3), **kwargs)
     assert ranged.success
     assert ranged.normal_sigma > 5.0 * exact.normal_sigma
-    assert "turn the normal by" in ranged.message
+    assert "range turns the normal by" in ranged.message
 
 
 def test_bad_radii_are_refused_and_collinear_touches_fail_with_a_message() -> None:
@@ -75,4 +75,4 @@ def test_bad_radii_are_refused_and_collinear_touches_fail_with_a_message() -> No
     line = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0], [2e-3, 0.0, 0.0], [3e-3, 0.0, 0.0]])
     fit = fit_sphere_of_radius(line, (0.03, 0.03), sigma=SIGMA, hint=(0, 0, 1))
     assert not fit.success
-    assert "no sphere of radius" in fit.message
+    assert "no sphere of the believed radius" in fit.message
