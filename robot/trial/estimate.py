@@ -181,14 +181,7 @@ def fit_rows(
     fitted = fit_record(advance, strains, inputs, stack.sensor, section, tip)
     if inputs.rigid:
         return fitted
-    lean = lean_of_rows(
-        rows,
-        stack.sensor,
-        section,
-        kind=inputs.kind,
-        exposed_length=inputs.exposed_length,
-        flush_translation=inputs.flush_translation,
-    )
+    lean = lean_of_rows(rows, stack.sensor, section, inputs)
     relaxation = None
     if times is not None:
         relaxation = relaxation_of(rows, times, inputs, stack.sensor, section, fitted.joint)

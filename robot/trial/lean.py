@@ -19,7 +19,8 @@ from config.schema import SensorConfig
 from estimation.misalignment import Lean, measure_lean
 from estimation.section import Section
 from estimation.slip_path import measure_slip_path
-from robot.trial.states import LOADING_STATES
+from robot.trial.inputs import EstimatorInputs
+from robot.trial.states import LOADING_STATES, record_lengths
 from sensor.strain import grating_intervals
 
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
@@ -56,38 +57,32 @@ def lean_of_rows(
     rows: Iterable[tuple[str, float, Sequence[float]]],
     sensor: SensorConfig,
     section: Section,
-    *,
-    kind: str,
-    exposed_length: float,
-    flush_translation: float,
+    inputs: EstimatorInputs,
 ) -> Lean:
-    """The lean from (state, advance, strains) rows: on the robot L = advance - flush
-    translation, on the bench ``exposed_length``; where the tip slid, the misalignment from its
-    path beside it."""
+    """The lean from (state, advance, strains) rows, at the exposed lengths ``inputs`` give
+    (``robot.trial.states.record_lengths``); where the tip slid, the misalignment from its path
+    beside it."""
     rows = list(rows)  # read twice: the rows before buckling, then all the loading rows
     gratings = len(sensor.used_gratings)
     x, strains = rows_in(rows, PRE_BUCKLING, gratings)
     if not x.size:
         return Lean(False, "no rows before buckling")
-    lengths = _lengths(x, kind, exposed_length, flush_translation)
     from_tip = grating_spans_from_tip(sensor)
-    lean = measure_lean(strains, lengths, from_tip, section.EA, section.EI, section.fiber_offset)
+    lean = measure_lean(
+        strains, record_lengths(x, inputs), from_tip, section.EA, section.EI, section.fiber_offset
+    )
     if not lean.lateral:
         return lean
     x, strains = rows_in(rows, LOADING_STATES, gratings)  # the slide goes on past the detector
-    lengths = _lengths(x, kind, exposed_length, flush_translation)
     path = measure_slip_path(
-        strains, x, lengths, from_tip, section.EA, section.EI, section.fiber_offset
+        strains,
+        x,
+        record_lengths(x, inputs),
+        from_tip,
+        section.EA,
+        section.EI,
+        section.fiber_offset,
     )
     if not path.success:
         return dataclasses.replace(lean, message=f"no misalignment from the path: {path.message}")
     return dataclasses.replace(lean, misalignment=path.angle, misalignment_sigma=path.sigma)
-
-
-def _lengths(
-    x: NDArray[np.float64], kind: str, exposed_length: float, flush_translation: float
-) -> NDArray[np.float64]:
-    """The exposed length at each advance: on the robot advance - flush translation."""
-    if kind == "robot":
-        return np.asarray(x - flush_translation, dtype=np.float64)
-    return np.full(x.size, exposed_length)
