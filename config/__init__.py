@@ -7,12 +7,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from config.loader import CONFIG_DIR, ConfigError, from_mapping, load, read_yaml, resolve
+from config.loader import (
+    CONFIG_DIR,
+    ConfigError,
+    InputError,
+    from_mapping,
+    load,
+    read_yaml,
+    resolve,
+)
 from config.schema import StackConfig
 
 __all__ = [
     "CONFIG_DIR",
     "ConfigError",
+    "InputError",
     "StackConfig",
     "from_mapping",
     "load",

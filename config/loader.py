@@ -40,7 +40,13 @@ _Loader.add_implicit_resolver(
 )
 
 
-class ConfigError(ValueError):
+class InputError(ValueError):
+    """What the user gave is wrong: a file, a key, an option, a log that fails its schema.
+    The message names it. The command line reports it as bad input (exit 2); any other
+    exception that reaches it is a bug (exit 1, ``internal error``)."""
+
+
+class ConfigError(InputError):
     """A configuration file or value is wrong; the message names the file and the key."""
 
     def __init__(self, source: str, key: str, problem: str) -> None:

@@ -158,14 +158,18 @@ class ServoBusConfig:
     """The Dynamixel bus: port, baud rate, and the three servos of the roller-gear drive.
 
     ``timeout_ms`` is how long the driver waits for a status packet beyond its transmission time;
-    a transaction that fails on the wire is retried ``retries`` times. ``max_goal_step_deg`` is
-    the safety clamp on how far a servo's goal may move in one control tick (shaft degrees).
+    a transaction that fails on the wire is retried ``retries`` times. A read that still fails
+    costs the trial one tick (the motion held, the tick's advance not recorded), not the trial:
+    the bus is lost only after ``silence_ms`` without an answer (docs/transport-and-scale.md has
+    the latencies these defaults are sized from). ``max_goal_step_deg`` is the safety clamp on
+    how far a servo's goal may move in one control tick (shaft degrees).
     """
 
     port: str = "sim"
     baudrate: int = field(default=1000000, metadata=limits(gt=0))
     timeout_ms: float = field(default=20.0, metadata=limits(gt=0, le=10000))
     retries: int = field(default=3, metadata=limits(ge=0, le=20))
+    silence_ms: float = field(default=250.0, metadata=limits(gt=0, le=10000))
     max_goal_step_deg: float = field(default=10.0, metadata=limits(gt=0, le=360))
     outer_roll: ServoConfig = ServoConfig(id=1)
     inner_roll: ServoConfig = ServoConfig(id=2)
@@ -179,6 +183,11 @@ class ServoBusConfig:
     @property
     def timeout(self) -> float:
         return self.timeout_ms * 1e-3
+
+    @property
+    def silence(self) -> float:
+        """How long the servos may not answer before the rig reports the bus lost (s)."""
+        return self.silence_ms * 1e-3
 
     @property
     def max_goal_step(self) -> float:

@@ -266,18 +266,21 @@ def main(argv: Sequence[str] | None = None) -> int:
 def report_failure(exc: Exception) -> int:
     """One line on stderr and the exit code for an error that ended a command:
 
-    - bad input, exit 2: a configuration error (file and key), any other ``ValueError`` (the
-      commands raise it naming the file and key or line, or the option), and a file that cannot
-      be read or written (an ``OSError`` that names a file: missing, a directory, no permission);
+    - bad input, exit 2: a configuration error (file and key), an
+      :class:`~config.loader.InputError` (the commands raise it at their boundary naming the
+      file and key or line, or the option; a trial log that fails its schema), and a file that
+      cannot be read or written (an ``OSError`` that names a file: missing, a directory, no
+      permission);
     - anything else is a fault, exit 1: a hardware error the command did not handle, or a bug
-      (``internal error``; ``-v`` shows the traceback). No input a user can give should get here:
-      the fuzz targets (``palpate bench --only fuzz``) check that."""
-    from config.loader import ConfigError
+      (``internal error``; ``-v`` shows the traceback), a ``ValueError`` from inside the code
+      among them. No input a user can give should get here: the fuzz targets (``palpate bench
+      --only fuzz``) check that."""
+    from config.loader import ConfigError, InputError
 
     if isinstance(exc, ConfigError):
         log.error("palpate: bad configuration: %s", exc)
         return EXIT_BAD_INPUT
-    if isinstance(exc, ValueError):
+    if isinstance(exc, InputError):
         log.error("palpate: bad input: %s", exc)
         return EXIT_BAD_INPUT
     if isinstance(exc, OSError) and exc.filename is not None:

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from config.loader import InputError
 from config.schema import SensorConfig, StackConfig, TubeConfig
 from estimation.beamstate import infer_states
 from estimation.elastica import post_buckling
@@ -104,7 +105,7 @@ class LiveView:
             import foxglove
             from foxglove.channels import FrameTransformsChannel, SceneUpdateChannel
         except ImportError:
-            raise ValueError(
+            raise InputError(
                 "--live needs foxglove-sdk: python3 -m pip install -e '.[live]'"
             ) from None
 
@@ -113,7 +114,7 @@ class LiveView:
         try:
             self.server = foxglove.start_server(host=HOST, port=port, context=self.context)
         except Exception as exc:  # the SDK raises its own error for a port it cannot bind
-            raise ValueError(f"--live: cannot serve on {HOST}:{port}: {exc}") from None
+            raise InputError(f"--live: cannot serve on {HOST}:{port}: {exc}") from None
         self.port = int(self.server.port)
         self.sensor, self.section = sensor, section
         ctx = self.context

@@ -36,6 +36,14 @@ class Observation:
     abort: bool = False  # the operator pressed stop
     twist: float = 0.0  # rad, inner roller gear's roll minus the outer's (the sensor's twist)
     tip_force: float | None = None  # N, the tip force grating's load (None: no tip grating)
+    # s since the servos last answered: > 0 on a tick whose read was missed (the joints are
+    # then the last ones read; the rig holds the motion until the bus answers again)
+    joints_age: float = 0.0
+
+    @property
+    def measured_advance(self) -> float:
+        """The stage advance as the record keeps it: NaN on a tick whose read was missed."""
+        return self.advance if self.joints_age == 0.0 else math.nan
 
 
 def limit_violation(guards: Guards, obs: Observation, x_contact: float | None) -> str | None:

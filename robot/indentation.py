@@ -37,6 +37,7 @@ from typing import Protocol
 from estimation.detect_buckling import BucklingDetector
 from robot.guards import STATE_TIMEOUT, Guards, Observation, limit_violation
 from robot.probe_result import ProbeResult
+from robot.rest_check import RestCheck
 
 # the guards' names, re-exported: the machine's interface is read from here
 __all__ = ["STATE_TIMEOUT", "Guards", "Observation", "limit_violation"]
@@ -138,6 +139,7 @@ class IndentationMachine:
     _last_command: Command | None = None
     _first_touch: float | None = None  # advance at the first contact event, planned or not
     _lost_since: float | None = None  # time the servo replies were lost while retracting
+    _rest: RestCheck = field(default_factory=lambda: RestCheck(REZERO_SETTLE_TICKS))
 
     def __post_init__(self) -> None:
         hold, timeout = self.plan.hold_time, self.guards.state_timeout
@@ -161,8 +163,7 @@ class IndentationMachine:
             self.start(obs.t)
         if not self.finished:
             self._check_guards(obs)
-        handler = _HANDLERS[self.state]
-        cmd = handler(self, obs)
+        cmd = self._held(obs) or _HANDLERS[self.state](self, obs)
         self._last_command = cmd
         return cmd
 
@@ -215,8 +216,9 @@ class IndentationMachine:
         if violation is not None:
             self._fault(obs, violation)
             return
-        if obs.contact and self.state in (State.HOMING, State.POSITIONING):
-            self._fault(obs, f"unexpected contact during {self.state.value}")
+        at_rest = self.state in (State.HOMING, State.POSITIONING)  # no tissue can be near
+        if obs.contact and at_rest and not self._rest.seen():  # seen again after a re-zero
+            self._fault(obs, f"unexpected contact during {self.state.value} ({self._rest})")
 
     def _fault(self, obs: Observation, reason: str, *, retract: bool = True) -> None:
         self.marks.reason = reason
@@ -243,6 +245,11 @@ class IndentationMachine:
         if self._first_touch is None:
             return p.home_advance
         return min(p.home_advance, self._first_touch - p.standoff)
+
+    def _held(self, obs: Observation) -> Command | None:
+        """Hold still while a :class:`RestCheck` runs (re-zeroing on its last tick)."""
+        rezero = self._rest.hold(self.state in (State.HOMING, State.POSITIONING))
+        return None if rezero is None else Command(obs.advance, obs.roll, 0.0, rezero=rezero)
 
     def _hold(self, obs: Observation) -> Command:
         return Command(advance=obs.advance, roll=obs.roll, speed=0.0, torque=True)
@@ -297,20 +304,21 @@ class IndentationMachine:
         if isinstance(out, Command):
             return out
         if isinstance(out, str):  # no surface where one must be: a geometric answer
-            self.marks.reason = f"unreachable: {out}"
-            self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
-            return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
+            return self._unreachable(obs, out)
         self.probe = out
         self.plan = dataclasses.replace(
             self.plan, roll=out.roll, contact_advance=out.contact_advance
         )
         if not out.reachable:
-            self.marks.reason = f"unreachable: {out.reason}"
-            self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
-            return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
+            return self._unreachable(obs, out.reason)
         self._settle = 0
         self._go(State.POSITIONING, obs.t, f"probed: {out.reason}", obs.advance, obs.strains)
         return self._positioning(obs)
+
+    def _unreachable(self, obs: Observation, why: str) -> Command:
+        self.marks.reason = f"unreachable: {why}"
+        self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
+        return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
 
     def _contact(self, obs: Observation) -> Command:
         self.detector.reset()
@@ -364,14 +372,9 @@ class IndentationMachine:
         p = self.plan
         goal = self._retract_goal()
         if abs(obs.advance - goal) <= p.position_tolerance:
-            if self.marks.reason.startswith("aborted"):
-                target = State.ABORTED
-            elif self.marks.reason.startswith("unreachable"):
-                target = State.UNREACHABLE
-            elif self.marks.reason == "completed":
-                target = State.DONE
-            else:
-                target = State.FAULT
+            reason, ends = self.marks.reason, (State.ABORTED, State.UNREACHABLE)
+            target = next((s for s in ends if reason.startswith(s.value)), State.FAULT)
+            target = State.DONE if reason == "completed" else target
             self._go(target, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains)
             return self._terminal(obs)
         return Command(goal, obs.roll, p.fast_speed)

@@ -13,6 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Protocol, Self
 
+from config.loader import InputError
+
 
 class ServoTransportError(OSError):
     """No valid answer on the bus after the bounded retries (timeout, corrupt packet, port)."""
@@ -42,7 +44,7 @@ class ServoFaultError(RuntimeError):
         super().__init__(f"servo {servo_id}: {message}")
 
 
-class ServoIdentityError(ValueError):
+class ServoIdentityError(InputError):
     """The servo at an ID is not the model the configuration names (a configuration error)."""
 
 

@@ -58,6 +58,10 @@ class RigSettings:
     frame_period: float = 1e-3  # s between board frames
     frame_wait_s: float = 2.0  # real-time bound on that wait (it never waits for a frame not sent)
     roll_speed: float = math.radians(90.0)  # rad/s for roll goals
+    # The servo bus may miss replies (a status packet late or lost: a busy host, noise on the
+    # line) for this long (s, the rig's clock) before the rig reports it lost; meanwhile the
+    # motion holds (no new goal) and the ticks keep the last joints read, marked stale.
+    bus_silence: float = 0.25
 
 
 class ServoFbgRig:
@@ -83,6 +87,9 @@ class ServoFbgRig:
         self._frame: Frame | None = None
         self._frame_t = -math.inf
         self._twist = 0.0
+        self._read_t: float | None = None  # when the servos last answered (the rig's clock)
+        self._stale = False  # the last read was missed: hold the motion
+        self.missed_reads = 0  # ticks whose servo read was missed and tolerated
         self.frames: list[Frame] = []  # every frame received, for the trial log and plots
 
     @classmethod
@@ -142,15 +149,23 @@ class ServoFbgRig:
     def observe(self, t: float) -> Observation:
         fault: str | None = None
         lost = False
+        age = 0.0
         try:
             joints, motors = self.drive.read()
-            self._joints = joints
+            self._joints, self._read_t, self._stale = joints, t, False
             self._twist = self.drive.drive.twist({n: m.position for n, m in motors.items()})
         except ServoFaultError as exc:
             fault = str(exc)
         except ServoTransportError as exc:
-            fault = f"bus transport: {exc}"
-            lost = True
+            # A missed reply: tolerated (the motion holds, the joints are the last read) while
+            # the bus has been silent for less than ``bus_silence``; then it is lost.
+            since = self._read_t
+            if since is None or t - since >= self.settings.bus_silence or self._joints is None:
+                silent = "" if since is None else f" (silent {1e3 * (t - since):.0f} ms)"
+                fault, lost = f"bus transport: {exc}{silent}", True
+            else:
+                age, self._stale = max(t - since, 1e-9), True
+                self.missed_reads += 1
         joints = self._joints or JointState(math.nan, math.nan)
         # A lost board port is not an error here: the reader counts it and reopens the port,
         # the stream goes stale, and the state machine's FBG-lost guard decides.
@@ -178,6 +193,7 @@ class ServoFbgRig:
             bus_lost=lost,
             twist=self._twist,
             tip_force=tip_force,
+            joints_age=age,
         )
 
     def _tip_force(self, f: Frame) -> float | None:
@@ -208,6 +224,8 @@ class ServoFbgRig:
             return
         if not cmd.torque:
             self.release()
+            return
+        if self._stale:  # the servos did not answer this tick: hold the goal sent last
             return
         sp = self._setpoint or self._joints
         step = cmd.speed * self.settings.tick

@@ -120,3 +120,24 @@ def test_a_bad_input_is_one_line_on_stderr_and_exit_2(
     assert out == ""
     assert err.startswith("palpate: bad input: ")
     assert err.count("\n") == 1
+
+
+def test_a_value_error_from_inside_the_code_is_an_internal_error_exit_1(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Only what the user gave is bad input: a ValueError raised inside the code is a bug, exit
+    1 with ``internal error``, its traceback under -v (it was 'bad input', exit 2)."""
+    import palpate.commands.replay as replay_command
+
+    def broken(args: object) -> int:
+        raise ValueError("lengths must be > 0 m")  # what the beam model raised inside export
+
+    monkeypatch.setattr(replay_command, "run", broken)
+    assert main(["replay", "any.jsonl"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("palpate: internal error (a bug; -v shows where): ValueError: lengths")
+    assert "Traceback" not in err
+    assert main(["-v", "replay", "any.jsonl"]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback (most recent call last)" in err
+    assert 'raise ValueError("lengths must be > 0 m")' in err

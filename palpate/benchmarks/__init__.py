@@ -19,4 +19,5 @@ SECTIONS: dict[str, str] = {
     "hold": "palpate.benchmarks.hold",
     "live": "palpate.benchmarks.live",
     "fuzz": "palpate.benchmarks.fuzz",
+    "rehearsal": "palpate.benchmarks.rehearsal",
 }

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from config.loader import InputError
 from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from config.schema import StackConfig
 from estimation.elastica import fast
@@ -244,7 +245,7 @@ def _execute(
     if executor is None or isinstance(executor, SerialExecutor):
         return [done(i, _run_job(job)) for i, job in jobs]
     if any(r.live is not None for r in runs):
-        raise ValueError("--live shows one trial at a time: run with --executor serial")
+        raise InputError("--live shows one trial at a time: run with --executor serial")
     futures = {executor.submit(_run_job, job): i for i, job in jobs}
     for fut in as_completed(futures):
         done(futures[fut], fut.result())

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from config.loader import InputError
 from config.sample import SampleConfig
 from config.scene import SceneConfig
 from config.schema import StackConfig, TipGratingConfig
@@ -76,7 +77,7 @@ def design_scene(
         exposed_length_mm=d.exposed_length * 1e3,
     )
     if ev.threshold is None:
-        raise ValueError("the design's buckling is not detectable: no detector threshold")
+        raise InputError("the design's buckling is not detectable: no detector threshold")
     c = base.campaign
     travel_mm = 1e3 * (3.0 * ev.delta_soft + ev.delta_bias) + c.post_buckling_mm + 0.5
     campaign = dataclasses.replace(

@@ -31,6 +31,8 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
 from typing import Any, TypeVar
 
+from config.loader import InputError
+
 T = TypeVar("T")
 
 _PR_SET_PDEATHSIG = 1  # linux/prctl.h
@@ -63,7 +65,7 @@ def process_pool(workers: int) -> ProcessPoolExecutor:
     )
 
 
-class ExecutorUnavailableError(ValueError):
+class ExecutorUnavailableError(InputError):
     """The executor asked for cannot be built here (missing optional dependency, bad option)."""
 
 

@@ -28,6 +28,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+from config.loader import InputError
+
 if sys.platform != "win32":  # POSIX advisory locks; on Windows runs keep apart by their folders
     import fcntl
 
@@ -37,7 +39,7 @@ INCOMPLETE = "incomplete"
 _STAMP = re.compile(r"^\d{8}-\d{6}(?:-(\d+))?$")
 
 
-class RunDirError(ValueError):
+class RunDirError(InputError):
     """A run folder cannot be used: another process writes there, or there is none to resume."""
 
 

@@ -23,6 +23,7 @@ import json
 from pathlib import Path
 
 from config import load_stack
+from config.loader import InputError
 from config.schema import MM
 from estimation.compliance import ComplianceFit
 from palpate.calibration import calibrate, config_lines, rig_key
@@ -74,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     if all(f.suffix == ".jsonl" for f in files):
         return _compliance(files, args)
     if len(files) != 1:
-        raise ValueError("give one CSV or one frame stream, or trial logs (.jsonl) only")
+        raise InputError("give one CSV or one frame stream, or trial logs (.jsonl) only")
     path = files[0]
     if args.tip or is_tip_csv(path, csv_columns(path)):
         return _tip(path, args)
@@ -85,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
                 strain, shift, confidence=args.confidence, through_origin=args.through_origin
             )
         except ValueError as exc:
-            raise ValueError(f"{path}: {exc}") from None
+            raise InputError(f"{path}: {exc}") from None
     else:
         stack = load_stack(args.config)
         length = (args.exposed_length_mm or stack.sensor.exposed_length_mm) * MM

@@ -15,7 +15,7 @@ import math
 from pathlib import Path
 
 from config import load, load_stack, resolve
-from config.loader import write_yaml
+from config.loader import InputError, write_yaml
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from estimation.design import (
@@ -49,9 +49,9 @@ def _floats(text: str, what: str) -> tuple[float, ...]:
     try:
         values = tuple(float(v) for v in text.split(",") if v.strip())
     except ValueError:
-        raise ValueError(f"{what}: expected comma-separated numbers, got {text!r}") from None
+        raise InputError(f"{what}: expected comma-separated numbers, got {text!r}") from None
     if not values:
-        raise ValueError(f"{what}: empty list")
+        raise InputError(f"{what}: empty list")
     return values
 
 
@@ -60,9 +60,9 @@ def _pair(text: str, what: str) -> tuple[float, float]:
     try:
         lo, hi = (float(p) for p in parts)
     except ValueError:
-        raise ValueError(f"{what}: expected MIN:MAX, got {text!r}") from None
+        raise InputError(f"{what}: expected MIN:MAX, got {text!r}") from None
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
-        raise ValueError(f"{what}: need 0 < MIN <= MAX, got {text!r}")
+        raise InputError(f"{what}: need 0 < MIN <= MAX, got {text!r}")
     return lo, hi
 
 
@@ -288,9 +288,9 @@ def run(args: argparse.Namespace) -> int:
     scene_path = args.scene if args.scene else resolve("scenes/bench.yaml")
     base = load(SceneConfig, scene_path)
     if args.moduli < 1 or args.lengths < 1:
-        raise ValueError("--moduli and --lengths must be >= 1")
+        raise InputError("--moduli and --lengths must be >= 1")
     if args.contact_uncertainty_mm < 0:
-        raise ValueError("--contact-uncertainty-mm must be >= 0")
+        raise InputError("--contact-uncertainty-mm must be >= 0")
     modulus_range, constraints, space = _inputs(args, stack, base)
     result = design_sensor(modulus_range, constraints, space)
     outcomes: list[TrialOutcome] = []

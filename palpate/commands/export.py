@@ -11,6 +11,7 @@ import argparse
 import logging
 from pathlib import Path
 
+from config.loader import InputError
 from robot.trial.export import export
 from robot.trial.log import TrialLogError
 from robot.trial.recording import read_recording
@@ -40,5 +41,5 @@ def run(args: argparse.Namespace) -> int:
         counts = ", ".join(f"{topic} {rec.count(topic)}" for topic in sorted(rec.messages))
         print(f"{written}: {counts}")
     if failed:
-        raise ValueError("not converted: " + "; ".join(failed))
+        raise InputError("not converted: " + "; ".join(failed))
     return 0

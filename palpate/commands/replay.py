@@ -11,6 +11,7 @@ import argparse
 import json
 from pathlib import Path
 
+from config.loader import InputError
 from palpate.reports.replay import replay
 from robot.trial.log import TrialLogError
 
@@ -29,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         report = replay(args.log)
     except TrialLogError as exc:
-        raise ValueError(str(exc)) from None
+        raise InputError(str(exc)) from None
     if args.plot is not None and not report.get("damaged"):
         from palpate.reports.fitplot import record_fit
         from robot.trial.log import read_log
@@ -48,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
         if args.plot is not None:
             print(f"plot: {report.get('plot') or report.get('plot_message')}")
         if report.get("damaged"):  # bad input: lines that do not follow the log format
-            raise ValueError(f"{args.log}: {report['message']}")
+            raise InputError(f"{args.log}: {report['message']}")
         if "message" in report:
             print(report["message"])
             return 1

@@ -11,7 +11,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from config import load, load_stack, resolve
+from config import InputError, load, load_stack, resolve
 from config.scene import SceneConfig
 from config.schema import StackConfig
 from palpate.argtypes import non_negative_int, positive_int
@@ -225,7 +225,7 @@ def _prepare(path: Path, args: argparse.Namespace) -> _Campaign:
     if args.limit:
         specs = specs[: args.limit]
     if not specs:
-        raise ValueError(f"{path}: the campaign has no trials")
+        raise InputError(f"{path}: the campaign has no trials")
     check_reachable(specs, stack, str(path), str(resolve(scene.robot)))
     transport: Transport = "wire" if args.wire else scene.transport
     return _Campaign(path, scene, stack, specs, transport)

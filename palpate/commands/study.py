@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from config import load, load_stack, resolve
+from config.loader import InputError
 from config.scene import SceneConfig
 from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
 from palpate.campaigns.executors import add_executor_arguments, open_executor
@@ -55,7 +56,7 @@ def register(parser: argparse.ArgumentParser) -> None:
 def study_scene(scene: SceneConfig, repeats: int) -> SceneConfig:
     """The scene with its campaign repeated ``repeats`` times over (trial ids end in r<k>)."""
     if repeats < 1:
-        raise ValueError(f"--repeats must be >= 1, got {repeats}")
+        raise InputError(f"--repeats must be >= 1, got {repeats}")
     campaign = dataclasses.replace(scene.campaign, repeats=scene.campaign.repeats * repeats)
     return dataclasses.replace(scene, campaign=campaign)
 

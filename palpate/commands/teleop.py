@@ -24,6 +24,7 @@ from typing import Any
 
 from config import CONFIG_DIR, load, load_stack, resolve
 from config.bench import load_bench
+from config.loader import InputError
 from config.scene import CampaignConfig, SceneConfig
 from config.schema import StackConfig
 from config.targets import save_target
@@ -92,11 +93,11 @@ class _Where:
 
 def run(args: argparse.Namespace) -> int:
     if not (sys.stdin.isatty() and sys.stdout.isatty()):
-        raise ValueError("palpate teleop needs a terminal (stdin and stdout)")
+        raise InputError("palpate teleop needs a terminal (stdin and stdout)")
     if not 1.0 <= args.rate <= 1000.0:
-        raise ValueError(f"--rate: {args.rate} outside 1..1000 ticks per second")
+        raise InputError(f"--rate: {args.rate} outside 1..1000 ticks per second")
     if (args.servo_port is None) != (args.board_port is None):
-        raise ValueError("--servo-port and --board-port go together")
+        raise InputError("--servo-port and --board-port go together")
     where = _where(args)
     if args.targets is not None:
         where.targets = args.targets
@@ -169,7 +170,7 @@ def _body(where: _Where, args: argparse.Namespace, summary: dict[str, Any]) -> i
 
 def _check_tube(stack: StackConfig, name: str | None) -> None:
     if name is not None and name not in [t.name for t in stack.tubes]:
-        raise ValueError(f"--tube: no tube {name!r}; known: {[t.name for t in stack.tubes]}")
+        raise InputError(f"--tube: no tube {name!r}; known: {[t.name for t in stack.tubes]}")
 
 
 def _session(

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from config.bench import BenchTrialConfig, LoadedBench
-from config.loader import ConfigError
+from config.loader import ConfigError, InputError
 from config.sample import AssumedConfig
 from config.schema import MM, TubeConfig
 from config.targets import TargetConfig, TargetsFile, load_targets
@@ -91,7 +91,7 @@ def _entries(
         if not entries:
             if not any(t.name == only for t in stored.targets):
                 known = sorted(t.name for t in stored.targets)
-                raise ValueError(
+                raise InputError(
                     f"--target: no target named {only!r} in {loaded.targets_path}; known: {known}"
                 )
             entries = [(-1, BenchTrialConfig(target=only))]  # a stored pose the list omits

@@ -32,6 +32,7 @@ from palpate.calibration import calibrate, rig_key, with_compliance
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
 from palpate.live import LiveView, Publisher
+from robot.dynamixel.stats import BusStats
 from robot.indentation import PLANNED_ENDS
 from robot.rig import ServoFbgRig
 from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
@@ -68,6 +69,7 @@ class BenchOutcome:
     calibration: ComplianceFit | None = None  # on a rigid reference
     relaxation: RelaxationFit | None = None  # a trial that held: relaxed and instantaneous moduli
     relaxed_verdict: Verdict | None = None
+    bus: dict[str, object] | None = None  # the servo bus during the trial (BusStats, measured)
 
     @property
     def status(self) -> str:
@@ -104,12 +106,29 @@ class BenchOutcome:
             "calibration": None if self.calibration is None else self.calibration.as_dict(),
             **relaxed_row(self.relaxation, self.relaxed_verdict),
             "duration_s": self.duration,
+            "bus": self.bus,
             "log": self.log_path,
         }
 
 
 def _kpa(v: float | None) -> float | None:
     return None if v is None else v / 1e3
+
+
+def bus_stats(hw: Hardware) -> BusStats | None:
+    """The servo bus's counters so far (a copy; None for a bus that keeps none)."""
+    stats = getattr(hw.drive.bus, "stats", None)
+    return stats.copy() if isinstance(stats, BusStats) else None
+
+
+def _bus_during(
+    before: BusStats | None, after: BusStats | None, missed: int
+) -> dict[str, object] | None:
+    """What the bus did during one trial (``BusStats.as_dict``; the worst latencies are the
+    session's so far) and the ticks whose read was missed and tolerated (the rig's)."""
+    if before is None or after is None:
+        return None
+    return {**after.since(before).as_dict(), "missed_reads": missed}
 
 
 def run_bench_trials(
@@ -145,9 +164,11 @@ def run_bench_trials(
         publisher = (
             None if live is None else live.trial(_tube(trial), trial.kind, trial.exposed_length)
         )
+        before = bus_stats(hw)
         outcome, rig = _run_one(
             hw, trial, loaded, session.stack, log_dir, (sync_to_clock, publisher)
         )
+        outcome.bus = _bus_during(before, bus_stats(hw), rig.missed_reads)
         session.add(trial, outcome)
         outcomes.append(outcome)
         if progress is not None:

@@ -23,6 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
+from config.loader import InputError
 from estimation.belief import Hypothesis
 from robot.trial.inputs import header_sensor
 from robot.trial.log import TrialLog, read_log
@@ -38,7 +39,7 @@ def record_fit(log: TrialLog, path: Path) -> Path:
     estimate = next(log.of_kind("estimate"), None)
     joint = None if estimate is None else estimate.get("joint")
     if not isinstance(joint, dict) or joint.get("modulus") is None or joint.get("best") is None:
-        raise ValueError(f"{log.path}: no joint fit to draw (the trial has no estimate)")
+        raise InputError(f"{log.path}: no joint fit to draw (the trial has no estimate)")
     sensor, section, inputs = header_sensor(log.header, str(log.path))
     gratings = len(sensor.used_gratings)
     rows = [r for r in log.of_kind("sample") if r["state"] in RECORD_STATES]

@@ -28,7 +28,7 @@ from typing import Any, Self
 import numpy as np
 
 from config.bench import LoadedBench
-from config.loader import ConfigError
+from config.loader import ConfigError, InputError
 from config.sample import SampleConfig
 from config.scene import SceneConfig
 from config.schema import MM, StackConfig, TubeConfig
@@ -135,7 +135,7 @@ class SimulatedBench:
             raise ValueError(f"scene {scene.name!r} has no tissue sample")
         chosen = sample if sample is not None else names[0]
         if chosen not in names:
-            raise ValueError(f"--sample: no sample {chosen!r} in scene {scene.name!r}; {names}")
+            raise InputError(f"--sample: no sample {chosen!r} in scene {scene.name!r}; {names}")
         self.stack = stack
         self.scene = scene
         if not stations:

@@ -17,6 +17,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from config.loader import InputError
 from config.sample import SampleConfig
 from config.scene import FidelityConfig, SceneConfig
 from config.schema import StackConfig, TubeConfig
@@ -106,7 +107,7 @@ def _robot_geometry(
         roll_limits=stack.drive.roll_limits,
     )
     if not ik.reachable:
-        raise ValueError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
+        raise InputError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
     if sample is None:
         surface = Surface(point=target, normal=normal)
     else:

@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,8 +48,10 @@ from robot.dynamixel.replies import (
     hardware_fault,
     status_fault,
 )
+from robot.dynamixel.stats import BusStats
 from robot.motors import (
     MotorState,
+    ServoFaultError,
     ServoIdentityError,
     ServoTransportError,
 )
@@ -106,6 +109,7 @@ class DynamixelBus:
         self._connected = False
         self._sysfs = usb_serial_sysfs  # where Linux shows the USB adapter's latency timer
         self.recovery = PortRecovery(self._port, baudrate)  # a lost port, opened again
+        self.stats = BusStats()  # retries and latency, measured (wall time)
 
     @classmethod
     def from_config(
@@ -319,7 +323,9 @@ class DynamixelBus:
         param: list[int] = []
         for name, goal in goals.items():
             m = self._motors[name]
-            last = self._last_goals[name]
+            last = self._last_goals.get(name)
+            if last is None:  # rebooted since torque went on: its torque is off
+                raise ServoFaultError(m.id, f"{name}: torque off since its reboot")
             step = max(-self.max_goal_step, min(self.max_goal_step, goal - last))
             ticks = units.ticks_from_rad(last + step)
             sent[name] = units.rad_from_ticks(ticks)
@@ -350,9 +356,12 @@ class DynamixelBus:
             raise ServoTransportError(f"{what}: the bus is not connected")
         attempts = 1 + (self._retries if retries is None else retries)
         result = sdk.COMM_TX_FAIL
-        for _ in range(attempts):
+        stats, start = self.stats, time.monotonic()
+        for attempt in range(attempts):
             if not self.recovery.ready():
                 break
+            stats.retries += attempt > 0
+            sent = time.monotonic()
             try:
                 value, result, error = call()
             except PORT_ERRORS as exc:  # the port failed (not a reply: the device itself)
@@ -360,10 +369,13 @@ class DynamixelBus:
                 self.recovery.lose(exc)
                 continue
             if result == sdk.COMM_SUCCESS:
+                now = time.monotonic()
+                stats.answered(now - sent, now - start)
                 if servo_id is not None:
                     self._raise_for_status(servo_id, error)
                 return value
             self._port.is_using = False  # the SDK leaves it set after some failures
+        stats.failures += 1
         if self.recovery.lost:
             name = self._port.getPortName()
             lost = self.recovery.lost

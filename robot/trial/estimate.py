@@ -212,8 +212,8 @@ def _loading_tip(
         return None
     picked = [
         math.nan if f is None else float(f)
-        for (state, _, strains), f in zip(rows, tip_forces, strict=True)
-        if row_in(state, strains, LOADING_STATES, gratings)
+        for (state, advance, strains), f in zip(rows, tip_forces, strict=True)
+        if row_in(state, advance, strains, LOADING_STATES, gratings)
     ]
     tip = np.asarray(picked, dtype=np.float64)
     return tip if tip.size and np.all(np.isfinite(tip)) else None

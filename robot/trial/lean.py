@@ -10,6 +10,7 @@ advance to :func:`estimation.slip_path.measure_slip_path`, the misalignment from
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Iterable, Sequence
 
 import numpy as np
@@ -26,9 +27,13 @@ from sensor.strain import grating_intervals
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
 
 
-def row_in(state: str, strains: Sequence[float], states: frozenset[str], gratings: int) -> bool:
-    """Whether a (state, advance, strains) row is one :func:`rows_in` picks."""
-    return state in states and len(strains) == gratings
+def row_in(
+    state: str, advance: float, strains: Sequence[float], states: frozenset[str], gratings: int
+) -> bool:
+    """Whether a (state, advance, strains) row is one :func:`rows_in` picks: in ``states``,
+    every grating read, and the stage measured (a tick whose servo read was missed has no
+    advance: NaN)."""
+    return state in states and len(strains) == gratings and math.isfinite(advance)
 
 
 def rows_in(
@@ -39,7 +44,7 @@ def rows_in(
     adv: list[float] = []
     eps: list[Sequence[float]] = []
     for state, advance, strains in rows:
-        if row_in(state, strains, states, gratings):
+        if row_in(state, advance, strains, states, gratings):
             adv.append(advance)
             eps.append(strains)
     x = np.asarray(adv, dtype=np.float64)

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
+from config.loader import InputError
 from robot.trial.logschema import LogRecordError, check_record
 from robot.trial.recording import McapRecorder, axial_loads
 
@@ -150,7 +151,7 @@ class TrialLog:
         return next(self.of_kind("end"), None)
 
 
-class TrialLogError(ValueError):
+class TrialLogError(InputError):
     """The file is not a trial log this version can read."""
 
 

@@ -129,14 +129,16 @@ class McapRecorder:
         failure writes none), then MCAP's summary and footer."""
         if self._fh is None:
             return
-        forces = loads(self) if loads is not None else None
-        if forces is not None:
-            for sample, load in zip(self.samples, forces, strict=True):
-                self._raw(*wrench(sample.stamp, load), sample.stamp)
-        self._transforms()
-        self._writer.finish()  # type: ignore[no-untyped-call,unused-ignore]
-        self._fh.close()
-        self._fh = None
+        try:
+            forces = loads(self) if loads is not None else None
+            if forces is not None:
+                for sample, load in zip(self.samples, forces, strict=True):
+                    self._raw(*wrench(sample.stamp, load), sample.stamp)
+            self._transforms()
+        finally:  # whatever the derived channels did, the file ends with its summary
+            self._writer.finish()  # type: ignore[no-untyped-call,unused-ignore]
+            self._fh.close()
+            self._fh = None
 
     def _transforms(self) -> None:
         """``/tf`` of every sample of a robot trial (its header names the tube)."""
@@ -232,14 +234,15 @@ def _take(
 
 def axial_loads(recorder: McapRecorder) -> list[float] | None:
     """The axial load (N) at every sample of ``recorder``: the tip grating's where the sensor
-    has one, else from its strains (the estimator's beam states; NaN where a sample's strains are
-    incomplete), or None when the header lacks the sensor, the section or the estimator's
-    inputs."""
+    has one, else from its strains (the estimator's beam states), NaN where a sample has no
+    beam state (strains incomplete, or the sensor not yet out of the tube: such rows are never
+    handed to the beam model); None when the header lacks the sensor, the section or the
+    estimator's inputs."""
     tips = [x.tip_force for x in recorder.samples]
     if any(math.isfinite(f) for f in tips):
         return tips
     from robot.trial.inputs import header_sensor
-    from robot.trial.states import record_states
+    from robot.trial.states import on_beam, record_lengths, states_at
 
     try:
         sensor, section, inputs = header_sensor(recorder.header)
@@ -247,13 +250,18 @@ def axial_loads(recorder: McapRecorder) -> list[float] | None:
         return None
     gratings = len(sensor.used_gratings)
     samples = recorder.samples
-    rows = [i for i, x in enumerate(samples) if _whole([x.advance, *x.strains], gratings + 1)]
+    whole = [i for i, x in enumerate(samples) if _whole([x.advance, *x.strains], gratings + 1)]
     loads = [math.nan] * len(samples)
+    if not whole:
+        return loads
+    advance = np.asarray([samples[i].advance for i in whole], dtype=np.float64)
+    lengths = record_lengths(advance, inputs)
+    keep = on_beam(lengths, sensor)
+    rows = [i for i, k in zip(whole, keep.tolist(), strict=True) if k]
     if not rows:
         return loads
     strains = np.asarray([samples[i].strains for i in rows], dtype=np.float64)
-    advance = np.asarray([samples[i].advance for i in rows], dtype=np.float64)
-    states, _ = record_states(advance, strains, inputs, sensor, section)
+    states, _ = states_at(strains, lengths[keep], sensor, section)
     for i, load in zip(rows, states.P.tolist(), strict=True):
         loads[i] = load
     return loads

@@ -22,7 +22,7 @@ from estimation.jointfit import JointFit
 from estimation.relaxation import RelaxationFit, RelaxationRecord, fit_relaxation
 from estimation.section import Section
 from robot.trial.inputs import EstimatorInputs
-from robot.trial.lean import rows_in
+from robot.trial.lean import row_in, rows_in
 from robot.trial.states import LOADING_STATES, record_states
 
 HOLD_STATE = "holding"
@@ -111,8 +111,8 @@ def _blocks(
             counts.append(len(block))
             block.clear()
 
-    for i, (state, _, row_strains) in enumerate(rows):
-        if state not in RECORD_STATES or len(row_strains) != gratings:
+    for i, (state, advance, row_strains) in enumerate(rows):
+        if not row_in(state, advance, row_strains, RECORD_STATES, gratings):
             continue
         if state not in SLOW_STATES:
             flush()

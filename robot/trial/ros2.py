@@ -13,8 +13,9 @@ Channels, one message per log record of the kind (a ``sample`` gives two):
 - ``/palpate/transition`` (``palpate_msgs/msg/StateTransition``): each transition;
 - ``/palpate/record`` (``palpate_msgs/msg/Record``): the ``probe``, ``world``, ``estimate`` and
   ``end`` records, as their JSON lines;
-- ``/tip/wrench`` (``geometry_msgs/msg/WrenchStamped``): each sample with whole strains, the tip
-  force derived from them when the trial ends;
+- ``/tip/wrench`` (``geometry_msgs/msg/WrenchStamped``): each sample, the tip force derived from
+  its strains when the trial ends (NaN where it has none: strains incomplete, or the sensor not
+  yet out of the tube);
 - ``/tf`` (``tf2_msgs/msg/TFMessage``): on the robot, each sample's ``base`` -> ``tube_tip`` (the
   tube's forward kinematics at the sample's roll) and ``tube_tip`` -> ``sensor_tip`` (the exposed
   length along the tangent, the beam taken straight), written when the trial ends.

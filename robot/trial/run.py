@@ -121,7 +121,7 @@ def run_trial(
             if _out_of_ticks(machine, clock.now(), ticks, max_ticks):
                 break
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
-            out.record.append((machine.state.value, obs.advance, tuple(obs.strains)))
+            out.record.append((machine.state.value, obs.measured_advance, tuple(obs.strains)))
             out.times.append(obs.t)
             if obs.tip_force is not None or out.tip_forces:
                 _append_tip(out, obs.tip_force)
@@ -208,7 +208,7 @@ def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, An
         "kind": "sample",
         "t": obs.t,
         "state": state.value,
-        "advance": obs.advance,
+        "advance": obs.measured_advance,
         "roll": obs.roll,
         "strains": list(obs.strains),
         "contact": obs.contact,

@@ -173,6 +173,7 @@ def rig_settings(
         sync_to_clock=sync_to_clock,
         frame_period=1.0 / stack.board.rate_hz,
         fbg_bending_mode=mode,
+        bus_silence=stack.servos.silence,
     )
 
 

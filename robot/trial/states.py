@@ -59,7 +59,17 @@ def states_at(
     return states, strain_sigma(states.residual, strains.shape[1]) / _UNIT_SIGMA
 
 
+def on_beam(lengths: FloatArray, sensor: SensorConfig) -> NDArray[np.bool_]:
+    """Per row, whether every used grating lies on the exposed beam at that exposed length (m):
+    the rows the beam model can read. Before the sensor has left the tube (a robot trial's
+    positioning, the stage behind the tube's flush translation) a row has no beam state."""
+    inner = grating_intervals(sensor, 0.0)[:, 0].min()  # the innermost grating's start at L = 0
+    return np.asarray((lengths > 0) & (lengths + inner >= 0))
+
+
 def record_lengths(advance: FloatArray, inputs: EstimatorInputs) -> FloatArray:
+    """The exposed length (m) at each row: the bench's fixed one, or the robot's advance past
+    the tube's flush translation (<= 0 while the sensor is still inside the tube)."""
     if inputs.kind == "robot":
         return np.asarray(advance - inputs.flush_translation)
     return np.full(advance.size, inputs.exposed_length)

@@ -45,8 +45,8 @@ TARGETS_YAML = """targets:
 """
 
 
-def bench_file(tmp_path: Path, trials: str, extra: str = "") -> Path:
-    (tmp_path / "robot.yaml").write_text(ROBOT_YAML, encoding="utf-8")
+def bench_file(tmp_path: Path, trials: str, extra: str = "", robot: str = ROBOT_YAML) -> Path:
+    (tmp_path / "robot.yaml").write_text(robot, encoding="utf-8")
     (tmp_path / "targets.yaml").write_text(TARGETS_YAML, encoding="utf-8")
     path = tmp_path / "bench.yaml"
     path.write_text(
