@@ -2,7 +2,8 @@
 
 ``estimation.layer_exact`` solves the contact of a rigid sphere on a layer over a rigid base in
 linear elasticity. A fit evaluates the law at ~10^5 depths, so here it is tabulated, per layer
-kind (Poisson's ratio, bonded or sliding; cached for the process), in two parts:
+kind (Poisson's ratio, bonded or sliding; cached for the process and in the user's cache,
+``config.cache``, so a campaign's workers do not solve them again), in two parts:
 
 - the paraboloid's bracket ``B_p(chi) = F / F_Hertz`` at ``chi = sqrt(R delta)/h``, one curve
   (:func:`paraboloid_bracket`, chi up to 3 and beyond);
@@ -30,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline  # type: ignore[import-untyped,unused-ignore]
 
+from config.cache import cached_arrays
 from estimation.layer_exact import kernel_transform, solve_contact
 from estimation.sneddon import sneddon_bracket, sneddon_y
 
@@ -51,6 +53,9 @@ ROW_THICKNESS = np.geomspace(0.02, 20.0, 31)
 ROW_RADII = 48
 ROW_POINTS = 41
 FACTOR_POINTS = 257
+TABLE_VERSION = 1
+"""Bump it whenever a change to the layer solve (``estimation.layer_exact``) or to these tables
+changes any number: the user's cache (``config.cache``) then solves them again."""
 
 
 def _sneddon_radius(depth_ratio: FloatArray) -> FloatArray:
@@ -69,12 +74,21 @@ def _kind(poisson: float, bonded: bool) -> tuple[float, bool]:
     return (round(float(poisson), 12) if bonded else 0.0), bool(bonded)
 
 
+def _record(poisson: float, bonded: bool, *grid: object) -> str:
+    """What a cached table was solved for: the kind, the grid, the tables' version."""
+    return repr((TABLE_VERSION, poisson, bonded, *grid))
+
+
 @functools.lru_cache(maxsize=64)
 def _paraboloid(poisson: float, bonded: bool) -> tuple[CubicSpline, float]:
-    alpha = np.linspace(ALPHA_CAP / PARABOLOID_RADII, ALPHA_CAP, PARABOLOID_RADII)
-    c = solve_contact(alpha, math.inf, kernel_transform(poisson, bonded))
-    chi = np.sqrt(c.depth)
-    bracket = c.force / (4.0 / 3.0 * c.depth**1.5)
+    def solve() -> dict[str, FloatArray]:
+        alpha = np.linspace(ALPHA_CAP / PARABOLOID_RADII, ALPHA_CAP, PARABOLOID_RADII)
+        c = solve_contact(alpha, math.inf, kernel_transform(poisson, bonded))
+        return {"chi": np.sqrt(c.depth), "bracket": c.force / (4.0 / 3.0 * c.depth**1.5)}
+
+    record = _record(poisson, bonded, ALPHA_CAP, PARABOLOID_RADII)
+    solved = cached_arrays("layer-paraboloid", record, solve)
+    chi, bracket = solved["chi"], solved["bracket"]
     spline = CubicSpline(np.concatenate(([0.0], chi)), np.concatenate(([1.0], bracket)))
     return spline, float(chi[-1])
 
@@ -112,9 +126,13 @@ def _row(lam: float, poisson: float, bonded: bool) -> tuple[float, FloatArray]:
 
 @functools.lru_cache(maxsize=64)
 def _rows(poisson: float, bonded: bool) -> SphereRows:
-    rows = [_row(float(lam), poisson, bonded) for lam in ROW_THICKNESS]
-    reach = np.array([r for r, _ in rows])
-    return SphereRows(ROW_THICKNESS, reach, np.array([t for _, t in rows]))
+    def solve() -> dict[str, FloatArray]:
+        rows = [_row(float(lam), poisson, bonded) for lam in ROW_THICKNESS]
+        return {"reach": np.array([r for r, _ in rows]), "ratio": np.array([t for _, t in rows])}
+
+    grid = (ALPHA_CAP, PARABOLOID_RADII, ROW_THICKNESS.tolist(), ROW_RADII, ROW_POINTS)
+    solved = cached_arrays("layer-sphere-rows", _record(poisson, bonded, *grid), solve)
+    return SphereRows(ROW_THICKNESS, solved["reach"], solved["ratio"])
 
 
 def sphere_rows(poisson: float, bonded: bool) -> SphereRows:

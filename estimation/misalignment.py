@@ -236,6 +236,7 @@ class _Model:
     cap: FloatArray  # (N,)
     loads: FloatArray  # (N, J) candidate loads
     h: FloatArray  # (N, J, G) lateral shape per unit tan(gamma) at each candidate load
+    base: FloatArray  # (N, J, G): y + P/EA at each candidate load (the part without c)
     L: FloatArray  # (N,)
     from_tip: FloatArray  # (G, 2)
     EA: float
@@ -255,34 +256,47 @@ class _Model:
         n, j = loads.shape
         h = lateral_shape(clipped.ravel(), np.repeat(L, j), from_tip, EI, dy).reshape(n, j, -1)
         unit = m / np.linalg.norm(m, axis=1, keepdims=True)
-        return cls(y, unit, cap, loads, h, L, from_tip, EA, EI, dy)
+        base = y[:, None, :] + loads[:, :, None] / EA
+        return cls(y, unit, cap, loads, h, base, L, from_tip, EA, EI, dy)
 
     def rss(self, c: float, pinned: bool = False) -> tuple[float, FloatArray]:
         """Residual sum of squares at ``c`` with each row's load and bow fitted, and the loads:
         the best candidate load, then golden-section refined between its neighbours. A free
         tip's loads stay below the capacity; ``pinned`` (c = 0) lets them reach 1.2 P_cr."""
+        rss, P = self.rss_many(np.array([c]), pinned)
+        return float(rss[0]), P[0]
+
+    def rss_many(self, cs: FloatArray, pinned: bool = False) -> tuple[FloatArray, FloatArray]:
+        """:meth:`rss` at every ``c`` of ``cs`` (C,) at once: (C,) sums and (C, N) loads. The
+        arithmetic of each c is :meth:`rss`'s element for element (one numpy call for all of
+        them instead of one per c: the rows are few, the calls' overhead was the cost)."""
         cols = self.loads.shape[1] if pinned else _BELOW
-        loads, h = self.loads[:, :cols], self.h[:, :cols]
-        ss = self._ss(self.y[:, None, :] + loads[:, :, None] / self.EA - c * h)
-        j = np.argmin(ss, axis=1)
-        rows = np.arange(ss.shape[0])
+        loads, h, base = self.loads[:, :cols], self.h[:, :cols], self.base[:, :cols]
+        ss = self._ss(base[None] - cs[:, None, None, None] * h[None], candidates=True)
+        j = np.argmin(ss, axis=-1)  # (C, N)
+        rows = np.arange(ss.shape[1])[None, :]
         lo = loads[rows, np.maximum(j - 1, 0)]
         hi = loads[rows, np.minimum(j + 1, cols - 1)]
+        both = np.concatenate([cs, cs])
         for _ in range(_GOLDEN):
             a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-            left = self._row_ss(c, a) < self._row_ss(c, b)
+            ss_a, ss_b = np.split(self._row_ss(both, np.concatenate([a, b])), 2)
+            left = ss_a < ss_b
             lo, hi = np.where(left, lo, a), np.where(left, b, hi)
         P = 0.5 * (lo + hi)
-        return float(np.sum(self._row_ss(c, P))), P
+        return np.sum(self._row_ss(cs, P), axis=-1), P
 
-    def _row_ss(self, c: float, P: FloatArray) -> FloatArray:
-        shape = lateral_shape(np.minimum(P, LOAD_SHARE * self.cap), self.L, self.from_tip,
-                              self.EI, self.dy)  # fmt: skip
-        return self._ss(self.y + P[:, None] / self.EA - c * shape)
+    def _row_ss(self, cs: FloatArray, P: FloatArray) -> FloatArray:
+        """(C, N): each row's residual at its load P (C, N) and the lean c of its line."""
+        flat = np.minimum(P, LOAD_SHARE * self.cap).ravel()
+        lengths = np.tile(self.L, P.shape[0])
+        shape = lateral_shape(flat, lengths, self.from_tip, self.EI, self.dy).reshape(*P.shape, -1)
+        return self._ss(self.y + P[..., None] / self.EA - cs[:, None, None] * shape)
 
-    def _ss(self, v: FloatArray) -> FloatArray:
-        """Squared norm over the last axis of v with the onset mode taken out (per row)."""
-        u = self.unit if v.ndim == 2 else self.unit[:, None, :]
+    def _ss(self, v: FloatArray, candidates: bool = False) -> FloatArray:
+        """Squared norm over the last axis of v with the onset mode taken out (per row; the
+        rows on the axis before the last with ``candidates``)."""
+        u = self.unit[:, None, :] if candidates else self.unit
         along = np.sum(v * u, axis=-1, keepdims=True)
         return np.asarray(np.sum((v - along * u) ** 2, axis=-1))
 
@@ -292,12 +306,13 @@ def _profile(model: _Model) -> Lean:
     sigma from the profile (the half-width where the residual rises by one noise variance);
     beside it how much worse a pinned tip with no lateral load fits."""
     grid = np.tan(np.radians(np.linspace(-GRID_DEG, GRID_DEG, GRID_POINTS)))
-    rss = np.array([model.rss(float(c))[0] for c in grid])
+    rss = model.rss_many(grid)[0]
     k = int(np.argmin(rss))
     lo, hi = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
     for _ in range(_GOLDEN_C):  # the profile between the grid's neighbours of its minimum
         a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-        lo, hi = (lo, b) if model.rss(a)[0] < model.rss(b)[0] else (a, hi)
+        at_a, at_b = model.rss_many(np.array([a, b]))[0]
+        lo, hi = (lo, b) if at_a < at_b else (a, hi)
     c = 0.5 * (lo + hi)
     rss_free, P = model.rss(c)
     rss_pinned, P_pinned = model.rss(0.0, pinned=True)

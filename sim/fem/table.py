@@ -17,8 +17,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-import os
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +24,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from config.cache import cache_dir, write_npz
 from sim.fem.problem import LayerProblem
 
 FloatArray = NDArray[np.float64]
@@ -71,34 +70,17 @@ def table_key(problem: LayerProblem) -> str:
     return hashlib.sha256(_record(problem).encode()).hexdigest()[:16]
 
 
-def cache_dir() -> Path:
-    """``$PALPATE_CACHE_DIR`` if set, else ``~/.cache/palpate/fe``."""
-    env = os.environ.get("PALPATE_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "palpate" / "fe"
-
-
 def save_table(table: ForceTable, directory: Path) -> Path:
     """Write ``table`` as ``<key>.npz`` in ``directory`` (atomically); returns the path."""
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"{table.key}.npz"
-    fd, tmp = tempfile.mkstemp(dir=directory, suffix=".npz.tmp")
-    os.close(fd)
-    try:
-        with open(tmp, "wb") as fh:
-            np.savez(
-                fh,
-                record=np.array(_record(table.problem)),
-                key=np.array(table.key),
-                success=np.array(table.success),
-                message=np.array(table.message),
-                build_seconds=np.array(table.build_seconds),
-                **{name: getattr(table, name) for name in _FIELDS},
-            )
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    return write_npz(
+        directory / f"{table.key}.npz",
+        record=np.array(_record(table.problem)),
+        key=np.array(table.key),
+        success=np.array(table.success),
+        message=np.array(table.message),
+        build_seconds=np.array(table.build_seconds),
+        **{name: getattr(table, name) for name in _FIELDS},
+    )
 
 
 def read_table(problem: LayerProblem, directory: Path) -> ForceTable | None:

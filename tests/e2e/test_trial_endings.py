@@ -10,6 +10,7 @@ unreachable, Ctrl-C and SIGTERM mid-trial (a SIGKILL: ``test_crash_log.py``).
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -133,3 +134,26 @@ def test_export_of_a_log_that_starts_in_the_tube_exits_0(tmp_path: Path) -> None
     assert main(["export", str(path), "--out", str(tmp_path / "again")]) == 0
     with open(tmp_path / "again" / path.with_suffix(".mcap").name, "rb") as fh:
         assert make_reader(fh).get_summary() is not None
+
+
+def test_palpate_trial_exits_1_on_a_fault_and_prints_its_results(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The command on the emulators' ptys in real time (as ``palpate emulate`` serves them): a
+    trial that faults is exit 1 with its row in the JSON (0 done: ``test_rehearsal.py``; 2 bad
+    input: ``test_trial_cli.py``)."""
+    path = bench_file(
+        tmp_path, "  - {target: up, sample: S8}\n", "campaign: {probe: false}\n", robot=FROM_HOME
+    )
+    loaded = load_bench(path)
+    stack = loaded.stack
+    surface = surface_at(stack.tube("bent30"), 0.0, 41e-3, stack.sensor.tip_radius)
+    with SimulatedBench(stack, ROBOT_SCENE, sample="S8", surface=surface, tube="bent30") as sim:
+        argv = ["trial", "--config", str(path), "--json"]
+        code = main([*argv, "--servo-port", sim.servo_port, "--board-port", sim.board_port])
+    assert code == 1
+    (trial,) = json.loads(capsys.readouterr().out)["trials"]
+    assert trial["state"] == "fault"
+    assert trial["reason"].startswith("no contact within")
+    assert trial["bus"]["transactions"] > 0
+    closed(Path(trial["log"]))
