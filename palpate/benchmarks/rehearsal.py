@@ -56,6 +56,15 @@ class Session:
     trials: list[dict[str, Any]] = field(default_factory=list)
 
     @property
+    def why(self) -> str:
+        """What ended the session short: a trial's reason, else the command's last error line."""
+        for t in self.trials:
+            if t["state"] != "done":
+                return f"{t['trial']}: {t['state']}: {t['reason']}"
+        lines = [x for x in self.stderr.splitlines() if x.strip()]
+        return lines[-1] if lines else f"exit {self.exit_code}"
+
+    @property
     def complete(self) -> bool:
         """Exit 0 and every trial done with a joint fit and its interval."""
         return (
@@ -189,6 +198,7 @@ def run(ctx: BenchContext) -> BenchSection:
             "worst reply ms",
             "worst transaction ms",
             "replies > 20 ms",
+            "why not complete",
         ],
     )
     complete = 0
@@ -213,6 +223,7 @@ def run(ctx: BenchContext) -> BenchSection:
                     reply,
                     max((b.get("worst_latency_ms", 0.0) for b in bus), default=0.0),
                     slow,
+                    "" if s.complete else s.why,
                 ]
             )
     table.note = (

@@ -15,8 +15,9 @@ section runs and removed afterwards (:func:`measured`).
 - control path: the trial loop and its ticks less the simulator's calls inside them, the MCAP
   recording (its messages as the trial runs; at its close the tip force, whose beam states count
   as the estimator's);
-- estimator: the joint fit, the beam states, the paper's strain fit, and the rest of the
-  trial's estimate (the paper's single point, Southwell, the verdict);
+- estimator: the joint fit, the beam states, the paper's strain fit, the load's lean and the
+  sliding tip's path, the relaxation fit, and the rest of the trial's estimate (the paper's
+  single point, Southwell, the verdict);
 - set-up: the rest of a trial (geometry, world, emulators, driver, zeroing);
 - start-up: a fresh process's interpreter and imports (``python -c 'import ...'``, CPU of the
   child), shared by the campaign's trials as ``palpate sim`` shares it.
@@ -76,6 +77,8 @@ BOUNDARIES = (
     Boundary("robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
     Boundary("robot.trial.states", "infer_states", "beam states", ESTIMATOR),
     Boundary("robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
+    Boundary("robot.trial.estimate", "lean_of_rows", "lean and slip-path fits", ESTIMATOR),
+    Boundary("robot.trial.estimate", "relaxation_of", "relaxation fit", ESTIMATOR),
     Boundary("palpate.simulation.result", "estimate_trial", "rest of the estimate", ESTIMATOR),
 )
 TICKS = "ticks (observe, decide, command)"

@@ -59,6 +59,7 @@ from sensor.ports import PORT_ERRORS, open_failure
 from wire import dynamixel as tables
 
 R = TypeVar("R")
+CONNECT_PATIENCE_S = 0.5
 log = logging.getLogger(__name__)
 
 
@@ -104,6 +105,9 @@ class DynamixelBus:
         self._ph = sdk.PacketHandler(2.0) if packet_handler is None else packet_handler
         self._baudrate = baudrate
         self._retries = retries
+        # connect pings each servo for CONNECT_PATIENCE_S at least: nothing moves yet, and a
+        # busy host (or an emulator starting beside it) may answer late
+        self._connect_retries = max(retries, math.ceil(CONNECT_PATIENCE_S / timeout) - 1)
         self.max_goal_step = max_goal_step
         self._last_goals: dict[str, float] = {}
         self._connected = False
@@ -173,7 +177,7 @@ class DynamixelBus:
         self._connected = True
         try:
             for m in self._motors.values():
-                model = self.ping(m.name)
+                model = self.ping(m.name, retries=self._connect_retries)
                 if model != tables.MODEL_NUMBERS[m.model]:
                     found = tables.MODEL_NAMES.get(model, f"model number {model}")
                     raise ServoIdentityError(
@@ -215,10 +219,12 @@ class DynamixelBus:
         self.close()
 
     # --- single-servo operations -------------------------------------------------------------
-    def ping(self, name: str) -> int:
-        """The model number the servo answers with."""
+    def ping(self, name: str, retries: int | None = None) -> int:
+        """The model number the servo answers with (``retries``: the bus's unless given)."""
         m = self._motors[name]
-        model = self._transact(f"ping {name}", lambda: self._ph.ping(self._port, m.id), m.id)
+        model = self._transact(
+            f"ping {name}", lambda: self._ph.ping(self._port, m.id), m.id, retries
+        )
         return int(model)
 
     def read_item(self, name: str, item: str) -> int:
