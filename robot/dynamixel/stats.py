@@ -12,6 +12,7 @@ Usage::
 from __future__ import annotations
 
 import bisect
+import dataclasses
 from dataclasses import dataclass, field
 
 REPLY_BINS_MS = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0)
@@ -53,14 +54,7 @@ class BusStats:
         )
 
     def copy(self) -> BusStats:
-        return BusStats(
-            self.transactions,
-            self.retries,
-            self.failures,
-            self.worst_latency,
-            self.worst_reply,
-            list(self.replies),
-        )
+        return dataclasses.replace(self, replies=list(self.replies))
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready, latencies in ms; ``replies_ms`` maps each bin's upper edge to its count

@@ -19,14 +19,12 @@ from mcap.reader import make_reader  # type: ignore[import-untyped,unused-ignore
 
 from config.bench import load_bench
 from palpate.cli import main
-from palpate.commands.trial import run_session
 from palpate.lab.hardware import Terminated
-from palpate.lab.trial import plan_bench_trials
 from palpate.simulation.twin import SimulatedBench, surface_at
 from robot.trial.log import read_log
 from robot.trial.recording import read_recording
 from sim.clock import VirtualClock
-from tests.e2e.test_trial_cli import ONE, ROBOT_SCENE, bench_file
+from tests.e2e.test_trial_cli import ONE, ROBOT_SCENE, bench_file, run_on
 
 # the shipped home pose (0 mm, the tube's flush translation: no sensor out) and a quick stage
 FROM_HOME = (
@@ -58,19 +56,8 @@ def session(tmp_path: Path, trials: str, clock: VirtualClock, extra: str = "") -
         stack, ROBOT_SCENE, sample="S8", surface=surface, tube="bent30", clock=clock, wire=True
     )
     with sim:
-        try:
-            run_session(
-                loaded,
-                plan_bench_trials(loaded),
-                tmp_path / "logs",
-                servo_port=sim.servo_port,
-                board_port=sim.board_port,
-                clock=clock,
-                sync_to_clock=True,
-            )
-        finally:
-            logs = sorted((tmp_path / "logs").glob("*.jsonl"))
-    return logs
+        run_on(sim, loaded, clock, tmp_path / "logs")
+    return sorted((tmp_path / "logs").glob("*.jsonl"))
 
 
 def closed(log_path: Path) -> tuple[str, list[float]]:
