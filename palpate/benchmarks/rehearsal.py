@@ -165,8 +165,13 @@ def cpu_load(busy: int = 0, campaign: bool = False) -> Iterator[None]:
             f"'--no-mcap', '--out', {out!r}], stdout=subprocess.DEVNULL, "
             "stderr=subprocess.DEVNULL)\n"
         )
+    # each load dies with this process however it dies (a killed benchmark left its load
+    # running, and the next rehearsal measured a host four times over-committed)
+    guard = (
+        f"from palpate.campaigns.executors import die_with_parent; die_with_parent({os.getpid()})\n"
+    )
     loads = [
-        subprocess.Popen([sys.executable, "-c", script], start_new_session=True)
+        subprocess.Popen([sys.executable, "-c", guard + script], start_new_session=True)
         for script in scripts
     ]
     try:
