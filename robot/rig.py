@@ -88,6 +88,7 @@ class ServoFbgRig:
         self._frame_t = -math.inf
         self._twist = 0.0
         self._read_t: float | None = None  # when the servos last answered (the rig's clock)
+        self._first_t: float | None = None  # the first tick's time: silence counts from it
         self._stale = False  # the last read was missed: hold the motion
         self.missed_reads = 0  # ticks whose servo read was missed and tolerated
         self.frames: list[Frame] = []  # every frame received, for the trial log and plots
@@ -150,6 +151,7 @@ class ServoFbgRig:
         fault: str | None = None
         lost = False
         age = 0.0
+        self._first_t = t if self._first_t is None else self._first_t
         try:
             joints, motors = self.drive.read()
             self._joints, self._read_t, self._stale = joints, t, False
@@ -157,12 +159,12 @@ class ServoFbgRig:
         except ServoFaultError as exc:
             fault = str(exc)
         except ServoTransportError as exc:
-            # A missed reply: tolerated (the motion holds, the joints are the last read) while
-            # the bus has been silent for less than ``bus_silence``; then it is lost.
-            since = self._read_t
-            if since is None or t - since >= self.settings.bus_silence or self._joints is None:
-                silent = "" if since is None else f" (silent {1e3 * (t - since):.0f} ms)"
-                fault, lost = f"bus transport: {exc}{silent}", True
+            # A missed reply: tolerated (the motion holds, the joints are the last read, none
+            # before the first) while the bus has been silent, since its last answer or the
+            # trial's first tick, for less than ``bus_silence``; then it is lost.
+            since = self._first_t if self._read_t is None else self._read_t
+            if t - since >= self.settings.bus_silence:
+                fault, lost = f"bus transport: {exc} (silent {1e3 * (t - since):.0f} ms)", True
             else:
                 age, self._stale = max(t - since, 1e-9), True
                 self.missed_reads += 1

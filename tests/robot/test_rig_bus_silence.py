@@ -109,10 +109,24 @@ def test_a_bus_silent_for_longer_than_its_bound_is_lost() -> None:
         assert "silent" in obs.servo_fault
 
 
-def test_a_bus_that_never_answered_is_lost_at_once() -> None:
+def test_a_first_read_missed_is_held_and_a_bus_silent_from_the_start_is_lost() -> None:
+    """The trial's first read missed (the rehearsal beside a campaign: it faulted at once):
+    held, no goal sent, no joints; silent from the first tick for the bound: lost."""
     rig, drive, clock, emu = rig_and_clock()
     with emu:
         drive.silent = 1
         obs = rig.observe(clock.now())
-        assert obs.bus_lost
-        assert obs.servo_fault is not None
+        assert not obs.bus_lost
+        assert math.isnan(obs.advance)
+        rig.command(Command(advance=20e-3, roll=0.0, speed=1e-3))
+        assert drive.sent == []
+        clock.sleep(TICK)
+        assert rig.observe(clock.now()).measured_advance == 10e-3  # it answers: streaming
+        rig2, drive2, clock2, emu2 = rig_and_clock()
+        with emu2:
+            drive2.silent = 100
+            lost = []
+            for _ in range(20):
+                lost.append(rig2.observe(clock2.now()).bus_lost)
+                clock2.sleep(TICK)
+            assert lost.index(True) == math.ceil(0.05 / TICK)  # silent 50 ms from the first tick
