@@ -63,6 +63,7 @@ class State(enum.Enum):
 TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})
 PLANNED_ENDS = frozenset({State.DONE, State.UNREACHABLE})  # torque stays on: nothing went wrong
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
+AT_REST = frozenset({State.HOMING, State.POSITIONING})  # no tissue can be near: a RestCheck
 
 
 @dataclass(frozen=True)
@@ -216,8 +217,7 @@ class IndentationMachine:
         if violation is not None:
             self._fault(obs, violation)
             return
-        at_rest = self.state in (State.HOMING, State.POSITIONING)  # no tissue can be near
-        if obs.contact and at_rest and not self._rest.seen():  # seen again after a re-zero
+        if obs.contact and self.state in AT_REST and not self._rest.seen():  # after a re-zero
             self._fault(obs, f"unexpected contact during {self.state.value} ({self._rest})")
 
     def _fault(self, obs: Observation, reason: str, *, retract: bool = True) -> None:
@@ -248,7 +248,7 @@ class IndentationMachine:
 
     def _held(self, obs: Observation) -> Command | None:
         """Hold still while a :class:`RestCheck` runs (re-zeroing on its last tick)."""
-        rezero = self._rest.hold(self.state in (State.HOMING, State.POSITIONING))
+        rezero = self._rest.hold(self.state in AT_REST)
         return None if rezero is None else Command(obs.advance, obs.roll, 0.0, rezero=rezero)
 
     def _hold(self, obs: Observation) -> Command:

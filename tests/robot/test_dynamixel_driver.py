@@ -140,7 +140,12 @@ def test_a_transient_lost_reply_is_retried(silent: EmulatedBus) -> None:
     with in_process(silent) as driver:
         silent.servo(2).drop_replies(1)
         silent.servo(3).corrupt_replies(1)
+        before = driver.stats.copy()
         assert set(driver.read_state()) == set(NAMES)
+        counted = driver.stats.since(before)
+        assert counted.transactions == 1  # one read ...
+        assert counted.retries == 1  # ... whose first attempt lost both replies (one sync read)
+        assert counted.failures == 0
 
 
 def test_a_silent_servo_ends_in_a_transport_error(silent: EmulatedBus) -> None:
