@@ -138,7 +138,8 @@ def _replay_joint(
         raw = {**raw, **probe_inputs(probe)}
     inputs = EstimatorInputs.from_dict(raw)
     samples = list(log.of_kind("sample"))
-    rows = [(r["state"], r["advance"], r["strains"]) for r in samples]
+    # a tick whose servo read was missed logged no advance (null): the estimate skips its row
+    rows = [(r["state"], _number(r["advance"]), r["strains"]) for r in samples]
     tips = [r.get("tip_force") for r in samples] if any("tip_force" in r for r in samples) else None
     fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples], tips)
     end = log.end or {}
@@ -184,3 +185,8 @@ def _replay_joint(
 
 def _tuples(d: dict[str, Any]) -> dict[str, Any]:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+
+
+def _number(value: object) -> float:
+    """A log's number, NaN for its null (a value the tick did not measure)."""
+    return math.nan if value is None else float(value)  # type: ignore[arg-type]

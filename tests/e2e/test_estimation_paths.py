@@ -98,3 +98,20 @@ def test_palpate_sim_reports_verdicts_and_replay_tells_an_old_log(
     assert report["identical"] is True  # the paper's estimate; the joint fit is shown
     assert "version 1" in report["note"]
     assert report["joint"]["modulus"] is not None
+
+
+def test_replay_skips_a_sample_whose_servo_read_was_missed(tmp_path: Path) -> None:
+    """A tick whose servo read was missed logs no advance (null): replay leaves the row out
+    instead of failing (the fault campaign's burst of corrupt replies found it)."""
+    sc = scene("thin")
+    stack = load_stack(resolve(sc.robot))
+    (outcome,) = run_campaign(campaign_trials(sc, stack)[:1], sc, stack, log_dir=tmp_path)
+    path = Path(str(outcome.log_path))
+    lines = [json.loads(x) for x in path.read_text(encoding="utf-8").splitlines()]
+    loading = [r for r in lines if r.get("kind") == "sample" and r["state"] == "indenting"]
+    for record in loading[len(loading) // 2 :][:3]:
+        record["advance"] = None
+    missed = tmp_path / "missed.jsonl"
+    missed.write_text("\n".join(json.dumps(x) for x in lines) + "\n", encoding="utf-8")
+    report = replay(missed)
+    assert report["joint"]["modulus"] == pytest.approx(outcome.joint.modulus, rel=0.02)
