@@ -51,6 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from estimation.beamcolumn import capacity, lateral_shape, lateral_shape_by_grating
 from estimation.beamstate import onset_mode
 
 FloatArray = NDArray[np.float64]
@@ -71,6 +72,8 @@ _GOLDEN = 14  # golden-section steps on each row's load
 _PHI = (math.sqrt(5.0) - 1.0) / 2.0
 GRID_DEG = 40.0  # the lean searched over +-this
 GRID_POINTS = 21
+
+__all__ = ["Lean", "capacity", "lateral_shape", "measure_lean"]
 
 
 @dataclass(frozen=True)
@@ -157,35 +160,6 @@ class Lean:
         }
 
 
-def lateral_shape(
-    load: FloatArray,
-    length: FloatArray | float,
-    from_tip: FloatArray,
-    EI: float,
-    fiber_offset: float,
-) -> FloatArray:
-    """h (N, G): grating-mean strain per unit tan(gamma) of a clamped beam-column loaded at its
-    free tip by ``load`` (N,) along the axis and ``load tan(gamma)`` across it.
-
-    ``from_tip`` (G, 2): each grating's (d0, d1), metres from the tip; the part beyond L is
-    inside the tube (straight). ``length``: L (m), one or (N,). Loads must be below the
-    capacity (kL < pi/2).
-    """
-    k = np.sqrt(np.maximum(load, 0.0) / EI)[:, None]
-    length = np.broadcast_to(np.asarray(length, dtype=np.float64), k.shape[:1])[:, None]
-    d0 = np.minimum(from_tip[None, :, 0], length)
-    d1 = np.minimum(from_tip[None, :, 1], length)
-    span = (from_tip[:, 1] - from_tip[:, 0])[None, :]
-    # int k sin(k d) dd = cos(k d0) - cos(k d1), written without the cancellation at small k
-    integral = 2.0 * np.sin(0.5 * k * (d0 + d1)) * np.sin(0.5 * k * (d1 - d0))
-    return np.asarray(-fiber_offset * integral / (span * np.cos(k * length)))
-
-
-def capacity(EI: float, length: float) -> float:
-    """(pi/2)^2 EI / L^2 (N): the free-tip beam-column's axial load at which it diverges."""
-    return (0.5 * math.pi) ** 2 * EI / length**2
-
-
 def measure_lean(
     strains: FloatArray,
     lengths: FloatArray,
@@ -229,14 +203,18 @@ def measure_lean(
 
 @dataclass(frozen=True)
 class _Model:
-    """The rows and, per row, the candidate loads P_j = f_j cap_n with their lateral shapes."""
+    """The rows and, per row, the candidate loads P_j = f_j cap_n with their lateral shapes.
 
-    y: FloatArray  # (N, G)
-    unit: FloatArray  # (N, G): the onset mode, normalised per row
+    The per-grating arrays are grating-major (G first): the sums over a row's few gratings are
+    then G - 1 whole-array additions in order, which is what numpy's sum over a last axis
+    shorter than 8 does element by element (the same results, without the reduction's
+    per-element overhead on a 3-long axis)."""
+
+    y: FloatArray  # (G, N)
+    unit: FloatArray  # (G, N): the onset mode, normalised per row
     cap: FloatArray  # (N,)
     loads: FloatArray  # (N, J) candidate loads
-    h: FloatArray  # (N, J, G) lateral shape per unit tan(gamma) at each candidate load
-    base: FloatArray  # (N, J, G): y + P/EA at each candidate load (the part without c)
+    quadratic: tuple[FloatArray, FloatArray, FloatArray]  # (N, J) each: see build
     L: FloatArray  # (N,)
     from_tip: FloatArray  # (G, 2)
     EA: float
@@ -254,10 +232,24 @@ class _Model:
         loads = cap[:, None] * f[None, :]
         clipped = np.minimum(loads, LOAD_SHARE * cap[:, None])  # saturated past the capacity
         n, j = loads.shape
-        h = lateral_shape(clipped.ravel(), np.repeat(L, j), from_tip, EI, dy).reshape(n, j, -1)
-        unit = m / np.linalg.norm(m, axis=1, keepdims=True)
-        base = y[:, None, :] + loads[:, :, None] / EA
-        return cls(y, unit, cap, loads, h, base, L, from_tip, EA, EI, dy)
+        h = lateral_shape_by_grating(clipped.ravel(), np.repeat(L, j), from_tip, EI, dy)
+        unit = (m / np.linalg.norm(m, axis=1, keepdims=True)).T
+        base = y.T[:, :, None] + loads[None, :, :] / EA  # (G, N, J): the part without c
+        # the candidates' squared residual, quadratic in c: |b - c h|^2 = A - 2 c B + c^2 C
+        # with b and h the base and the lateral shape with the onset mode taken out per row
+        b = _without_mode(list(base), [g[:, None] for g in unit])
+        hp = _without_mode(list(h.reshape(-1, n, j)), [g[:, None] for g in unit])
+        cross = _in_order([g * w for g, w in zip(b, hp, strict=True)])
+        quadratic = (_in_order([g * g for g in b]), cross, _in_order([w * w for w in hp]))
+        return cls(y.T, unit, cap, loads, quadratic, L, from_tip, EA, EI, dy)
+
+    @property
+    def rows(self) -> int:
+        return int(self.y.shape[1])
+
+    @property
+    def gratings(self) -> int:
+        return int(self.y.shape[0])
 
     def rss(self, c: float, pinned: bool = False) -> tuple[float, FloatArray]:
         """Residual sum of squares at ``c`` with each row's load and bow fitted, and the loads:
@@ -271,10 +263,11 @@ class _Model:
         arithmetic of each c is :meth:`rss`'s element for element (one numpy call for all of
         them instead of one per c: the rows are few, the calls' overhead was the cost)."""
         cols = self.loads.shape[1] if pinned else _BELOW
-        loads, h, base = self.loads[:, :cols], self.h[:, :cols], self.base[:, :cols]
-        ss = self._ss(base[None] - cs[:, None, None, None] * h[None], candidates=True)
-        j = np.argmin(ss, axis=-1)  # (C, N)
-        rows = np.arange(ss.shape[1])[None, :]
+        loads = self.loads[:, :cols]
+        bb, bh, hh = (q[None, :, :cols] for q in self.quadratic)
+        c3 = cs[:, None, None]
+        j = np.argmin(bb - 2.0 * c3 * bh + c3 * c3 * hh, axis=-1)  # (C, N): the best candidate
+        rows = np.arange(j.shape[1])[None, :]
         lo = loads[rows, np.maximum(j - 1, 0)]
         hi = loads[rows, np.minimum(j + 1, cols - 1)]
         both = np.concatenate([cs, cs])
@@ -287,18 +280,41 @@ class _Model:
         return np.sum(self._row_ss(cs, P), axis=-1), P
 
     def _row_ss(self, cs: FloatArray, P: FloatArray) -> FloatArray:
-        """(C, N): each row's residual at its load P (C, N) and the lean c of its line."""
-        flat = np.minimum(P, LOAD_SHARE * self.cap).ravel()
-        lengths = np.tile(self.L, P.shape[0])
-        shape = lateral_shape(flat, lengths, self.from_tip, self.EI, self.dy).reshape(*P.shape, -1)
-        return self._ss(self.y + P[..., None] / self.EA - cs[:, None, None] * shape)
+        """(C, N): each row's residual at its load P (C, N) and the lean c of its line (the
+        lateral shape as :func:`lateral_shape_by_grating` computes it, element for element,
+        with the rows' grating spans taken once)."""
+        k = np.sqrt(np.maximum(np.minimum(P, LOAD_SHARE * self.cap), 0.0) / self.EI)
+        half_k = 0.5 * k
+        d0 = np.minimum(self.from_tip[:, 0, None], self.L)  # (G, N)
+        d1 = np.minimum(self.from_tip[:, 1, None], self.L)
+        span = (self.from_tip[:, 1] - self.from_tip[:, 0])[:, None, None]
+        integral = (
+            2.0 * np.sin(half_k * (d0 + d1)[:, None, :]) * np.sin(half_k * (d1 - d0)[:, None, :])
+        )
+        shape = -self.dy * integral / (span * np.cos(k * self.L))
+        axial = P / self.EA
+        c2 = cs[:, None]
+        return self._ss([y + axial - c2 * g for y, g in zip(self.y, shape, strict=True)])
 
-    def _ss(self, v: FloatArray, candidates: bool = False) -> FloatArray:
-        """Squared norm over the last axis of v with the onset mode taken out (per row; the
-        rows on the axis before the last with ``candidates``)."""
-        u = self.unit[:, None, :] if candidates else self.unit
-        along = np.sum(v * u, axis=-1, keepdims=True)
-        return np.asarray(np.sum((v - along * u) ** 2, axis=-1))
+    def _ss(self, v: list[FloatArray]) -> FloatArray:
+        """Squared norm over the gratings of v (one (C, N) array per grating) with the onset
+        mode taken out per row."""
+        return _in_order([g**2 for g in _without_mode(v, list(self.unit))])
+
+
+def _without_mode(v: list[FloatArray], u: list[FloatArray]) -> list[FloatArray]:
+    """v (one array per grating) with its component along the unit onset mode u taken out."""
+    along = _in_order([vg * ug for vg, ug in zip(v, u, strict=True)])
+    return [vg - along * ug for vg, ug in zip(v, u, strict=True)]
+
+
+def _in_order(terms: list[FloatArray]) -> FloatArray:
+    """t0 + t1 + ... added left to right: numpy's sum over a last axis of fewer than 8
+    elements, element for element."""
+    total = terms[0]
+    for term in terms[1:]:
+        total = total + term
+    return total
 
 
 def _profile(model: _Model) -> Lean:
@@ -316,8 +332,8 @@ def _profile(model: _Model) -> Lean:
     c = 0.5 * (lo + hi)
     rss_free, P = model.rss(c)
     rss_pinned, P_pinned = model.rss(0.0, pinned=True)
-    rows = model.y.shape[0]
-    dof = max(rows * (model.y.shape[1] - 2) - 1, 1)  # each row: its load and its bow
+    rows = model.rows
+    dof = max(rows * (model.gratings - 2) - 1, 1)  # each row: its load and its bow
     s2 = max(min(rss_free, rss_pinned) / dof, 1e-30)
     sigma_c = _half_width(grid, (rss - rss_free) / s2)
     sigma = math.hypot(sigma_c / (1.0 + c * c), MODEL_FLOOR)
@@ -343,31 +359,6 @@ def _crossing(grid: FloatArray, chi2: FloatArray, out: int, inside: int) -> floa
     """Where chi2 crosses 1 between grid points ``out`` (> 1) and ``inside`` (<= 1)."""
     x0, x1, y0, y1 = grid[inside], grid[out], chi2[inside], chi2[out]
     return float(x0 + (1.0 - y0) * (x1 - x0) / (y1 - y0))
-
-
-def _basis(m: FloatArray) -> FloatArray:
-    """(N, G, 2): per row the columns -1 (the axial strain) and the onset mode."""
-    return np.stack([-np.ones_like(m), m], axis=2)
-
-
-def _per_row(y: FloatArray, m: FloatArray, lateral: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """(P/EA, A) per row: least squares of y - lateral on the basis."""
-    b = _basis(m)
-    coef = _solve(b, y - lateral)
-    return coef[:, 0], coef[:, 1]
-
-
-def _project(v: FloatArray, m: FloatArray) -> FloatArray:
-    """v (N, G) with each row's part in the span of its basis taken out."""
-    b = _basis(m)
-    coef = _solve(b, v)
-    return np.asarray(v - np.einsum("ngi,ni->ng", b, coef))
-
-
-def _solve(b: FloatArray, v: FloatArray) -> FloatArray:
-    """(N, 2): per row the least-squares coefficients of v (N, G) on the columns b (N, G, 2)."""
-    normal = np.einsum("ngi,ngj->nij", b, b)
-    return np.asarray(np.linalg.solve(normal, np.einsum("ngi,ng->ni", b, v)[..., None])[..., 0])
 
 
 def _groups(L: FloatArray) -> NDArray[np.int64]:

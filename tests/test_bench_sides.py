@@ -90,3 +90,20 @@ def test_sides_of_two_trials_add_up_and_leave_the_estimates_alone(tmp_path: Path
         timed = run_campaign(spec, scene, stack, log_dir=tmp_path / "b")[0]
     assert plain.modulus("joint") == timed.modulus("joint")
     assert plain.modulus("paper") == timed.modulus("paper")
+
+
+def test_the_estimator_check_says_when_the_estimate_got_slower() -> None:
+    from palpate.benchmarks.sides import REGRESSION, Sides, estimator_check
+
+    def sides(estimator_s: float) -> Sides:
+        parts = {b.part: 0.0 for b in BOUNDARIES}
+        parts[next(b.part for b in BOUNDARIES if b.side == ESTIMATOR)] = estimator_s
+        return Sides(trials=10, ticks=1000, sim_time=40.0, whole=4.0, parts=parts, calls={},
+                     startup=1.0, removed=0.0)  # fmt: skip
+
+    within = estimator_check(sides(1.0), reference_ms=100.0)  # 100 ms a trial
+    assert within["ratio"] == pytest.approx(1.0)
+    assert within["share"] == pytest.approx(0.25)
+    assert within["regression"] is False
+    slower = estimator_check(sides(1.0 * REGRESSION + 0.01), reference_ms=100.0)
+    assert slower["regression"] is True

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import nnls  # type: ignore[import-untyped,unused-ignore]
-from scipy.signal import lfilter  # type: ignore[import-untyped,unused-ignore]
 
 from estimation.corrections import ContactLaw
 from estimation.jointfit.noise import lag1
@@ -82,6 +81,9 @@ def memory_basis(times: FloatArray, shape: FloatArray, taus: FloatArray) -> Floa
         gain = np.where(x > 0, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0)
         drive = gain * df
         if uniform and times.size > 2:
+            # imported here: scipy.signal costs 0.1 s to import, and few trials hold
+            from scipy.signal import lfilter  # type: ignore[import-untyped,unused-ignore]
+
             out[:, k] = lfilter([1.0], [1.0, -decay[1]], drive)
             continue
         h = 0.0

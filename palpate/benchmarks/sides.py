@@ -85,6 +85,17 @@ TICKS = "ticks (observe, decide, command)"
 SHIPPED, LEAN = "scenes/bench.yaml", "scenes/bench-lean.yaml"
 # (scene, its name in the table, the issue's target in x real time per core)
 SCENES = ((SHIPPED, "shipped bench scene", 100.0), (LEAN, "lean level (bench-lean.yaml)", 500.0))
+# The estimator's CPU a trial (ms) when the issue on its cost set it (2-core machine of
+# docs/speed.md; --quick and full runs): a run above REGRESSION times its reference says so in
+# the table's note and the summary. A reference, not a timed test: another machine's figures
+# scale with its speed, so read the ratio on the machine the reference was taken on.
+ESTIMATOR_REFERENCE_MS = {
+    (SHIPPED, True): 107.0,
+    (SHIPPED, False): 129.0,
+    (LEAN, True): 48.0,
+    (LEAN, False): 52.0,
+}
+REGRESSION = 1.25
 IMPORTS = (
     "import palpate.cli, palpate.campaigns.campaign, palpate.simulation.trial,"
     " palpate.simulation.result"
@@ -240,7 +251,21 @@ def measure_sides(
     )
 
 
-def _table(s: Sides, ctx: BenchContext, name: str, target: float) -> Table:
+def estimator_check(s: Sides, reference_ms: float) -> dict[str, Any]:
+    """The estimator's CPU a trial against its stored reference: the share of the trial, the
+    ratio and whether it is a regression (above ``REGRESSION`` times the reference)."""
+    ms = 1e3 * s.side(ESTIMATOR) / s.trials
+    ratio = ms / reference_ms
+    return {
+        "ms_per_trial": ms,
+        "share": s.side(ESTIMATOR) / s.whole,
+        "reference_ms": reference_ms,
+        "ratio": ratio,
+        "regression": ratio > REGRESSION,
+    }
+
+
+def _table(s: Sides, ctx: BenchContext, name: str, target: float, reference: float) -> Table:
     n, ticks = s.trials, max(s.ticks, 1)
     rows: list[Sequence[Any]] = []
     for side in (SIMULATOR, CONTROL, ESTIMATOR):
@@ -252,6 +277,8 @@ def _table(s: Sides, ctx: BenchContext, name: str, target: float) -> Table:
     rows.append(["-", "start-up share (one process)", 1e3 * s.startup / n, "-"])
     per_trial = s.sim_time / n
     free = s.real_time_per_core(CONTROL, ESTIMATOR, startup=True)
+    check = estimator_check(s, reference)
+    judged = ": SLOWER than " if check["regression"] else ", within "
     return Table(
         title=f"{name[0].upper()}{name[1:]} (fast, serial): a trial's CPU by side",
         columns=["side", "part", "CPU ms/trial", "us/tick"],
@@ -265,7 +292,11 @@ def _table(s: Sides, ctx: BenchContext, name: str, target: float) -> Table:
             "simulator cost "
             f"nothing: {free:.1f}x with the start-up, "
             f"{s.real_time_per_core(CONTROL, ESTIMATOR, startup=False):.1f}x without; the "
-            f"control path alone: {s.real_time_per_core(CONTROL, startup=False):.1f}x."
+            f"control path alone: {s.real_time_per_core(CONTROL, startup=False):.1f}x. "
+            f"The estimator: {check['ms_per_trial']:.1f} ms a trial, "
+            f"{100 * check['share']:.0f} % of it; {check['ratio']:.2f}x its reference "
+            f"({check['reference_ms']:.0f} ms){judged}"
+            f"{REGRESSION}x."
         ),
     )
 
@@ -275,7 +306,8 @@ def run(ctx: BenchContext) -> BenchSection:
     for path, name, target in SCENES:
         with tempfile.TemporaryDirectory(prefix="palpate-sides-") as tmp:
             sides = measure_sides(ctx.quick, ctx.seed, Path(tmp), scene_path=path)
-        tables.append(_table(sides, ctx, name, target))
+        reference = ESTIMATOR_REFERENCE_MS[(path, ctx.quick)]
+        tables.append(_table(sides, ctx, name, target, reference))
         summary[name] = {
             "trials": sides.trials,
             "ticks": sides.ticks,
@@ -287,5 +319,6 @@ def run(ctx: BenchContext) -> BenchSection:
                 CONTROL, ESTIMATOR, startup=True
             ),
             "x_real_time_control_only": sides.real_time_per_core(CONTROL, startup=False),
+            "estimator": estimator_check(sides, reference),
         }
     return BenchSection(name="sides", tables=tables, summary=summary)

@@ -32,7 +32,6 @@ from palpate.cli import EXIT_FAULT, EXIT_OK
 from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
 from palpate.reports import verdicts
-from palpate.reports.plots import campaign_figures
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
 from palpate.simulation.world import tissue_description
@@ -283,6 +282,13 @@ def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> None
         print(json.dumps(payloads[0] if len(payloads) == 1 else {"campaigns": payloads}, indent=2))
 
 
+def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
+    """The campaign's figures (matplotlib is imported here: 0.3 s a run that draws none)."""
+    from palpate.reports.plots import campaign_figures
+
+    return campaign_figures(c.outcomes, rows, c.run_dir, c.scene.name)
+
+
 def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     """Print one campaign's table (unless ``--json``) and return its JSON payload."""
     scene, outcomes, wall = c.scene, c.outcomes, c.wall
@@ -290,7 +296,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     sim_time = sum(o.sim_time for o in outcomes)
     mare = median_abs_relative_error(outcomes)
     paper = median_abs_relative_error(outcomes, "paper")
-    figures = [] if args.no_plots else campaign_figures(c.outcomes, rows, c.run_dir, c.scene.name)
+    figures = [] if args.no_plots else _figures(c, rows)
     payload: dict[str, object] = {
         "scene": scene.name,
         "log_dir": str(c.log_dir),
