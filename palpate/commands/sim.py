@@ -32,6 +32,7 @@ from palpate.cli import EXIT_FAULT, EXIT_OK
 from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
 from palpate.reports import verdicts
+from palpate.reports.campaign_table import kpa_fields, print_table
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
 from palpate.simulation.world import tissue_description
@@ -304,7 +305,7 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
         "seed": args.seed,
         "trials": [o.as_dict() for o in outcomes],
         "samples": [
-            {"sample": r.sample, "trials": r.trials, **_kpa(r.summary.__dict__)}
+            {"sample": r.sample, "trials": r.trials, **kpa_fields(r.summary.__dict__)}
             | {"tissue_model": tissue_description(scene, c.stack, r.sample)}
             for r in rows
         ],
@@ -342,7 +343,7 @@ def _print_report(
     sim_time = sum(o.sim_time for o in outcomes)
     paper = median_abs_relative_error(outcomes, "paper")
     failed = [o for o in outcomes if o.state != "done"]
-    _print_table(c.scene.name, rows, verdicts.by_sample(outcomes))
+    print_table(c.scene.name, rows, verdicts.by_sample(outcomes))
     samples = c.scene.campaign_samples()
     levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
@@ -367,40 +368,3 @@ def _print_report(
     for f in figures:
         print(f"plot: {f}")
     print()
-
-
-def _kpa(d: dict[str, object]) -> dict[str, object]:
-    out: dict[str, object] = {}
-    for k, v in d.items():
-        if k in ("actual", "mean", "median", "rmse", "iqr") and isinstance(v, float):
-            out[f"{k}_kpa"] = v / 1e3
-        else:
-            out[k] = v
-    return out
-
-
-def _print_table(name: str, rows: list, tallies: dict[str, verdicts.Tally]) -> None:  # type: ignore[type-arg]
-    print(
-        f"{name} campaign: estimated vs actual Young's modulus (kPa), joint fit (E and contact "
-        "point fitted on the whole record; the paper's estimate is in --json) over the trials "
-        "whose verdict is ok, outliers > 3 MPa removed; ok/sus/none: verdicts; cover: 95 % "
-        "intervals holding the truth / trials with a number"
-    )
-    cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("estimated", 10), ("actual", 9)]
-    cols += [("RMSE", 9), ("IQR", 9), ("rel.err", 8), ("cover", 6)]
-    head = " ".join(f"{c:>{w}}" for c, w in cols)
-    print(head)
-    print("-" * len(head))
-    for r in rows:
-        s = r.summary
-
-        def k(v: float | None) -> str:
-            return "-" if v is None else f"{v / 1e3:.2f}"
-
-        rel = "-" if s.relative_error is None else f"{100 * s.relative_error:+.1f}%"
-        t = tallies[r.sample]
-        counts = verdicts.counts_column(t)
-        print(
-            f"{r.sample:>8} {r.trials:>6} {counts:>11} {k(s.mean):>10} {k(s.actual):>9} "
-            f"{k(s.rmse):>9} {k(s.iqr):>9} {rel:>8} {f'{t.covered}/{t.numbers}':>6}"
-        )
