@@ -130,10 +130,15 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
         return _none(soft, facts)
     if fit is None or not fit.success or fit.modulus is None:
         return _none("no estimate: " + ("no fit" if fit is None else fit.message), facts)
+    # outside the designed range: still a number and its interval, marked suspect (a clinician's
+    # answer to 0.8 kPa before a 1-20 kPa sensor is "softer than 1 kPa", not nothing)
+    # -- unless the tip slid: its load never reached the pinned beam's, so the number is the
+    # slide's, not the tissue's (none, naming the slide)
     outside = _outside_range(fit, facts.designed_range)
-    if outside is not None:
+    if outside is not None and facts.lean is not None and facts.lean.lateral:
         return _none(outside, facts)
-    reasons = [w for w in fit.warnings if _is_suspect(w)]
+    reasons = [] if outside is None else [outside]
+    reasons += [w for w in fit.warnings if _is_suspect(w)]
     imprecise = _imprecise(fit)
     if imprecise is not None:
         reasons.append(imprecise)
@@ -155,8 +160,8 @@ def _none(reason: str, facts: TrialFacts) -> Verdict:
 
 
 def _outside_range(fit: JointFit, designed: tuple[float, float] | None) -> str | None:
-    """Why a modulus whose whole interval lies outside the sensor's designed range has no number,
-    or None."""
+    """Why a modulus whose whole interval lies outside the sensor's designed range is suspect
+    (its number kept: which side of the range it lies is the answer), or None."""
     if designed is None or fit.modulus is None:
         return None
     lo = fit.modulus if fit.ci_low is None else fit.ci_low
@@ -165,8 +170,9 @@ def _outside_range(fit: JointFit, designed: tuple[float, float] | None) -> str |
         return None
     side = "below" if hi < designed[0] else "above"
     return (
-        f"outside the sensor's designed range: {fit.modulus / 1e3:.3g} kPa is {side} "
-        f"{designed[0] / 1e3:g}-{designed[1] / 1e3:g} kPa (see `palpate design`)"
+        f"{side} the designed range {designed[0] / 1e3:g}-{designed[1] / 1e3:g} kPa: "
+        f"{fit.modulus / 1e3:.3g} kPa, outside the sensor's designed range, less accurate "
+        "there (see `palpate design`)"
     )
 
 

@@ -259,6 +259,7 @@ def run(ctx: BenchContext) -> BenchSection:
     cheapest = next(r for r in rows if r.level == CHEAPEST)
     summary["cheapest_vs_shipped"] = ref.cpu_per_trial / cheapest.cpu_per_trial
     summary["cheapest_usable"] = usable(cheapest)
+    ctx.out_dir.mkdir(parents=True, exist_ok=True)  # only a section that draws makes it
     figure = _plot(rows, ctx.out_dir / "campaign_fidelity.png")
     return BenchSection(
         name="campaign", tables=[_table(rows, ctx)], figures=[figure], summary=summary

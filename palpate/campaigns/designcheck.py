@@ -196,3 +196,73 @@ def error_summary(outcomes: list[TrialOutcome], method: str) -> dict[str, float 
         "median_abs_relative_error": median_abs_relative_error(outcomes, method),
         "max_abs_relative_error": max(errors, default=None),
     }
+
+
+DEFAULT_TOLERANCE = 0.20
+"""The largest |relative error| of the joint fit on a phantom for the design to be usable."""
+
+
+@dataclass(frozen=True)
+class DesignVerdict:
+    """Whether a proposed design works, from its own checks: ``usable`` (None when it was not
+    checked in simulation), the reasons it is not (or why it is unchecked), and the conditions
+    it is usable under (a tip that sags held across: only pointing vertically or bending in a
+    horizontal plane; the paper's own sensor sags 5 % of L held across, and worked)."""
+
+    usable: bool | None
+    reasons: tuple[str, ...]
+    conditions: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "usable": self.usable,
+            "reasons": list(self.reasons),
+            "conditions": list(self.conditions),
+        }
+
+    def headline(self) -> str:
+        """The first line of ``palpate design``'s report."""
+        only = "; usable only " + "; ".join(self.conditions) if self.conditions else ""
+        if self.usable:
+            return (
+                "USABLE design: its simulated check estimates every phantom within tolerance" + only
+            )
+        if self.usable is None:
+            return "UNCHECKED design: " + "; ".join(self.reasons) + only
+        return "NOT USABLE: " + "; ".join(self.reasons)
+
+
+def design_verdict(
+    found: bool,
+    outcomes: list[TrialOutcome] | None,
+    sag_ok: bool | None,
+    sag_text: str = "",
+    tolerance: float = DEFAULT_TOLERANCE,
+) -> DesignVerdict:
+    """The verdict on a proposal (``found``: the search found one) from its simulated check's
+    ``outcomes`` (None: skipped), its weight check (``sag_ok``, None without one; ``sag_text``
+    says by how much) and the ``tolerance`` on the joint fit's |relative error|."""
+    if not found:
+        return DesignVerdict(False, ("no design satisfies the constraints",))
+    conditions: tuple[str, ...] = ()
+    if sag_ok is False:
+        conditions = (
+            f"pointing vertically or bending in a horizontal plane (held across, {sag_text})",
+        )
+    if outcomes is None:
+        return DesignVerdict(None, ("simulated check skipped",), conditions)
+    faulted = [o.spec.sample for o in outcomes if o.state != "done"]
+    missing = [o.spec.sample for o in outcomes if o.modulus("joint") is None]
+    wrong = [
+        f"{o.spec.sample} {100 * e:+.0f} %"
+        for o in outcomes
+        if (e := relative_error(o, "joint")) is not None and abs(e) > tolerance
+    ]
+    reasons: list[str] = []
+    if faulted:
+        reasons.append(f"trials that did not complete: {', '.join(faulted)}")
+    if missing:
+        reasons.append(f"no estimate on {len(missing)} of {len(outcomes)}: {', '.join(missing)}")
+    if wrong:
+        reasons.append(f"errors beyond +-{100 * tolerance:.0f} %: {', '.join(wrong)}")
+    return DesignVerdict(not reasons, tuple(reasons), conditions)

@@ -4,9 +4,10 @@ A run of ``palpate sim`` writes each scene's logs and plots under ``OUT/<scene>/
 stamp is the local start time ``YYYYmmdd-HHMMSS``, with ``-2``, ``-3``, ... when two runs start in
 the same second): the folder is created exclusively, so two runs never share one, and nothing
 already under ``OUT`` is deleted. The folder holds ``run.json`` (what ran: the scene, seed, limit,
-transport and a fingerprint of the configuration) and ``.lock``, locked while a process writes
-there, so a second writer (``--resume`` of a run still going) is refused instead of mixing its
-logs in. The lock dies with its process: a run killed with SIGKILL leaves it free.
+transport and a fingerprint of the configuration), its results (``palpate.reports.results``) and,
+while a process writes there, ``.lock``, so a second writer (``--resume`` of a run still going)
+is refused instead of mixing its logs in. A run that ends (done, error, Ctrl-C) removes its
+lock; the lock dies with its process, so a run killed with SIGKILL leaves a free ``.lock``.
 
 ``--resume`` picks the newest folder of the scene whose ``run.json`` matches the run asked for
 (same configuration, seed, limit and transport): its complete logs are kept and their trials
@@ -119,7 +120,11 @@ def locked(run_dir: Path) -> Iterator[Path]:
             ) from None
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-        yield run_dir
+        try:
+            yield run_dir
+        finally:  # still holding it: no other process can be using the file
+            with contextlib.suppress(OSError):
+                os.unlink(run_dir / LOCK_FILE)
     finally:
         os.close(fd)  # releases the lock
 

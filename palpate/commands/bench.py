@@ -29,7 +29,6 @@ def register(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     repeats = 3 if args.quick else 7
     ctx = BenchContext(out_dir=args.out, quick=args.quick, seed=args.seed, repeats=repeats)
-    ctx.out_dir.mkdir(parents=True, exist_ok=True)
     names = args.only or list(SECTIONS)
     results: list[BenchSection] = []
     for name in names:

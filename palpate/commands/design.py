@@ -3,8 +3,12 @@
 ``palpate design --modulus-range 1:10 --unit kPa`` proposes the fiber, wires, tip radius and
 exposed length (``estimation.design``), prints the predicted indentation at buckling at both
 ends of the range with every check's margin, then runs a short simulated bench campaign with
-the proposed sensor on phantoms spread over the range (``--no-sim`` skips it). Exit code 2 when
-no design satisfies the constraints (the message names the failing constraint).
+the proposed sensor on phantoms spread over the range (``--no-sim`` skips it). The first line
+says whether the proposal is usable (``palpate.campaigns.designcheck.design_verdict``: every
+phantom estimated within ``--tolerance-pct``, no trial failing, the tip's sag within its limit)
+and why not; ``--json`` has ``usable`` and ``reasons``. Exit 0 for a usable (or unchecked)
+design, 1 for one that is not usable, 2 when no design satisfies the constraints (the message
+names the failing constraint).
 """
 
 from __future__ import annotations
@@ -29,9 +33,11 @@ from estimation.section import composite_section
 from palpate.argtypes import non_negative_int, positive_int
 from palpate.campaigns.campaign import campaign_trials, default_workers
 from palpate.campaigns.designcheck import (
+    DEFAULT_TOLERANCE,
     UNITS,
     CheckSettings,
     design_scene,
+    design_verdict,
     designed_stack,
     run_check,
 )
@@ -143,6 +149,13 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     )
     add_executor_arguments(parser)
     parser.add_argument("--no-sim", action="store_true", help="skip the simulated campaign")
+    parser.add_argument(
+        "--tolerance-pct",
+        type=float,
+        default=100 * DEFAULT_TOLERANCE,
+        help="the largest |relative error| of the joint fit on a phantom of the simulated check "
+        "for the design to be usable (default %(default)g %%)",
+    )
     parser.add_argument(
         "--tip-grating",
         action="store_true",
@@ -259,7 +272,6 @@ def _print_tip(
             f"({tip.resolution_share:.2%} of P_cr at 1 sigma)"
         )
     if weight is not None:
-        verdict = "within" if weight.ok else "beyond"
         advice = (
             ""
             if weight.ok
@@ -268,13 +280,23 @@ def _print_tip(
                 "(docs/lung.md)"
             )
         )
-        print(
-            f"weight: held across, the tip sags {weight.sag * 1e3:.3g} mm "
-            f"({weight.sag_over_length:.1%} of L, {verdict} {SAG_LIMIT:.1%}; a tip under "
-            f"{_two_digits_down(weight.tip_mass_limit * 1e3):g} g would be within){advice}"
-        )
+        print(f"weight: held across, {_sag_text(weight)}{advice}")
     if written is not None:
         print(f"wrote {written}")
+
+
+def _sag_text(weight: WeightCheck) -> str:
+    verdict = "within" if weight.ok else "beyond"
+    limit = weight.tip_mass_limit * 1e3
+    lighter = (
+        f"a tip under {_two_digits_down(limit):g} g would be within"
+        if limit > 0
+        else "the beam's own weight sags it beyond, whatever its tip"
+    )
+    return (
+        f"the tip sags {weight.sag * 1e3:.3g} mm ({weight.sag_over_length:.1%} of L, {verdict} "
+        f"{SAG_LIMIT:.1%}; {lighter})"
+    )
 
 
 def _two_digits_down(x: float) -> float:
@@ -317,14 +339,21 @@ def run(args: argparse.Namespace) -> int:
         if not args.no_sim:
             outcomes, wall = _run_sim(scene, sim_stack, args)
     run = CheckRun(outcomes, wall, args.unit, args.executor)
+    verdict = design_verdict(
+        result.success,
+        None if args.no_sim else outcomes,
+        None if weight is None else weight.ok,
+        "" if weight is None else _sag_text(weight),
+        args.tolerance_pct / 100,
+    )
     if args.json:
         extra = {**_tip_payload(tip), **({} if weight is None else {"weight": weight.as_dict()})}
-        print(json.dumps({**payload(result, constraints, run), **extra}, indent=2))
+        body = {**verdict.as_dict(), **payload(result, constraints, run), **extra}
+        print(json.dumps(body, indent=2))
     else:
+        print(verdict.headline())
         print_report(result, constraints, run)
         _print_tip(tip, weight, args.write)
     if not result.success:
         return EXIT_NO_DESIGN
-    if any(o.state != "done" for o in outcomes):  # a trial of the check faulted
-        return 1
-    return 0
+    return 0 if verdict.usable is not False else 1

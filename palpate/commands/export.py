@@ -1,8 +1,9 @@
 """Convert trial logs to MCAP recordings that ROS 2 tools and Foxglove open.
 
-Each ``LOG`` (a ``.jsonl`` trial log of ``palpate sim`` or ``palpate trial``) becomes
-``LOG.mcap`` beside it, or in ``--out``: the messages its trial would have recorded
-(``robot.trial.recording``; docs/recordings.md). Exit 0 when every log converted, 2 when one is
+Each ``LOG`` (a ``.jsonl`` trial log of ``palpate sim`` or ``palpate trial``) becomes a
+recording of the same name with ``.mcap`` for ``.jsonl`` (``S1.jsonl`` -> ``S1.mcap``) beside
+it, or in ``--out``: the messages its trial would have recorded (``robot.trial.recording``;
+docs/recordings.md). Exit 0 when every log converted, 2 when one is
 not a trial log (named, with what is wrong); the others are still converted."""
 
 from __future__ import annotations

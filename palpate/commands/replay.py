@@ -53,11 +53,18 @@ def run(args: argparse.Namespace) -> int:
         if "message" in report:
             print(report["message"])
             return 1
-        m, r = report["modulus"], report["recorded_modulus"]
         print(f"final state: {report['state']} ({report['reason']})")
-        print(f"replayed estimate: {'-' if m is None else f'{m / 1e3:.3f} kPa'}")
-        print(f"recorded estimate: {'-' if r is None else f'{r / 1e3:.3f} kPa'}")
         _print_joint(report)
+        m, r = report["paper_modulus"], report["recorded_paper_modulus"]
+        single = "the paper's single point (Eqs. 13-14), no interval"
+        print(f"replayed paper estimate: {'-' if m is None else f'{m / 1e3:.3f} kPa'} ({single})")
+        print(f"recorded paper estimate: {'-' if r is None else f'{r / 1e3:.3f} kPa'}")
+        for key, what in (
+            ("truth_kpa", "true modulus (simulation)"),
+            ("reference_kpa", "reference"),
+        ):
+            if report.get(key) is not None:
+                print(f"{what}: {report[key]:.3f} kPa")
         print("identical" if report["identical"] else "DIFFERENT")
     return 0 if report.get("identical") else 1
 
@@ -97,8 +104,8 @@ def _print_joint(report: dict[str, object]) -> None:
         else:
             print(f"replayed compliance: none ({cal.get('message')})")
     if report.get("joint") is not None:
-        print(f"replayed joint fit: {_fit_text(report['joint'])}")
-        print(f"recorded joint fit: {_fit_text(report.get('recorded_joint'))}")
+        print(f"replayed joint fit estimate: {_fit_text(report['joint'])}")
+        print(f"recorded joint fit estimate: {_fit_text(report.get('recorded_joint'))}")
     if "replayed_verdict" in report:
         print(f"replayed verdict: {_verdict_text(report['replayed_verdict'])}")
         print(f"recorded verdict: {_verdict_text(report.get('recorded_verdict'))}")

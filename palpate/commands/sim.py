@@ -10,6 +10,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from config import InputError, load, load_stack, resolve
 from config.scene import SceneConfig
@@ -32,7 +33,8 @@ from palpate.cli import EXIT_FAULT, EXIT_OK
 from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
 from palpate.reports import verdicts
-from palpate.reports.campaign_table import kpa_fields, print_table
+from palpate.reports.campaign_table import kpa_fields, print_table, sample_records
+from palpate.reports.results import CampaignResults
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
 from palpate.simulation.world import tissue_description
@@ -114,6 +116,7 @@ class _Campaign:
     done: dict[str, TrialOutcome] = field(default_factory=dict)  # read back on --resume
     outcomes: list[TrialOutcome] = field(default_factory=list)
     wall: float = 0.0
+    results: CampaignResults = field(default_factory=lambda: CampaignResults(Path()))
 
     @property
     def log_dir(self) -> Path:
@@ -155,9 +158,14 @@ def _run(campaigns: list[_Campaign], args: argparse.Namespace) -> float:
     total = sum(len(c.to_run()) for c in campaigns)
     bar = progress_bar(total, "campaign")
 
+    by_logs = {c.log_dir: c for c in campaigns}
+
     def progress(o: TrialOutcome) -> None:
         bar.update(1)
         bar.set_postfix_str(o.spec.trial_id)
+        c = by_logs.get(Path(o.log_path).parent) if o.log_path else None
+        if c is not None:  # each trial's row on disk as it finishes
+            c.results.add(o.as_dict())
 
     runs = [
         CampaignRun(
@@ -246,12 +254,15 @@ def _open_run(c: _Campaign, args: argparse.Namespace, locks: contextlib.ExitStac
     if args.resume:
         c.run_dir = locks.enter_context(locked(resumable(base, info)))
         c.done = resume_outcomes(c.log_dir, c.specs, c.stack)
+        c.results = CampaignResults(c.run_dir)
+        c.results.start(o.as_dict() for s in c.specs if (o := c.done.get(s.trial_id)))
         log.info(
             "resuming %s: %d of %d trials already complete", c.run_dir, len(c.done), len(c.specs)
         )
     else:
         c.run_dir = locks.enter_context(locked(new_run_dir(base)))
         write_run_info(c.run_dir, info)
+        c.results = CampaignResults(c.run_dir)
     c.log_dir.mkdir(exist_ok=True)
 
 
@@ -291,27 +302,33 @@ def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
 
 
 def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
-    """Print one campaign's table (unless ``--json``) and return its JSON payload."""
+    """Print one campaign's table (unless ``--json``), write its results into the run folder
+    (``palpate.reports.results``) and return its JSON payload."""
     scene, outcomes, wall = c.scene, c.outcomes, c.wall
-    rows = summarize_campaign(outcomes, scene.campaign.outlier_above_kpa * 1e3)
+    outlier_above = scene.campaign.outlier_above_kpa * 1e3
+    rows = summarize_campaign(outcomes, outlier_above)
+    records = sample_records(outcomes, rows, outlier_above)
     sim_time = sum(o.sim_time for o in outcomes)
-    mare = median_abs_relative_error(outcomes)
-    paper = median_abs_relative_error(outcomes, "paper")
     figures = [] if args.no_plots else _figures(c, rows)
+    trials = [o.as_dict() for o in outcomes]
     payload: dict[str, object] = {
         "scene": scene.name,
+        "run_dir": str(c.run_dir),
         "log_dir": str(c.log_dir),
         "transport": c.transport,
         "seed": args.seed,
-        "trials": [o.as_dict() for o in outcomes],
+        "trials": trials,
         "samples": [
-            {"sample": r.sample, "trials": r.trials, **kpa_fields(r.summary.__dict__)}
+            {**rec, "joint_median_kpa": kpa_fields(r.summary.__dict__).get("median_kpa")}
             | {"tissue_model": tissue_description(scene, c.stack, r.sample)}
-            for r in rows
+            for r, rec in zip(rows, records, strict=True)
         ],
-        "median_abs_relative_error": mare,
-        "method": "joint fit (contact-point-free); paper estimate per trial as estimated_kpa",
-        "median_abs_relative_error_paper": paper,
+        "median_abs_relative_error": median_abs_relative_error(outcomes),
+        "method": (
+            "joint fit (contact-point-free; joint_kpa, ok trials in the medians); the paper's "
+            "single-point estimate (Eqs. 13-14) per trial as paper_kpa"
+        ),
+        "median_abs_relative_error_paper": median_abs_relative_error(outcomes, "paper"),
         "wall_s": wall,
         "simulated_s": sim_time,
         "speedup": sim_time / wall if wall > 0 else None,
@@ -325,25 +342,25 @@ def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     )
     if found:
         payload["calibration"] = {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()}
-    if args.json:
-        return payload
-    _print_report(c, args, rows, found, figures)
+    files = c.results.finish(trials, records, payload)
+    if not args.json:
+        _print_report(c, args, records, found, figures + [str(f) for f in files])
     return payload
 
 
 def _print_report(
     c: _Campaign,
     args: argparse.Namespace,
-    rows: list[SampleRow],
+    records: list[dict[str, Any]],
     found: dict[str, tuple[float, float]],
-    figures: list[str],
+    files: list[str],
 ) -> None:
     """One campaign's table and summary lines, as a person reads them."""
     scene, outcomes, wall = c.scene, c.outcomes, c.wall
     sim_time = sum(o.sim_time for o in outcomes)
     paper = median_abs_relative_error(outcomes, "paper")
     failed = [o for o in outcomes if o.state != "done"]
-    print_table(c.scene.name, rows, verdicts.by_sample(outcomes))
+    print_table(c.scene.name, records)
     samples = c.scene.campaign_samples()
     levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
@@ -365,6 +382,6 @@ def _print_report(
         print(f"  trial {o.spec.trial_id}: {o.state}: {o.reason}")
     print(f"run folder: {c.run_dir}")
     print(f"logs: {c.log_dir}")
-    for f in figures:
-        print(f"plot: {f}")
+    for f in files:
+        print(f"{'plot' if f.endswith('.png') else 'results'}: {f}")
     print()

@@ -29,6 +29,7 @@ from palpate.lab.trial import (
     run_bench_trials,
 )
 from palpate.live import add_live_argument, live_view
+from palpate.reports.results import CampaignResults
 from sensor.clock import Clock
 from sensor.reader import SerialLike
 
@@ -102,7 +103,10 @@ def run(args: argparse.Namespace) -> int:
     log_dir = base / time.strftime("%Y%m%d-%H%M%S")
     quiet = args.json
 
+    results = CampaignResults(log_dir)
+
     def progress(o: BenchOutcome) -> None:
+        results.add(o.as_dict())  # each trial's row on disk as it finishes
         if not quiet:
             print(_row(o.as_dict()), flush=True)
 
@@ -124,32 +128,49 @@ def run(args: argparse.Namespace) -> int:
         for o in outcomes
         if o.calibration is not None
     )
+    trial_rows = [o.as_dict() for o in outcomes]
+    payload = {
+        "bench": str(loaded.path),
+        "log_dir": str(log_dir),
+        "trials": trial_rows,
+        "samples": samples,
+        "calibration": {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()},
+    }
+    files = results.finish(trial_rows, samples, payload) if outcomes else []
     if args.json:
-        payload = {
-            "bench": str(loaded.path),
-            "log_dir": str(log_dir),
-            "trials": [o.as_dict() for o in outcomes],
-            "samples": samples,
-            "calibration": {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()},
-        }
         print(json.dumps(payload, indent=2))
     else:
-        for o in outcomes:
-            if o.state == SKIPPED:
-                print(_row(o.as_dict()))
-        for line in config_lines(found):
-            print(f"calibrated on the rigid reference (store in {loaded.bench.robot}): {line}")
-        for s in samples:
-            rel = s["relative_error"]
-            print(
-                f"sample {s['sample']}: mean {_kpa(s['mean_kpa'])} kPa vs {s['actual_kpa']:.2f} "
-                f"kPa, RMSE {_kpa(s['rmse_kpa'])}, IQR {_kpa(s['iqr_kpa'])}, relative error "
-                + ("-" if rel is None else f"{100 * rel:+.1f} %")
-                + f" (joint fit, {s['count']} ok kept, {s['outliers']} outliers; verdicts "
-                + ", ".join(f"{n} {v}" for v, n in s["verdicts"].items())
-                + ")"
-            )
+        _print_summary(outcomes, samples, found, loaded.bench.robot, files)
     return 0 if all(o.state == "done" for o in outcomes) else 1
+
+
+def _print_summary(
+    outcomes: list[BenchOutcome],
+    samples: list[dict[str, Any]],
+    found: dict[str, tuple[float, float]],
+    robot: str,
+    files: list[Path],
+) -> None:
+    """The session's end as a person reads it: skipped trials, the calibration, each sample's
+    statistics and the results files."""
+    for o in outcomes:
+        if o.state == SKIPPED:
+            print(_row(o.as_dict()))
+    for line in config_lines(found):
+        print(f"calibrated on the rigid reference (store in {robot}): {line}")
+    for s in samples:
+        rel = s["joint_relative_error"]
+        print(
+            f"sample {s['sample']}: joint fit mean {_kpa(s['joint_mean_kpa'])} kPa vs "
+            f"{s['actual_kpa']:.2f} kPa, RMSE {_kpa(s['joint_rmse_kpa'])}, IQR "
+            f"{_kpa(s['joint_iqr_kpa'])}, relative error "
+            + ("-" if rel is None else f"{100 * rel:+.1f} %")
+            + f" ({s['count']} ok kept, {s['outliers']} outliers; verdicts "
+            + ", ".join(f"{s[v]} {v}" for v in STATUSES)
+            + f"); the paper's estimate's mean {_kpa(s['paper_mean_kpa'])} kPa"
+        )
+    for f in files:
+        print(f"results: {f}")
 
 
 def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> int:
@@ -171,8 +192,8 @@ def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> in
         print(json.dumps(payload, indent=2))
         return 0
     print(f"bench file {loaded.path}, targets {loaded.targets_path}: {len(trials)} trial(s)")
-    for name, (port, why) in ports.items():
-        print(f"  {name} port {port}: {why or 'present'}")
+    for name, (port, why) in ports.items():  # a problem names its port itself
+        print(f"  {name}: {why}" if why else f"  {name} port {port}: present")
     for t in trials:
         d = t.describe()
         print(
@@ -198,18 +219,23 @@ def _summaries(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[
         assert actual is not None
         kept = [o.modulus() if o.status == "ok" else None for o in outs]
         s = summarize(kept, actual, outlier_above)
+        paper = summarize([_paper(o) for o in outs], actual, outlier_above)
+        counts: dict[str, int] = {v: sum(1 for o in outs if o.status == v) for v in STATUSES}
         rows.append(
             {
                 "sample": name,
+                "trials": len(outs),
+                **counts,
                 "actual_kpa": actual / 1e3,
-                "mean_kpa": None if s.mean is None else s.mean / 1e3,
-                "rmse_kpa": None if s.rmse is None else s.rmse / 1e3,
-                "iqr_kpa": None if s.iqr is None else s.iqr / 1e3,
-                "relative_error": s.relative_error,
+                "joint_mean_kpa": _pa_to_kpa(s.mean),
+                "joint_rmse_kpa": _pa_to_kpa(s.rmse),
+                "joint_iqr_kpa": _pa_to_kpa(s.iqr),
+                "joint_relative_error": s.relative_error,
                 "count": s.count,
                 "outliers": s.outliers,
                 "failed": s.failed,
-                "verdicts": {v: sum(1 for o in outs if o.status == v) for v in STATUSES},
+                "paper_mean_kpa": _pa_to_kpa(paper.mean),
+                "paper_relative_error": paper.relative_error,
             }
         )
     return rows
@@ -252,5 +278,14 @@ def _row(d: dict[str, Any]) -> str:
         verdict = "calib."
     return (
         f"{d['trial']:<28} {d['state']:<9} {joint:>30} {verdict:<8} "
-        f"{_kpa(d['estimated_kpa']):>9} {_kpa(d['actual_kpa']):>9} {rel:>8}  {why}"
+        f"{_kpa(d['paper_kpa']):>9} {_kpa(d['actual_kpa']):>9} {rel:>8}  {why}"
     )
+
+
+def _paper(o: BenchOutcome) -> float | None:
+    """The paper's single-point estimate (Pa), None without one."""
+    return None if o.estimate is None else o.estimate.modulus
+
+
+def _pa_to_kpa(v: float | None) -> float | None:
+    return None if v is None else v / 1e3

@@ -1,11 +1,20 @@
-"""A campaign's per-sample table as ``palpate sim`` prints it, and its JSON fields in kPa."""
+"""A campaign's per-sample table (as the paper's Tables I and II): as ``palpate sim`` prints
+it, as ``samples.csv`` holds it, and its JSON fields in kPa.
+
+Each sample's row gives the joint fit's statistics (over the trials whose verdict is ``ok``)
+and, beside them, the paper's single-point estimate's (Eqs. 13-14) over the same sample's
+trials, so neither is read for the other.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
+from typing import Any
 
-from palpate.campaigns.campaign import SampleRow
+from estimation.verdict import STATUSES
+from palpate.campaigns.campaign import SampleRow, summarize_campaign
 from palpate.reports import verdicts
+from palpate.simulation.trial import TrialOutcome
 
 
 def kpa_fields(d: dict[str, object]) -> dict[str, object]:
@@ -19,29 +28,71 @@ def kpa_fields(d: dict[str, object]) -> dict[str, object]:
     return out
 
 
-def print_table(name: str, rows: Sequence[SampleRow], tallies: dict[str, verdicts.Tally]) -> None:
-    """The campaign's per-sample table (as the paper's Tables I and II), as a person reads it."""
-    print(
-        f"{name} campaign: estimated vs actual Young's modulus (kPa), joint fit (E and contact "
-        "point fitted on the whole record; the paper's estimate is in --json) over the trials "
-        "whose verdict is ok, outliers > 3 MPa removed; ok/sus/none: verdicts; cover: 95 % "
-        "intervals holding the truth / trials with a number"
-    )
-    cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("estimated", 10), ("actual", 9)]
-    cols += [("RMSE", 9), ("IQR", 9), ("rel.err", 8), ("cover", 6)]
+def sample_records(
+    outcomes: Sequence[TrialOutcome], joint: Iterable[SampleRow], outlier_above: float
+) -> list[dict[str, Any]]:
+    """One record per sample (``samples.csv``'s columns): the joint fit's row, the verdicts'
+    tally and the paper's estimate over the same trials."""
+    paper = {r.sample: r.summary for r in summarize_campaign(outcomes, outlier_above, "paper")}
+    tallies = verdicts.by_sample(outcomes)
+    records = []
+    for r in joint:
+        s, p, t = r.summary, paper.get(r.sample), tallies.get(r.sample)
+        counts: dict[str, int] = {} if t is None else {k: t.counts.get(k, 0) for k in STATUSES}
+        records.append(
+            {
+                "sample": r.sample,
+                "trials": r.trials,
+                **counts,
+                "joint_mean_kpa": _kpa(s.mean),
+                "actual_kpa": _kpa(s.actual),
+                "joint_rmse_kpa": _kpa(s.rmse),
+                "joint_iqr_kpa": _kpa(s.iqr),
+                "joint_relative_error": s.relative_error,
+                "intervals_holding_truth": None if t is None else t.covered,
+                "trials_with_number": None if t is None else t.numbers,
+                "paper_mean_kpa": None if p is None else _kpa(p.mean),
+                "paper_relative_error": None if p is None else p.relative_error,
+            }
+        )
+    return records
+
+
+def _kpa(v: float | None) -> float | None:
+    return None if v is None else v / 1e3
+
+
+TITLE = (
+    "{name} campaign: Young's modulus (kPa) per sample. joint: the joint fit (E and contact "
+    "fitted on the whole record) over the trials whose verdict is ok, outliers > 3 MPa removed; "
+    "paper: the paper's single-point estimate (Eqs. 13-14) over the same sample's trials; "
+    "ok/sus/none: verdicts; cover: 95 % intervals holding the truth / trials with a number"
+)
+
+
+def print_table(name: str, records: Sequence[dict[str, Any]]) -> None:
+    """The campaign's per-sample table (:func:`sample_records`), as a person reads it."""
+    print(TITLE.format(name=name))
+    cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("joint", 10), ("actual", 9)]
+    cols += [("RMSE", 9), ("IQR", 9), ("rel.err", 8), ("cover", 6), ("paper", 9)]
+    cols += [("rel.err", 8)]
     head = " ".join(f"{c:>{w}}" for c, w in cols)
     print(head)
     print("-" * len(head))
-    for r in rows:
-        s = r.summary
-
-        def k(v: float | None) -> str:
-            return "-" if v is None else f"{v / 1e3:.2f}"
-
-        rel = "-" if s.relative_error is None else f"{100 * s.relative_error:+.1f}%"
-        t = tallies[r.sample]
-        counts = verdicts.counts_column(t)
+    for r in records:
+        counts = "/".join(str(r.get(k, 0)) for k in STATUSES)
+        cover = f"{r['intervals_holding_truth']}/{r['trials_with_number']}"
         print(
-            f"{r.sample:>8} {r.trials:>6} {counts:>11} {k(s.mean):>10} {k(s.actual):>9} "
-            f"{k(s.rmse):>9} {k(s.iqr):>9} {rel:>8} {f'{t.covered}/{t.numbers}':>6}"
+            f"{r['sample']:>8} {r['trials']:>6} {counts:>11} {_cell(r['joint_mean_kpa']):>10} "
+            f"{_cell(r['actual_kpa']):>9} {_cell(r['joint_rmse_kpa']):>9} "
+            f"{_cell(r['joint_iqr_kpa']):>9} {_pct(r['joint_relative_error']):>8} {cover:>6} "
+            f"{_cell(r['paper_mean_kpa']):>9} {_pct(r['paper_relative_error']):>8}"
         )
+
+
+def _cell(v: float | None) -> str:
+    return "-" if v is None else f"{v:.2f}"
+
+
+def _pct(v: float | None) -> str:
+    return "-" if v is None else f"{100 * v:+.1f}%"

@@ -7,7 +7,9 @@ strains (the estimator's beam states), the depth measured from the joint fit's c
 ``delta = u - x0 - e - c P``; the fitted model ``P0 + E f(delta)`` at the best hypothesis; the
 fitted contact (delta = 0, with its interval); the paper's single point (Eqs. 13-14: its depth
 from the contact event and the buckling mark, its load from the elastica); for a trial that held
-after buckling, the held samples in their own colour. Nothing of the simulated world is drawn.
+after buckling, the held samples in their own colour; and the model at the moduli the log's
+header knows (the world's truth in simulation, the stated reference), so an interval that
+misses them shows. Nothing else of the simulated world is drawn.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from matplotlib.lines import Line2D
 
 from config.loader import InputError
 from estimation.belief import Hypothesis
+from palpate.reports.replay import known_moduli
 from robot.trial.inputs import header_sensor
 from robot.trial.log import TrialLog, read_log
 from robot.trial.relaxed import HOLD_STATE, RECORD_STATES
@@ -59,13 +62,18 @@ def record_fit(log: TrialLog, path: Path) -> Path:
         ax.plot(depth[held] * mm, states.P[held], ".", ms=2, color="tab:purple", label="hold")
     grid = np.linspace(min(depth.min(), 0.0), depth.max(), 300)
     model = offset + float(joint["modulus"]) * law.shape(grid)[0]
-    label = f"fit: E = {joint['modulus'] / 1e3:.0f} kPa {_interval(joint)}"
+    label = f"joint fit: E = {joint['modulus'] / 1e3:.0f} kPa {_interval(joint)}"
     ax.plot(grid * mm, model, color="tab:blue", lw=1.5, label=label)
     relaxation = (estimate or {}).get("relaxation") or {}
     if relaxation.get("relaxes") and relaxation.get("relaxed") is not None:
         relaxed = offset + float(relaxation["relaxed"]) * law.shape(grid)[0]
         text = f"relaxed: E_inf = {relaxation['relaxed'] / 1e3:.0f} kPa"
         ax.plot(grid * mm, relaxed, color="tab:purple", lw=1.2, ls="--", label=text)
+    for name, (modulus, style) in _known(log.header).items():  # what the log knows besides
+        curve = offset + modulus * law.shape(grid)[0]
+        ax.plot(
+            grid * mm, curve, color="k", lw=1, ls=style, label=f"{name}: {modulus / 1e3:.0f} kPa"
+        )
     _contact(ax, joint, x0)
     _paper(ax, estimate)
     verdict = (estimate or {}).get("verdict") or {}
@@ -73,11 +81,19 @@ def record_fit(log: TrialLog, path: Path) -> Path:
     ax.set_title(f"trial {log.header.get('trial')}: verdict {status}")
     ax.set_xlabel("indentation from the fitted contact (mm)")
     ax.set_ylabel("axial load P from the strains (N)")
-    ax.legend(loc="upper left", fontsize=8)
+    ax.legend(loc="upper left", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def _known(header: dict[str, Any]) -> dict[str, tuple[float, str]]:
+    """The moduli the log knows (``replay.known_moduli``) as the model curves to draw beside
+    the fit: the world's truth (simulation) and the stated reference, each with its style."""
+    known = known_moduli(header)
+    names = {"truth": ("true modulus (simulation)", "--"), "reference": ("reference", ":")}
+    return {names[k][0]: (float(v), names[k][1]) for k, v in known.items() if v is not None}
 
 
 def _interval(joint: dict[str, Any]) -> str:
@@ -106,14 +122,17 @@ def _paper(ax: Any, estimate: dict[str, Any] | None) -> None:
 
 def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: str) -> Path:
     """Each trial's joint estimate with its 95 % interval (coloured by verdict) and the paper's
-    estimate beside it, relative to the truth (1; the reported reference dashed), from the
-    ``--json`` trial rows of ``palpate sim`` (``joint_kpa``, ``joint_ci_kpa``,
-    ``estimated_kpa``, ``verdict``, ``actual_kpa``, ``reference_kpa``). The axis spans the
-    joint fit's intervals; a paper estimate beyond it is drawn at the edge, pointing out."""
-    fig, ax = plt.subplots(figsize=(max(7.0, 0.18 * len(rows) + 3), 4.8))
+    estimate beside it, relative to the truth (1), the sample's reported reference (what a lab
+    would have called the truth: the paper's 'actual') dashed, from the ``--json`` trial rows
+    of ``palpate sim`` (``joint_kpa``, ``joint_ci_kpa``, ``paper_kpa``, ``verdict``,
+    ``actual_kpa``, ``reference_kpa``). Trials are grouped by sample, named below. The axis
+    spans the joint fit's intervals; a paper estimate beyond it is drawn at the edge, pointing
+    out."""
+    fig, ax = plt.subplots(figsize=(max(7.0, 0.18 * len(rows) + 3), 5.2))
     ax.axhline(1.0, color="k", lw=1)
     spans: list[float] = [0.9, 1.1]
     papers: list[tuple[int, float]] = []
+    shown: set[str] = set()
     for i, r in enumerate(rows):
         truth = r.get("actual_kpa")
         if not truth:
@@ -122,17 +141,13 @@ def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: 
             ref = r["reference_kpa"] / truth
             ax.plot([i - 0.4, i + 0.4], [ref, ref], color="0.5", lw=1, ls="--")
             spans.append(ref)
-        colour = STATUS_COLOURS.get(str(r.get("verdict")), "0.6")
+            shown.add("reference")
+        status = str(r.get("verdict"))
         if r.get("joint_kpa") is not None:
-            est = r["joint_kpa"] / truth
-            lo, hi = r.get("joint_ci_kpa") or (None, None)
-            yerr = None
-            if lo is not None and hi is not None:
-                yerr = [[est - lo / truth], [hi / truth - est]]
-                spans += [lo / truth, hi / truth]
-            ax.errorbar([i - 0.1], [est], yerr=yerr, fmt="o", ms=4, color=colour, capsize=2)
-        if r.get("estimated_kpa") is not None:
-            papers.append((i, r["estimated_kpa"] / truth))
+            spans += _joint_bar(ax, i, r, truth, STATUS_COLOURS.get(status, "0.6"))
+            shown.add(status)
+        if r.get("paper_kpa") is not None:
+            papers.append((i, r["paper_kpa"] / truth))
     low, high = min(spans), max(spans)
     pad = 0.1 * (high - low)
     low, high = low - pad, high + pad
@@ -141,25 +156,58 @@ def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: 
         marker = "x" if inside else ("^" if ratio > high else "v")
         ax.plot([i + 0.15], [min(max(ratio, low), high)], marker, ms=5, color="tab:red")
     ax.set_ylim(low, high)
-    handles = [
-        Line2D([], [], color="k", lw=1, label="truth"),
-        Line2D([], [], color="0.5", lw=1, ls="--", label="reference"),
-        *(
-            Line2D([], [], marker="o", ls="", color=c, label=f"joint fit, {s}")
-            for s, c in STATUS_COLOURS.items()
-        ),
-        Line2D(
-            [], [], marker="x", ls="", color="tab:red", label="paper (Eqs. 13-14; ^ v: off axis)"
-        ),
-    ]
-    ax.legend(handles=handles, fontsize=7, ncol=3)
-    ax.set_xticks(range(len(rows)), [str(r.get("trial")) for r in rows], rotation=90, fontsize=6)
-    ax.set_ylabel("estimate / truth, with its 95 % interval")
-    ax.set_title(title)
+    ax.legend(handles=_interval_legend(shown, bool(papers)), fontsize=9, ncol=2,
+              loc="upper center", bbox_to_anchor=(0.5, -0.14))  # fmt: skip
+    _sample_ticks(ax, rows)
+    ax.set_ylabel("estimate / true modulus (95 % interval)", fontsize=10)
+    ax.set_title(title, fontsize=11)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def _joint_bar(ax: Any, i: int, r: dict[str, Any], truth: float, colour: str) -> list[float]:
+    """One trial's joint estimate with its interval, relative to the truth; the values drawn."""
+    est = r["joint_kpa"] / truth
+    lo, hi = r.get("joint_ci_kpa") or (None, None)
+    if lo is None or hi is None:
+        ax.plot([i - 0.1], [est], "o", ms=4, color=colour)
+        return [est]
+    yerr = [[est - lo / truth], [hi / truth - est]]
+    ax.errorbar([i - 0.1], [est], yerr=yerr, fmt="o", ms=4, color=colour, capsize=2)
+    return [est, lo / truth, hi / truth]
+
+
+def _interval_legend(shown: set[str], papers: bool) -> list[Line2D]:
+    """The legend of what the figure draws, and only that."""
+    handles = [Line2D([], [], color="k", lw=1, label="true modulus (the simulated world's)")]
+    if "reference" in shown:
+        text = "reported reference (the paper's 'actual')"
+        handles.append(Line2D([], [], color="0.5", lw=1, ls="--", label=text))
+    handles += [
+        Line2D([], [], marker="o", ls="", color=c, label=f"joint fit, verdict {s}")
+        for s, c in STATUS_COLOURS.items()
+        if s in shown
+    ]
+    if papers:
+        text = "paper's single point (Eqs. 13-14; ^ v: beyond the axis)"
+        handles.append(Line2D([], [], marker="x", ls="", color="tab:red", label=text))
+    return handles
+
+
+def _sample_ticks(ax: Any, rows: Sequence[dict[str, Any]]) -> None:
+    """One tick per sample at the middle of its trials, thin lines between samples."""
+    groups: dict[str, list[int]] = {}
+    for i, r in enumerate(rows):
+        groups.setdefault(str(r.get("sample")), []).append(i)
+    centres = [0.5 * (members[0] + members[-1]) for members in groups.values()]
+    ax.set_xticks(centres, list(groups), fontsize=9, rotation=45 if len(groups) > 12 else 0)
+    for members in list(groups.values())[1:]:
+        ax.axvline(members[0] - 0.5, color="0.85", lw=0.8)
+    ax.set_xlim(-0.6, len(rows) - 0.4)
+    ax.set_xlabel("trials, grouped by sample", fontsize=10)
+    ax.tick_params(axis="y", labelsize=9)
 
 
 def fit_figures(outcomes: Sequence[Any], out_dir: Path, name: str) -> list[str]:

@@ -106,15 +106,18 @@ def _replay_complete(log: TrialLog, end: dict[str, Any], report: dict[str, Any])
     )
     recorded = next(log.of_kind("estimate"), None)
     modulus = None if est is None else est.modulus
+    rec = None if recorded is None else recorded.get("modulus")
     report.update(
         {
             "state": end["state"],
             "reason": end["reason"],
-            "modulus": modulus,
-            "recorded_modulus": None if recorded is None else recorded.get("modulus"),
+            "paper_modulus": modulus,  # the paper's single point (Eqs. 13-14), Pa
+            "recorded_paper_modulus": rec,
+            "paper_kpa": _kpa(modulus),
+            "recorded_paper_kpa": _kpa(rec),
+            **{f"{k}_kpa": _kpa(v) for k, v in known_moduli(h).items()},
         }
     )
-    rec = report["recorded_modulus"]
     paper_same = (modulus is None and rec is None) or (
         modulus is not None and rec is not None and math.isclose(modulus, rec, rel_tol=0, abs_tol=0)
     )
@@ -138,8 +141,7 @@ def _replay_joint(
         raw = {**raw, **probe_inputs(probe)}
     inputs = EstimatorInputs.from_dict(raw)
     samples = list(log.of_kind("sample"))
-    # a tick whose servo read was missed logged no advance (null): the estimate skips its row
-    rows = [(r["state"], _number(r["advance"]), r["strains"]) for r in samples]
+    rows = [(r["state"], _number(r["advance"]), r["strains"]) for r in samples]  # null: missed
     tips = [r.get("tip_force") for r in samples] if any("tip_force" in r for r in samples) else None
     fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples], tips)
     end = log.end or {}
@@ -170,6 +172,7 @@ def _replay_joint(
     replayed = json.loads(json.dumps(keys))
     report.update({f"replayed_{k}" if k != "joint" else k: v for k, v in replayed.items()})
     report["recorded_joint"] = recorded.get("joint")
+    report.update({**_joint_kpa(replayed.get("joint"), ""), **_joint_kpa(recorded, "recorded_")})
     report["recorded_verdict"] = recorded.get("verdict")
     if inputs.version < VERSION:
         report["note"] = (
@@ -183,6 +186,16 @@ def _replay_joint(
     return same
 
 
+def known_moduli(header: dict[str, Any]) -> dict[str, float | None]:
+    """The moduli (Pa) a log's header knows besides the estimates: ``truth`` (the world's, a
+    simulated trial only) and ``reference`` (the sample's stated modulus: the scene's reported
+    reference in simulation, the bench file's modulus on the bench); None where unknown."""
+    spec = header.get("spec") or {}
+    if header.get("source") == "simulation":
+        return {"truth": spec.get("modulus"), "reference": spec.get("reference")}
+    return {"truth": None, "reference": spec.get("modulus")}
+
+
 def _tuples(d: dict[str, Any]) -> dict[str, Any]:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
 
@@ -190,3 +203,21 @@ def _tuples(d: dict[str, Any]) -> dict[str, Any]:
 def _number(value: object) -> float:
     """A log's number, NaN for its null (a value the tick did not measure)."""
     return math.nan if value is None else float(value)  # type: ignore[arg-type]
+
+
+def _kpa(value: object) -> float | None:
+    return float(value) / 1e3 if isinstance(value, int | float) else None
+
+
+def _joint_kpa(joint: object, prefix: str) -> dict[str, Any]:
+    """``joint_kpa`` and ``joint_ci_kpa`` (with ``prefix``) of a joint fit's record (or of an
+    estimate record's ``joint``, with ``recorded_``)."""
+    j: dict[str, Any] = joint if isinstance(joint, dict) else {}
+    if prefix == "recorded_":
+        inner = j.get("joint")
+        j = inner if isinstance(inner, dict) else {}
+    lo, hi = _kpa(j.get("ci_low")), _kpa(j.get("ci_high"))
+    return {
+        f"{prefix}joint_kpa": _kpa(j.get("modulus")),
+        f"{prefix}joint_ci_kpa": None if lo is None or hi is None else [lo, hi],
+    }

@@ -16,8 +16,13 @@ def test_design_for_soft_tissue_and_its_simulated_check(capsys: pytest.CaptureFi
     argv = ["design", "--modulus-range", "1:10", "--unit", "kPa", "--json", *QUICK]
     code = main([*argv, "--moduli", "3", "--lengths", "1", "--executor", "serial"])
     out = json.loads(capsys.readouterr().out)
+    # the proposal passes its checks and estimates every phantom within 20 %; held across its
+    # tip sags most of its length: usable only pointing vertically (a condition, stated)
     assert code == 0
     assert out["success"] is True
+    assert out["usable"] is True, out["reasons"]
+    assert out["reasons"] == []
+    assert out["conditions"][0].startswith("pointing vertically")
     d = out["design"]
     assert d["modulus_range_kpa"] == [1.0, 10.0]
     assert d["depth_ratio_at_min_modulus"] <= 0.5
@@ -39,7 +44,8 @@ def test_text_output_without_the_campaign(capsys: pytest.CaptureFixture[str]) ->
     code = main(["design", "--modulus-range", "300:1100", "--thickness-mm", "10", "--no-sim"])
     out = capsys.readouterr().out
     assert code == 0
-    assert out.startswith("design: ")
+    assert out.startswith("UNCHECKED design: simulated check skipped")
+    assert out.splitlines()[1].startswith("design: ")
     for label in ("exposed length", "tip radius", "delta at 300 kPa", "detector threshold"):
         assert label in out
     assert "simulated bench campaign" not in out
@@ -86,3 +92,28 @@ def test_design_writes_a_robot_file_the_stack_reads(tmp_path: Path) -> None:
     assert stack.board.has_reference
     assert stack.fbg.reference_wavelength_nm is not None
     assert stack.sensor.tip_radius_mm == 10.0
+
+
+def test_the_verdict_names_every_reason_a_design_is_not_usable() -> None:
+    """No estimate, errors beyond tolerance, a trial that failed, the sag: each named; a clean
+    check is usable; a skipped one unchecked."""
+    from types import SimpleNamespace
+
+    from palpate.campaigns.designcheck import design_verdict
+
+    def trial(sample: str, truth: float, joint: float | None, state: str = "done") -> object:
+        spec = SimpleNamespace(sample=sample, modulus=truth)
+        return SimpleNamespace(spec=spec, state=state, modulus=lambda method: joint)
+
+    good = [trial("E1", 1e3, 1.05e3), trial("E10", 1e4, 0.95e4)]
+    assert design_verdict(True, good, True).usable is True  # type: ignore[arg-type]
+    bad = [trial("E1", 1e3, 0.54e3), trial("E3", 3e3, None), trial("E10", 1e4, 1e4, "fault")]
+    v = design_verdict(True, bad, False, "the tip sags 30 mm", 0.2)  # type: ignore[arg-type]
+    assert v.usable is False
+    assert v.conditions[0].startswith("pointing vertically")
+    assert any("did not complete: E10" in r for r in v.reasons)
+    assert any(r.startswith("no estimate on 1 of 3: E3") for r in v.reasons)
+    assert any("beyond +-20 %: E1 -46 %" in r for r in v.reasons)
+    assert v.headline().startswith("NOT USABLE: ")
+    assert design_verdict(True, None, True).usable is None
+    assert design_verdict(False, None, None).usable is False

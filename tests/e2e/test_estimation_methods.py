@@ -51,7 +51,7 @@ def test_joint_fit_is_close_with_an_interval_and_flags(outcomes: list[TrialOutco
 def test_results_and_logs_carry_both_estimates(outcomes: list[TrialOutcome]) -> None:
     d = outcomes[0].as_dict()
     assert d["joint_kpa"] is not None
-    assert d["estimated_kpa"] is not None
+    assert d["paper_kpa"] is not None
     assert len(d["joint_ci_kpa"]) == 2
     json.dumps(d)
     lines = Path(str(outcomes[0].log_path)).read_text(encoding="utf-8").splitlines()

@@ -174,9 +174,12 @@ def test_palpate_emulate_streams_the_tip_grating_of_the_designed_sensor() -> Non
         proc.communicate(timeout=30)  # reaps it and closes its stdout
 
 
-def test_a_sample_stiffer_than_the_designed_range_gets_no_number(tmp_path: Path) -> None:
+def test_a_sample_stiffer_than_the_designed_range_keeps_its_number_as_suspect(
+    tmp_path: Path,
+) -> None:
     """60 kPa in front of the 1-20 kPa sensor: it buckles at 0.15 mm and the fit reads about
-    60 kPa, whose whole interval lies outside the designed range: `none`, saying so."""
+    60 kPa, whose whole interval lies outside the designed range: `suspect`, saying so, with
+    its number (the answer is "stiffer than 20 kPa")."""
     import dataclasses
 
     from config.sample import SampleConfig
@@ -190,9 +193,10 @@ def test_a_sample_stiffer_than_the_designed_range_gets_no_number(tmp_path: Path)
     out = run_sim_trial(spec, scene, STACK, log_dir=tmp_path)
     assert out.state == "done", out.reason
     assert out.verdict is not None
-    assert out.verdict.status == "none"
-    assert "outside the sensor's designed range" in out.verdict.reasons[0]
-    assert "1-20 kPa" in out.verdict.reasons[0]
+    assert out.verdict.status == "suspect"
+    assert out.verdict.reasons[0].startswith("above the designed range 1-20 kPa")
+    assert out.modulus("joint") is not None
+    assert out.modulus("joint") > 20e3
 
 
 def test_probing_finds_a_tilted_soft_samples_normal_with_the_tip_grating() -> None:

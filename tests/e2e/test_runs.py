@@ -4,6 +4,7 @@ same table, a faulted trial makes the exit code 1, and pool workers die with the
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import signal
@@ -51,6 +52,26 @@ def test_two_runs_on_one_out_write_apart_and_delete_nothing(
         logs = sorted(p.stem for p in Path(payload["log_dir"]).glob("*.jsonl"))
         assert logs == sorted(t["trial"] for t in payload["trials"])
         assert all(Path(t["log"]).parent == Path(payload["log_dir"]) for t in payload["trials"])
+        assert_results_on_disk(payload)
+
+
+def assert_results_on_disk(payload: dict) -> None:  # type: ignore[type-arg]
+    """The run folder holds what --json printed, a CSV row per trial and per sample, and no
+    lock once the run ended."""
+    run_dir = Path(payload["run_dir"])
+    assert json.loads((run_dir / "results.json").read_text(encoding="utf-8")) == payload
+    with open(run_dir / "trials.csv", encoding="utf-8", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["trial"] for r in rows] == [t["trial"] for t in payload["trials"]]
+    for row, t in zip(rows, payload["trials"], strict=True):
+        assert row["verdict"] == t["verdict"]
+        assert float(row["actual_kpa"]) == t["actual_kpa"]
+        assert (row["joint_kpa"] == "") == (t["joint_kpa"] is None)
+        assert (row["paper_kpa"] == "") == (t["paper_kpa"] is None)
+    with open(run_dir / "samples.csv", encoding="utf-8", newline="") as fh:
+        samples = list(csv.DictReader(fh))
+    assert [s["sample"] for s in samples] == [s["sample"] for s in payload["samples"]]
+    assert not (run_dir / ".lock").exists()
 
 
 def test_a_second_writer_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -74,9 +95,12 @@ def test_resume_reads_complete_trials_and_reruns_the_rest(
     lines = cut.read_text(encoding="utf-8").splitlines(keepends=True)
     cut.write_text("".join(lines[: len(lines) // 2]), encoding="utf-8")  # killed mid-trial
     lost.unlink()  # killed before its log was opened
+    table = (logs.parent / "trials.csv").read_text(encoding="utf-8")
     code, resumed = sim(tmp_path, "--limit", "3", "--resume", capsys=capsys)
     assert code == 0
     assert resumed["log_dir"] == whole["log_dir"]
+    assert (logs.parent / "trials.csv").read_text(encoding="utf-8") == table  # kept whole
+    assert_results_on_disk(resumed)
     assert trials(resumed) == trials(whole)  # the same table, bit for bit
     assert resumed["samples"] == whole["samples"]
     assert kept.read_bytes() == kept_bytes  # a complete trial is not run again

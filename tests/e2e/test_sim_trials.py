@@ -81,7 +81,7 @@ def test_replay_reproduces_the_estimate_exactly(tmp_path: Path) -> None:
     report = replay(Path(str(out.log_path)))
     assert report["identical"] is True
     assert out.estimate is not None
-    assert report["modulus"] == out.estimate.modulus
+    assert report["paper_modulus"] == out.estimate.modulus
 
 
 def test_replay_reports_a_truncated_log(tmp_path: Path) -> None:

@@ -129,7 +129,7 @@ def test_a_session_on_the_emulators_ptys_runs_logs_and_releases(tmp_path: Path) 
     assert [r["to"] for r in log.of_kind("transition")][-1] == "done"
     report = replay(Path(str(o.log_path)))
     assert report["identical"] is True
-    assert report["modulus"] == o.estimate.modulus
+    assert report["paper_modulus"] == o.estimate.modulus
     # the joint fit, its interval and its verdict are logged and replayed as they were
     assert o.joint is not None
     assert o.joint.ci_low is not None
