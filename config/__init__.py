@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from config.loader import (
+from palpate.config.loader import (
     CONFIG_DIR,
     ConfigError,
     InputError,
@@ -16,7 +16,7 @@ from config.loader import (
     read_yaml,
     resolve,
 )
-from config.schema import StackConfig
+from palpate.config.schema import StackConfig
 
 __all__ = [
     "CONFIG_DIR",

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from config.loader import limits
+from palpate.config.loader import limits
 
 ServoName = Literal["outer_roll", "inner_roll", "translation"]
 # Hardware Error Status bits by name (wire.dynamixel.HW_*).

@@ -11,10 +11,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from config.faults import FaultsConfig
-from config.loader import limits
-from config.sample import PAPER_SAMPLES, SampleConfig
-from config.schema import DEFAULT_CONTROL_RATE_HZ
+from palpate.config.faults import FaultsConfig
+from palpate.config.loader import limits
+from palpate.config.sample import PAPER_SAMPLES, SampleConfig
+from palpate.config.schema import DEFAULT_CONTROL_RATE_HZ
 
 Orientation = Literal["downward", "sideways", "upward"]
 ORIENTATION_ROLL_DEG: dict[str, float] = {"downward": 0.0, "sideways": 90.0, "upward": 180.0}

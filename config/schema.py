@@ -11,9 +11,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
-from config.drive import DriveConfig
-from config.loader import limits
-from config.optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
+from palpate.config.drive import DriveConfig
+from palpate.config.loader import limits
+from palpate.config.optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
 
 __all__ = [
     "DEFAULT_CONTROL_RATE_HZ",

@@ -35,11 +35,11 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from estimation.hertz import MAX_DEPTH_RATIO as MAX_DEPTH_RATIO_HERTZ
-from estimation.hertz import hertz_validity
-from estimation.layer import dimitriadis_bracket, layer_coefficients
-from estimation.layer_table import DEPTH_RATIO_MAX, LayerFactor, layer_factor
-from estimation.sneddon import sneddon_bracket, sneddon_y
+from palpate.estimation.hertz import MAX_DEPTH_RATIO as MAX_DEPTH_RATIO_HERTZ
+from palpate.estimation.hertz import hertz_validity
+from palpate.estimation.layer import dimitriadis_bracket, layer_coefficients
+from palpate.estimation.layer_table import DEPTH_RATIO_MAX, LayerFactor, layer_factor
+from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
 
 FloatArray = NDArray[np.float64]
 

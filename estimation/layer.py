@@ -15,7 +15,7 @@ chi^4``. The series is a small-chi expansion, published with ``chi = sqrt(R delt
 
 The law here (:func:`layer_coefficients`) takes the bonded coefficients as published and
 replaces the non-bonded ones, which vary with nu although the exact law of a layer sliding on
-a frictionless base does not (DESIGN.md): to first order in chi the layer adds a uniform
+a frictionless base does not (docs/tissue-fe.md): to first order in chi the layer adds a uniform
 approach ``F (1 - nu^2) a0 / (pi E h)``, with ``a0`` the integral over u of ``K(u) - 1``, K the
 layer's surface-compliance kernel in Hankel space (:func:`layer_kernel`; Lebedev & Ufliand
 1958). For the bonded kernel this integral gives Dimitriadis' bonded a0 to 0.7 % at

@@ -15,10 +15,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from estimation.beam import Beam
-from estimation.elastica import fast
-from estimation.elastica._scipy import least_squares
-from estimation.elastica.constants import E_OVER_L_MAX
+from palpate.estimation.beam import Beam
+from palpate.estimation.elastica import fast
+from palpate.estimation.elastica._scipy import least_squares
+from palpate.estimation.elastica.constants import E_OVER_L_MAX
 
 FloatArray = NDArray[np.float64]
 

@@ -31,11 +31,11 @@ from typing import Literal
 
 import numpy as np
 
-from estimation.belief import Hypothesis
-from estimation.jointfit import JointFit
-from estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
-from estimation.misalignment import Lean
-from estimation.relaxation import RelaxationFit
+from palpate.estimation.belief import Hypothesis
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
+from palpate.estimation.misalignment import Lean
+from palpate.estimation.relaxation import RelaxationFit
 
 Status = Literal["ok", "suspect", "none"]
 STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")

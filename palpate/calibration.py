@@ -15,9 +15,9 @@ import dataclasses
 from collections.abc import Iterable, Sequence
 from typing import Protocol
 
-from config.scene import SceneConfig
-from config.schema import MM, StackConfig
-from estimation.compliance import ComplianceFit, pooled
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import MM, StackConfig
+from palpate.estimation.compliance import ComplianceFit, pooled
 
 STAGE = "bench-stage"  # the key of the bench-top stage's compliance
 

@@ -22,9 +22,7 @@ from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
 
-EXIT_OK = 0
-EXIT_FAULT = 1
-EXIT_BAD_INPUT = 2
+from palpate.exitcodes import EXIT_BAD_INPUT, EXIT_FAULT, EXIT_OK
 
 log = logging.getLogger("palpate")
 
@@ -275,7 +273,7 @@ def report_failure(exc: Exception) -> int:
       (``internal error``; ``-v`` shows the traceback), a ``ValueError`` from inside the code
       among them. No input a user can give should get here: the fuzz targets (``palpate bench
       --only fuzz``) check that."""
-    from config.loader import ConfigError, InputError
+    from palpate.config.loader import ConfigError, InputError
 
     if isinstance(exc, ConfigError):
         log.error("palpate: bad configuration: %s", exc)

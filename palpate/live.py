@@ -36,18 +36,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from config.loader import InputError
-from config.schema import SensorConfig, StackConfig, TubeConfig
-from estimation.beamstate import infer_states
-from estimation.elastica import post_buckling
-from estimation.section import Section, sensor_section
 from palpate.argtypes import port_number
-from robot.guards import Observation
-from robot.indentation import State
-from robot.kinematics import forward
-from robot.trial.cdr import Transform
-from robot.trial.ros2 import tip_transforms
-from sensor.strain import grating_intervals
+from palpate.config.loader import InputError
+from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
+from palpate.estimation.beamstate import infer_states
+from palpate.estimation.elastica import post_buckling
+from palpate.estimation.section import Section, sensor_section
+from palpate.robot.guards import Observation
+from palpate.robot.indentation import State
+from palpate.robot.kinematics import forward
+from palpate.robot.trial.cdr import Transform
+from palpate.robot.trial.ros2 import tip_transforms
+from palpate.sensor.strain import grating_intervals
 
 log = logging.getLogger(__name__)
 

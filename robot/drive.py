@@ -1,7 +1,8 @@
 """The dual roller-gear drive: joint space <-> servo shaft angles, limits, profiles, homing.
 
-Joint space is ``JointState(roll, translation)``: the tube roll phi (rad, about the base x axis,
-DESIGN.md) and the stage translation (m) that advances the sensor. Three servos move it:
+Joint space is ``JointState(roll, translation)``: the tube roll phi (rad, about the base x
+axis; docs/architecture.md, Conventions) and the stage translation (m) that advances the
+sensor. Three servos move it:
 
 * ``outer_roll`` turns the outer roller gear, which carries the tube: shaft = r_o * phi;
 * ``inner_roll`` turns the inner roller gear, slaved to the outer one so that the push rod and
@@ -22,8 +23,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from config.schema import DriveConfig
-from robot.motors import MotorBus, MotorState
+from palpate.config.schema import DriveConfig
+from palpate.robot.motors import MotorBus, MotorState
 
 OUTER_ROLL = "outer_roll"
 INNER_ROLL = "inner_roll"

@@ -28,98 +28,44 @@ answers; the trial record is closed with the reason.
 from __future__ import annotations
 
 import dataclasses
-import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
 
-from estimation.detect_buckling import BucklingDetector
-from robot.guards import STATE_TIMEOUT, Guards, Observation, limit_violation
-from robot.probe_result import ProbeResult
-from robot.rest_check import RestCheck
+from palpate.estimation.detect_buckling import BucklingDetector
+from palpate.robot.guards import STATE_TIMEOUT, Guards, Observation, limit_violation
+from palpate.robot.plan import (
+    PLANNED_ENDS,
+    TERMINAL,
+    Command,
+    Prober,
+    State,
+    Transition,
+    TrialMarks,
+    TrialPlan,
+)
+from palpate.robot.probe_result import ProbeResult
+from palpate.robot.rest_check import RestCheck
 
-# the guards' names, re-exported: the machine's interface is read from here
-__all__ = ["STATE_TIMEOUT", "Guards", "Observation", "limit_violation"]
+# the guards' and the plan's names, re-exported: the machine's interface is read from here
+__all__ = [
+    "PLANNED_ENDS",
+    "STATE_TIMEOUT",
+    "TERMINAL",
+    "Command",
+    "Guards",
+    "Observation",
+    "Prober",
+    "State",
+    "Transition",
+    "TrialMarks",
+    "TrialPlan",
+    "limit_violation",
+]
 
 
-class State(enum.Enum):
-    IDLE = "idle"
-    HOMING = "homing"
-    POSITIONING = "positioning"
-    PROBING = "probing"
-    APPROACH = "approach"
-    CONTACT = "contact"
-    INDENTING = "indenting"
-    BUCKLED = "buckled"
-    HOLDING = "holding"
-    RETRACTING = "retracting"
-    DONE = "done"
-    FAULT = "fault"
-    ABORTED = "aborted"
-    UNREACHABLE = "unreachable"
-
-
-TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})
-PLANNED_ENDS = frozenset({State.DONE, State.UNREACHABLE})  # torque stays on: nothing went wrong
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 AT_REST = frozenset({State.HOMING, State.POSITIONING})  # no tissue can be near: a RestCheck
-
-
-@dataclass(frozen=True)
-class TrialPlan:
-    """Where to go: from inverse kinematics and the campaign (SI: m, rad, m/s)."""
-
-    roll: float
-    contact_advance: float  # advance where the tip sphere is expected to touch (m)
-    home_advance: float = 0.0
-    standoff: float = 2e-3  # stop this far before the expected contact, then approach slowly
-    approach_window: float = 3e-3  # no contact this far past the expected contact -> fault
-    post_buckling_travel: float = 0.3e-3  # keep indenting after detection, for the record
-    fast_speed: float = 5e-3
-    approach_speed: float = 1e-3
-    indent_speed: float = 0.5e-3
-    roll_tolerance: float = 2e-3
-    position_tolerance: float = 5e-6
-    hold_time: float = 0.0  # s at rest after the post-buckling travel (a creep test); 0: none
-
-
-@dataclass(frozen=True)
-class Command:
-    advance: float  # goal, m
-    roll: float  # goal, rad
-    speed: float  # m/s for the advance
-    torque: bool = True
-    rezero: bool = False  # take the strain zero again on the frames of the last ticks at rest
-
-
-class Prober(Protocol):
-    """The probing step (``robot.probing.ProbeRoutine``): each tick a command, then its result
-    (or a ``str``: why it failed)."""
-
-    def step(self, obs: Observation) -> Command | ProbeResult | str: ...
-
-
-@dataclass(frozen=True)
-class Transition:
-    t: float
-    source: State
-    target: State
-    reason: str
-    advance: float
-    strains: tuple[float, ...]
-
-
-@dataclass
-class TrialMarks:
-    """What the estimator needs: encoder values at contact and at detected buckling."""
-
-    x_contact: float | None = None
-    x_buckling: float | None = None
-    t_contact: float | None = None
-    t_buckling: float | None = None
-    strains_at_buckling: tuple[float, ...] = ()
-    reason: str = ""
 
 
 @dataclass
@@ -141,6 +87,8 @@ class IndentationMachine:
     _first_touch: float | None = None  # advance at the first contact event, planned or not
     _lost_since: float | None = None  # time the servo replies were lost while retracting
     _rest: RestCheck = field(default_factory=lambda: RestCheck(REZERO_SETTLE_TICKS))
+    # how the trial will end once retracted: set with the reason, never read back from its text
+    ending: State = State.FAULT
 
     def __post_init__(self) -> None:
         hold, timeout = self.plan.hold_time, self.guards.state_timeout
@@ -171,12 +119,12 @@ class IndentationMachine:
     def abort(self, t: float, reason: str) -> None:
         """Operator stop: go to RETRACTING at once, ending in ABORTED."""
         if not self.finished:
-            self.marks.reason = f"aborted: {reason}"
+            self.marks.reason, self.ending = f"aborted: {reason}", State.ABORTED
             self._go(State.RETRACTING, t, self.marks.reason, math.nan, ())
 
     # -- guards -------------------------------------------------------------------------------
     def _check_guards(self, obs: Observation) -> None:
-        if obs.abort and not self.marks.reason.startswith("aborted"):
+        if obs.abort and self.ending is not State.ABORTED:
             self.abort(obs.t, "operator stop")
             return
         if obs.contact and self._first_touch is None and math.isfinite(obs.advance):
@@ -221,7 +169,7 @@ class IndentationMachine:
             self._fault(obs, f"unexpected contact during {self.state.value} ({self._rest})")
 
     def _fault(self, obs: Observation, reason: str, *, retract: bool = True) -> None:
-        self.marks.reason = reason
+        self.marks.reason, self.ending = reason, State.FAULT
         if retract:
             self._go(State.RETRACTING, obs.t, f"fault: {reason}", obs.advance, obs.strains)
         else:
@@ -316,7 +264,7 @@ class IndentationMachine:
         return self._positioning(obs)
 
     def _unreachable(self, obs: Observation, why: str) -> Command:
-        self.marks.reason = f"unreachable: {why}"
+        self.marks.reason, self.ending = f"unreachable: {why}", State.UNREACHABLE
         self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
         return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
 
@@ -364,7 +312,7 @@ class IndentationMachine:
         return Command(goal, self.plan.roll, self.plan.indent_speed)
 
     def _complete(self, obs: Observation, why: str) -> Command:
-        self.marks.reason = self.marks.reason or "completed"
+        self.marks.reason, self.ending = self.marks.reason or "completed", State.DONE
         self._go(State.RETRACTING, obs.t, why, obs.advance, obs.strains)
         return Command(self._retract_goal(), self.plan.roll, self.plan.fast_speed)
 
@@ -372,10 +320,9 @@ class IndentationMachine:
         p = self.plan
         goal = self._retract_goal()
         if abs(obs.advance - goal) <= p.position_tolerance:
-            reason, ends = self.marks.reason, (State.ABORTED, State.UNREACHABLE)
-            target = next((s for s in ends if reason.startswith(s.value)), State.FAULT)
-            target = State.DONE if reason == "completed" else target
-            self._go(target, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains)
+            self._go(
+                self.ending, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains
+            )
             return self._terminal(obs)
         return Command(goal, obs.roll, p.fast_speed)
 

@@ -1,10 +1,10 @@
 """Kinematics of the mock concentric tube robot: tube, roll, advance <-> sensor tip.
 
-Conventions (DESIGN.md): base frame B has its origin where the tube leaves the outer roller
-gear, x forward along the straight part, z up, y = z x x (so +y is to the left looking along +x).
-A tube is a straight part of length l_s then an arc of length l_a turning by its tip angle
-alpha; at roll phi = 0 the arc bends toward -z. Roll turns the tube about +x (right-handed), so
-the bend direction is (0, sin phi, -cos phi):
+Conventions (docs/architecture.md): base frame B has its origin where the tube leaves the outer
+roller gear, x forward along the straight part, z up, y = z x x (so +y is to the left looking
+along +x). A tube is a straight part of length l_s then an arc of length l_a turning by its tip
+angle alpha; at roll phi = 0 the arc bends toward -z. Roll turns the tube about +x
+(right-handed), so the bend direction is (0, sin phi, -cos phi):
 
 * phi = 0: downward (-z);  phi = pi/2: sideways, toward +y (left);  phi = pi: upward (+z).
 
@@ -34,8 +34,8 @@ import numpy as np
 import transforms3d
 from numpy.typing import NDArray
 
-from config.schema import TubeConfig
-from estimation.surface import SurfaceGeometry
+from palpate.config.schema import TubeConfig
+from palpate.estimation.surface import SurfaceGeometry
 
 Vector = NDArray[np.float64]
 

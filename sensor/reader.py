@@ -23,11 +23,11 @@ from typing import Protocol
 
 import serial
 
-from config.schema import BoardConfig, SensorConfig
-from sensor.clock import Clock, SystemClock
-from sensor.parser import FrameParser, ReaderCounters, layout_from_config
-from sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff, open_failure
-from wire.frame import Frame, FrameLayout
+from palpate.config.schema import BoardConfig, SensorConfig
+from palpate.sensor.clock import Clock, SystemClock
+from palpate.sensor.parser import FrameParser, ReaderCounters, layout_from_config
+from palpate.sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff, open_failure
+from palpate.wire.frame import Frame, FrameLayout
 
 REOPEN_BACKOFF_S = (0.01, 1.0)  # first and longest wait between attempts to reopen a lost port
 

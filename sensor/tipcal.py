@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from config.schema import StackConfig
-from sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
-from sensor.tipforce import TipForceChain
-from wire.frame import Status
-from wire.frameblock import FrameBlock
+from palpate.config.schema import StackConfig
+from palpate.sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
+from palpate.sensor.tipforce import TipForceChain
+from palpate.wire.frame import Status
+from palpate.wire.frameblock import FrameBlock
 
 PM_PER_MN = 1e-12 / 1e-3  # m/N in one pm/mN
 COLUMNS = ("force_mn", "shift_pm")

@@ -21,8 +21,8 @@ from typing import Any
 
 import dynamixel_sdk as sdk
 
-from sim.dynamixel.bus import EmulatedBus
-from wire.frame import Frame
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.wire.frame import Frame
 
 
 class InProcessPort(sdk.PortHandler):  # type: ignore[misc]  # the SDK is untyped

@@ -30,19 +30,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from config.scene import FidelityConfig
-from config.schema import FbgConfig, SensorConfig
-from estimation.section import Section
-from estimation.surface import SurfaceGeometry
-from sim.board import BoardSample
-from sim.contact_history import ViscoelasticContact
-from sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
-from sim.equilibrium import ContactEffects, TissueLaw
-from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
-from sim.oblique import ObliqueContact
-from sim.readout import GratingReadout, TipReadout, grating_ends
-from sim.viscoelastic import Relaxation
-from wire.frame import Status
+from palpate.config.scene import FidelityConfig
+from palpate.config.schema import FbgConfig, SensorConfig
+from palpate.estimation.section import Section
+from palpate.estimation.surface import SurfaceGeometry
+from palpate.sim.board import BoardSample
+from palpate.sim.contact_history import ViscoelasticContact
+from palpate.sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
+from palpate.sim.equilibrium import ContactEffects, TissueLaw
+from palpate.sim.gravity import BeamWeight, offset_to_mode, sensing_axis
+from palpate.sim.oblique import ObliqueContact
+from palpate.sim.readout import GratingReadout, TipReadout, grating_ends
+from palpate.sim.viscoelastic import Relaxation
+from palpate.wire.frame import Status
 
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)
 PoseFn = Callable[[float, float], tuple[Vector, Vector, float]]

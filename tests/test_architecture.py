@@ -1,5 +1,5 @@
-"""The layers of DESIGN.md, read from every module's imports (ast, so imports inside functions
-count too): which package may import which, and no two packages importing each other.
+"""The layers of docs/architecture.md, read from every module's imports (ast, so imports inside
+functions count too): which package may import which, and no two packages importing each other.
 
 wire imports nothing of ours; config only config; estimation only estimation and config; sensor
 wire, estimation, config; robot wire, estimation, sensor, config; sim wire, estimation, config
@@ -33,9 +33,22 @@ def module_name(path: Path, root: Path = ROOT) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+LAYERS = frozenset({"wire", "config", "estimation", "sensor", "robot", "sim"})
+
+
+def layer_name(name: str) -> str:
+    """An import's name in the layers' terms: the layers are installed under ``palpate``
+    (``palpate.sim.world`` is ``sim.world``; ``palpate.simulation`` stays the application's)."""
+    parts = name.split(".")
+    if len(parts) > 1 and parts[0] == "palpate" and parts[1] in LAYERS:
+        return ".".join(parts[1:])
+    return name
+
+
 def imported_modules(path: Path, root: Path = ROOT) -> Iterator[tuple[int, str]]:
     """(line, absolute name) of every import in the file, relative ones resolved; ``from a
-    import b`` gives ``a.b`` (``b`` may be a module or a name in ``a``)."""
+    import b`` gives ``a.b`` (``b`` may be a module or a name in ``a``); names in the layers'
+    terms (:func:`layer_name`)."""
     tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
     package = module_name(path, root)
     if path.name != "__init__.py":
@@ -43,14 +56,14 @@ def imported_modules(path: Path, root: Path = ROOT) -> Iterator[tuple[int, str]]
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for alias in node.names:
-                yield node.lineno, alias.name
+                yield node.lineno, layer_name(alias.name)
         elif isinstance(node, ast.ImportFrom):
             base = node.module or ""
             if node.level:
                 anchor = package.split(".")[: len(package.split(".")) - (node.level - 1)]
                 base = ".".join([*anchor, base]) if base else ".".join(anchor)
             for alias in node.names:  # a name may be a module: ``from sim.dynamixel import bus``
-                yield node.lineno, f"{base}.{alias.name}"
+                yield node.lineno, layer_name(f"{base}.{alias.name}")
 
 
 def our_imports(root: Path = ROOT) -> Iterator[tuple[str, str, str]]:
@@ -167,7 +180,8 @@ def test_the_check_sees_every_kind_of_import(tmp_path: Path) -> None:
     (tmp_path / "robot" / "__init__.py").write_text("", encoding="utf-8")
     (pkg / "__init__.py").write_text("from . import model\n", encoding="utf-8")
     (pkg / "model.py").write_text(
-        "import math\n\ndef f():\n    from sim.world import World\n    from ..drive import x\n",
+        "import math\n\ndef f():\n"
+        "    from palpate.sim.world import World\n    from ..drive import x\n",
         encoding="utf-8",
     )
     found = {name for _, name in imported_modules(pkg / "model.py", tmp_path)}
@@ -228,8 +242,18 @@ PALPATE_ROOMS: dict[str, frozenset[str]] = {
     "palpate.benchmarks": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
     "palpate.commands": _BELOW_REPORTS
     | {"palpate.reports", "palpate.faults", "palpate.benchmarks", "palpate.lab"},
+    # the Python API (palpate/api.py): the commands' surface for scripts, above them all
+    "palpate.api": _BELOW_REPORTS
+    | {
+        "palpate.reports",
+        "palpate.faults",
+        "palpate.benchmarks",
+        "palpate.lab",
+        "palpate.commands",
+    },
 }
-MAX_PALPATE_TOP_MODULES = 6  # besides __init__, __main__ and cli
+FRONT_DOOR = "palpate/__init__.py"  # the installed name re-exports the API, and only that
+MAX_PALPATE_TOP_MODULES = 6  # besides __init__, __main__, cli and api
 
 
 def palpate_room(module: str) -> str:
@@ -244,22 +268,30 @@ def palpate_room_breaks(root: Path = ROOT) -> list[str]:
     bad = []
     for path in sorted((root / "palpate").rglob("*.py")):
         source = palpate_room(module_name(path, root))
+        front = path.relative_to(root).as_posix() == FRONT_DOOR
         for line, name in imported_modules(path, root):
             if name.partition(".")[0] != "palpate" or name == "palpate":
                 continue
             target = palpate_room(name)
+            if front and target == "palpate.api":
+                continue
             if target != source and target not in PALPATE_ROOMS[source]:
                 bad.append(f"{path.relative_to(root)}:{line} {name} ({source} -> {target})")
     return bad
 
 
 def test_every_module_of_palpate_lives_in_a_known_room() -> None:
-    rooms = {f"palpate.{init.parent.name}" for init in (ROOT / "palpate").glob("*/__init__.py")}
+    rooms = {
+        f"palpate.{init.parent.name}"
+        for init in (ROOT / "palpate").glob("*/__init__.py")
+        if init.parent.name not in LAYERS  # the layers' folders, linked in (pyproject.toml)
+    }
+    rooms.add("palpate.api")
     assert rooms <= set(PALPATE_ROOMS), "a new sub-package of palpate needs its PALPATE_ROOMS entry"
     top = sorted(
         p.stem
         for p in (ROOT / "palpate").glob("*.py")
-        if p.stem not in {"__init__", "__main__", "cli"}
+        if p.stem not in {"__init__", "__main__", "cli", "api"}
     )
     assert len(top) <= MAX_PALPATE_TOP_MODULES, f"palpate/ top level: {top}"
 
@@ -282,3 +314,24 @@ def test_the_room_check_sees_an_arrow_running_back_up(tmp_path: Path) -> None:
         "palpate -> palpate.simulation)",
         "palpate.simulation -> palpate.reports)",
     ]
+
+
+def test_our_code_imports_the_layers_by_their_installed_names() -> None:
+    """``from palpate.config import ...``, never ``from config import ...``: a bare name would
+    be shadowed by a user's own config.py (or sim.py, robot.py, ...) beside their script."""
+    bare = []
+    for folder in sorted({*LAYERS, "palpate", "tests", "bench", "examples"}):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+            for node in ast.walk(tree):
+                names = []
+                if isinstance(node, ast.Import):
+                    names = [a.name for a in node.names]
+                elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+                    names = [node.module]
+                bare += [
+                    f"{path.relative_to(ROOT)}:{node.lineno} {n}"
+                    for n in names
+                    if n.partition(".")[0] in LAYERS
+                ]
+    assert not bare, "\n".join(bare)

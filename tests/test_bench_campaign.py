@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import dataclasses
 
-from config import load, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.campaign import CHEAPEST, LEVELS, REFERENCE, LevelRow, pareto_front, usable
+from palpate.config import load, resolve
+from palpate.config.scene import SceneConfig
 
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.hold import HOLDS_S, SCENES, hold_scene
 from palpate.campaigns.campaign import campaign_trials
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.simulation.trial import trial_campaign
 
 STACK = load_stack()
@@ -42,7 +42,7 @@ def test_a_speed_sweep_runs_each_trial_at_each_speed() -> None:
 
 
 def test_a_campaign_that_ramps_through_the_contact_approaches_at_the_indentation_speed() -> None:
-    from robot.trial.setup import trial_plan
+    from palpate.robot.trial.setup import trial_plan
 
     scene = load(SceneConfig, resolve("scenes/viscoelastic/power-law.yaml"))
     assert scene.campaign.ramp_through_contact

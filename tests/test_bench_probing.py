@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 import palpate.simulation.trial
-from config import load_stack
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.probing import (
     ExactSurfaceGeometry,
@@ -17,11 +16,12 @@ from palpate.benchmarks.probing import (
     prober_hooks,
     trial_subset,
 )
+from palpate.config import load_stack
+from palpate.robot import kinematics
+from palpate.robot.probe_plan import ProbeGeometry, ProbeSettings
+from palpate.robot.probe_result import Touch
+from palpate.sim.world import Surface
 from palpate.simulation.trial import run_sim_trial
-from robot import kinematics
-from robot.probe_plan import ProbeGeometry, ProbeSettings
-from robot.probe_result import Touch
-from sim.world import Surface
 
 STACK = load_stack()
 

@@ -7,11 +7,9 @@ from pathlib import Path
 
 import pytest
 
-import palpate.simulation.trial
-import robot.trial.run
-import sim.world
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
+import palpate.robot.trial.run
+import palpate.robot.trial.session
+import palpate.sim.world
 from palpate.benchmarks.sides import (
     BOUNDARIES,
     CONTROL,
@@ -22,8 +20,10 @@ from palpate.benchmarks.sides import (
     measured,
 )
 from palpate.campaigns.campaign import campaign_trials, run_campaign
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
 
 
 def test_ledger_counts_each_part_exclusively() -> None:
@@ -50,9 +50,9 @@ def _hooked() -> tuple[object, ...]:
     return (
         VirtualClock.__dict__["advance"],
         EmulatedBus.__dict__["exchange"],
-        sim.world.equilibrium_on_grid,
-        palpate.simulation.trial.run_trial,
-        robot.trial.run._tick,
+        palpate.sim.world.equilibrium_on_grid,
+        palpate.robot.trial.session.run_trial,
+        palpate.robot.trial.run._tick,
     )
 
 

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from config import load, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.tissue import LEVELS, VISCO, level_scene
 from palpate.benchmarks.tissue_fe import _markdown_tables
+from palpate.config import load, resolve
+from palpate.config.scene import SceneConfig
 
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
 

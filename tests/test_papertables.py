@@ -6,9 +6,9 @@ import dataclasses
 
 import pytest
 
-from config import load, resolve
-from config.scene import SceneConfig
 from palpate.campaigns.campaign import reported_references
+from palpate.config import load, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.papertables import TABLE_I, TABLE_II, ErrorStructure, TableRow, structure
 
 

@@ -21,8 +21,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from estimation.elastica._scipy import brentq
-from estimation.elastica.closed_form import State, shortening_ratio, state, terms, wavenumber
+from palpate.estimation.elastica._scipy import brentq
+from palpate.estimation.elastica.closed_form import (
+    State,
+    shortening_ratio,
+    state,
+    terms,
+    wavenumber,
+)
 
 
 def _first_root_tan_x_equals_x() -> float:

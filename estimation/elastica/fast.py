@@ -26,10 +26,10 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from estimation.elastica import accurate
-from estimation.elastica.constants import E_OVER_L_MAX
-from estimation.elastica.errors import checked_e_over_L
-from estimation.elastica.solution import ElasticaSolution
+from palpate.estimation.elastica import accurate
+from palpate.estimation.elastica.constants import E_OVER_L_MAX
+from palpate.estimation.elastica.errors import checked_e_over_L
+from palpate.estimation.elastica.solution import ElasticaSolution
 
 FloatArray = NDArray[np.float64]
 

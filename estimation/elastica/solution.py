@@ -14,8 +14,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from estimation.elastica._scipy import ellipeinc, ellipj
-from estimation.elastica.errors import checked_unit_interval
+from palpate.estimation.elastica._scipy import ellipeinc, ellipj
+from palpate.estimation.elastica.errors import checked_unit_interval
 
 FloatArray = NDArray[np.float64]
 

@@ -7,7 +7,7 @@ exact for none of the tissues the sensor meets. What the literature says about i
 - thin layer (Dimitriadis et al. 2002, Biophys. J. 82:2798, and the exact linear-elastic layer
   solutions it was checked against): the series is exact to first order in
   chi = sqrt(R delta)/h; truncated, it departs from the exact layer by about 1 % at chi = 0.2 and
-  by several % at chi = 0.5 (bonded, nu -> 0.5; see DESIGN.md): a relative error of about
+  by several % at chi = 0.5 (bonded, nu -> 0.5; see docs/tissue-fe.md): a relative error of about
   ``LAYER_SERIES * chi^2`` (0.25: 1 % at 0.2, 6 % at 0.5);
 - depth (Hertz's range): Hertz holds for delta/R <= 0.1 (``estimation.hertz``); Sneddon's
   sphere removes the geometric part of the error beyond (-0.1 delta/R to first order), but it is
@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from estimation.corrections import ContactLaw
+from palpate.estimation.corrections import ContactLaw
 
 LAYER_SERIES = 0.25
 FINITE_STRAIN = 0.1

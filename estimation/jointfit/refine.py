@@ -25,12 +25,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from estimation.belief import Hypothesis
-from estimation.corrections import ContactLaw
-from estimation.elastica._scipy import least_squares
-from estimation.jointfit.record import Record
-from estimation.jointfit.result import FitFailed
-from estimation.jointfit.scan import SCAN_POINTS, SCAN_STEP, Start
+from palpate.estimation.belief import Hypothesis
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.elastica._scipy import least_squares
+from palpate.estimation.jointfit.record import Record
+from palpate.estimation.jointfit.result import FitFailed
+from palpate.estimation.jointfit.scan import SCAN_POINTS, SCAN_STEP, Start
 
 FloatArray = NDArray[np.float64]
 

@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from estimation.belief import Hypothesis
-from estimation.jointfit.grid import grid_fits
-from estimation.jointfit.record import Record
-from estimation.jointfit.result import FitFailed
+from palpate.estimation.belief import Hypothesis
+from palpate.estimation.jointfit.grid import grid_fits
+from palpate.estimation.jointfit.record import Record
+from palpate.estimation.jointfit.result import FitFailed
 
 FloatArray = NDArray[np.float64]
 

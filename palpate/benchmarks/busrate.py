@@ -14,15 +14,15 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from config.schema import ServoBusConfig
-from robot.dynamixel.driver import DynamixelBus
-from robot.dynamixel.replies import GOAL_LEN, STATE_LEN
-from sim.clock import VirtualClock
-from sim.dynamixel import protocol
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.direct import direct_transport
-from sim.dynamixel.timing import RETURN_DELAY_UNIT_S, BusTiming
-from wire import dynamixel as tables
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.dynamixel.replies import GOAL_LEN, STATE_LEN
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel import protocol
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.direct import direct_transport
+from palpate.sim.dynamixel.timing import RETURN_DELAY_UNIT_S, BusTiming
+from palpate.wire import dynamixel as tables
 
 CASES = ((1_000_000, 16.0), (1_000_000, 1.0), (57_600, 16.0), (57_600, 1.0))
 

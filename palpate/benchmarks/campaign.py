@@ -26,8 +26,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import (
     campaign_trials,
@@ -35,9 +33,11 @@ from palpate.campaigns.campaign import (
     run_campaign,
     warm_up,
 )
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.verdicts import counts_column, tally
+from palpate.sim.contact_table import equilibrium_on_grid
 from palpate.simulation.trial import Transport, TrialOutcome
-from sim.contact_table import equilibrium_on_grid
 
 SceneChange = Callable[[SceneConfig], SceneConfig]
 

@@ -19,12 +19,12 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.loader import CONFIG_DIR
-from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.calibration import is_reference
 from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
+from palpate.config import load, load_stack, resolve
+from palpate.config.loader import CONFIG_DIR
+from palpate.config.scene import SceneConfig
 from palpate.reports.verdicts import Tally, counts_column, tally
 
 CASES: tuple[tuple[str, str], ...] = (

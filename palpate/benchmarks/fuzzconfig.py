@@ -13,9 +13,9 @@ from typing import Any
 import numpy as np
 import yaml
 
-from config.loader import ConfigError, from_mapping, read_yaml
-from config.scene import SceneConfig
-from config.schema import StackConfig
+from palpate.config.loader import ConfigError, from_mapping, read_yaml
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
 
 Rng = np.random.Generator
 

@@ -25,10 +25,10 @@ from typing import Any
 import numpy as np
 import yaml
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.fuzzconfig import mutate_mapping, mutate_text
 from palpate.campaigns.campaign import campaign_trials
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import TrialSpec, run_sim_trial

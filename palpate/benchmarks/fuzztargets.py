@@ -40,14 +40,14 @@ from palpate.benchmarks.fuzzconfig import (
     mutate_text,
     plain,
 )
-from robot.dynamixel.driver import DynamixelBus, Motor
-from robot.motors import ServoFaultError, ServoTransportError
-from sensor.parser import FrameParser
-from sim.dynamixel import protocol
-from sim.dynamixel.faults import FaultyBus
-from sim.dynamixel.servo import EmulatedServo
-from sim.inprocess import InProcessPort
-from wire.frame import Frame, FrameError, FrameLayout, decode, encode, layout_of
+from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.motors import ServoFaultError, ServoTransportError
+from palpate.sensor.parser import FrameParser
+from palpate.sim.dynamixel import protocol
+from palpate.sim.dynamixel.faults import FaultyBus
+from palpate.sim.dynamixel.servo import EmulatedServo
+from palpate.sim.inprocess import InProcessPort
+from palpate.wire.frame import Frame, FrameError, FrameLayout, decode, encode, layout_of
 
 Rng = np.random.Generator
 

@@ -18,10 +18,10 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, default_workers, run_campaign, warm_up
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.verdicts import relaxed_tally
 
 HOLDS_S = (0.5, 1.0, 2.0, 5.0, 10.0)

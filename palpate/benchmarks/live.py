@@ -18,11 +18,11 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from estimation.section import sensor_section
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, warm_up
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.estimation.section import sensor_section
 from palpate.live import HOST, TOPICS, LiveView
 from palpate.simulation.trial import run_sim_trial
 

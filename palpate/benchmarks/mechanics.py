@@ -23,13 +23,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from config.schema import SensorConfig
-from estimation.beam import Beam
-from estimation.elastica import E_OVER_L_MAX, accurate, fast, shooting
-from estimation.elastica._scipy import solve_ivp
-from estimation.section import sensor_section
-from estimation.strain_fit import fit_strains
 from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
+from palpate.config.schema import SensorConfig
+from palpate.estimation.beam import Beam
+from palpate.estimation.elastica import E_OVER_L_MAX, accurate, fast, shooting
+from palpate.estimation.elastica._scipy import solve_ivp
+from palpate.estimation.section import sensor_section
+from palpate.estimation.strain_fit import fit_strains
 
 FloatArray = NDArray[np.float64]
 L_PAPER = 0.042

@@ -32,10 +32,6 @@ import statistics
 from collections.abc import Callable
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from config.schema import StackConfig
-from estimation.surface import SurfaceGeometry
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import (
@@ -44,12 +40,16 @@ from palpate.campaigns.campaign import (
     run_campaign,
     warm_up,
 )
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.estimation.surface import SurfaceGeometry
+from palpate.robot.probe_plan import ProbeGeometry, ProbeSettings
+from palpate.robot.probe_result import Touch
+from palpate.robot.probing import ProbeRoutine
+from palpate.sim.world import Surface
 from palpate.simulation.trial import TrialOutcome
 from palpate.simulation.world import TrialGeometry
-from robot.probe_plan import ProbeGeometry, ProbeSettings
-from robot.probe_result import Touch
-from robot.probing import ProbeRoutine
-from sim.world import Surface
 
 SCENE = "scenes/tilted.yaml"
 STRIDE, QUICK_STRIDE = 7, 19  # coprime to the 3 orientations and 3 tubes: a spread subset

@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from config import resolve
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from palpate.config import resolve
 
 SCENE = "scenes/robot.yaml"
 BENCH = "bench.yaml"

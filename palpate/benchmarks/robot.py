@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from config.schema import DEFAULT_TUBES, ServoBusConfig
 from palpate.benchmarks import busrate
 from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
-from robot.dynamixel.driver import DynamixelBus
-from robot.kinematics import forward, inverse
-from sim.dynamixel.bus import EmulatedBus
+from palpate.config.schema import DEFAULT_TUBES, ServoBusConfig
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.kinematics import forward, inverse
+from palpate.sim.dynamixel.bus import EmulatedBus
 
 TARGET_HZ = 500.0
 

@@ -25,24 +25,24 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from config.schema import SensorConfig
-from estimation.detect_buckling import (
+from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from palpate.config.schema import SensorConfig
+from palpate.estimation.detect_buckling import (
     CusumDetector,
     Detector,
     NormThreshold,
     first_mode_pattern,
     first_mode_strains,
 )
-from estimation.elastica.constants import P_CRIT
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
-from sensor.clock import SystemClock
-from sensor.parser import FrameParser
-from sensor.reader import FrameReader
-from sensor.strain import grating_intervals, strain_noise
-from sim.board import BoardEmulator, BoardFaults, BoardSample
-from sim.clock import VirtualClock
-from wire.frame import FrameLayout
-from wire.frameblock import FrameBlock, decode_block, encode_block
+from palpate.estimation.elastica.constants import P_CRIT
+from palpate.sensor.clock import SystemClock
+from palpate.sensor.parser import FrameParser
+from palpate.sensor.reader import FrameReader
+from palpate.sensor.strain import grating_intervals, strain_noise
+from palpate.sim.board import BoardEmulator, BoardFaults, BoardSample
+from palpate.sim.clock import VirtualClock
+from palpate.wire.frame import FrameLayout
+from palpate.wire.frameblock import FrameBlock, decode_block, encode_block
 
 LAYOUT = FrameLayout(3)
 BASE = np.array([1530e-9, 1535e-9, 1540e-9])

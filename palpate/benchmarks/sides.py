@@ -43,13 +43,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.benchmarks.patching import patched
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.sim.contact_table import equilibrium_on_grid
 from palpate.simulation.trial import TrialOutcome
-from sim.contact_table import equilibrium_on_grid
 
 SIMULATOR, CONTROL, ESTIMATOR = "simulator", "control path", "estimator"
 
@@ -66,19 +66,28 @@ class Boundary:
 
 
 BOUNDARIES = (
-    Boundary("sim.clock:VirtualClock", "advance", "clock advance: servos, board, world", SIMULATOR),
-    Boundary("sim.dynamixel.bus:EmulatedBus", "exchange", "emulated bus requests", SIMULATOR),
-    Boundary("sim.inprocess:FramePipe", "take_frames", "frame pipe", SIMULATOR),
-    Boundary("sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
-    Boundary("palpate.simulation.trial", "run_trial", "trial loop", CONTROL),
-    Boundary("robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
-    Boundary("robot.trial.recording:McapRecorder", "write", "MCAP recording", CONTROL),
-    Boundary("robot.trial.recording:McapRecorder", "close", "MCAP close (tip force)", CONTROL),
-    Boundary("robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
-    Boundary("robot.trial.states", "infer_states", "beam states", ESTIMATOR),
-    Boundary("robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
-    Boundary("robot.trial.estimate", "lean_of_rows", "lean and slip-path fits", ESTIMATOR),
-    Boundary("robot.trial.estimate", "relaxation_of", "relaxation fit", ESTIMATOR),
+    Boundary(
+        "palpate.sim.clock:VirtualClock",
+        "advance",
+        "clock advance: servos, board, world",
+        SIMULATOR,
+    ),
+    Boundary(
+        "palpate.sim.dynamixel.bus:EmulatedBus", "exchange", "emulated bus requests", SIMULATOR
+    ),
+    Boundary("palpate.sim.inprocess:FramePipe", "take_frames", "frame pipe", SIMULATOR),
+    Boundary("palpate.sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
+    Boundary("palpate.robot.trial.session", "run_trial", "trial loop", CONTROL),
+    Boundary("palpate.robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
+    Boundary("palpate.robot.trial.recording:McapRecorder", "write", "MCAP recording", CONTROL),
+    Boundary(
+        "palpate.robot.trial.recording:McapRecorder", "close", "MCAP close (tip force)", CONTROL
+    ),
+    Boundary("palpate.robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
+    Boundary("palpate.robot.trial.states", "infer_states", "beam states", ESTIMATOR),
+    Boundary("palpate.robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
+    Boundary("palpate.robot.trial.estimate", "lean_of_rows", "lean and slip-path fits", ESTIMATOR),
+    Boundary("palpate.robot.trial.estimate", "relaxation_of", "relaxation fit", ESTIMATOR),
     Boundary("palpate.simulation.result", "estimate_trial", "rest of the estimate", ESTIMATOR),
 )
 TICKS = "ticks (observe, decide, command)"

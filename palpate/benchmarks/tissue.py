@@ -30,17 +30,17 @@ from typing import Any
 
 import numpy as np
 
-from config import load, load_stack, resolve
-from config.sample import SampleConfig
-from config.scene import SceneConfig
 from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
 from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
+from palpate.config import load, load_stack, resolve
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import SceneConfig
+from palpate.sim.fem import FeTissueLaw, LayerProblem
+from palpate.sim.fem.law import curve_from_table
+from palpate.sim.fem.table import SHIPPED_DIR, read_table
+from palpate.sim.sample_law import fe_problem, relaxation, world_tissue
+from palpate.sim.viscoelastic import force_history
 from palpate.simulation.trial import TrialOutcome
-from sim.fem import FeTissueLaw, LayerProblem
-from sim.fem.law import curve_from_table
-from sim.fem.table import SHIPPED_DIR, read_table
-from sim.sample_law import fe_problem, relaxation, world_tissue
-from sim.viscoelastic import force_history
 
 VISCO = {"relaxation_time_s": 1.0, "relaxed_ratio": 0.7}
 SPEEDS_MM_PER_S = (0.1, 0.5, 2.0)

@@ -26,14 +26,14 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from estimation.hertz import hertz_force
-from estimation.layer import dimitriadis_bracket, dimitriadis_coefficients
 from palpate.benchmarks.report import BenchContext, BenchSection, Table
-from sim.fem.law import curve_from_table
-from sim.fem.problem import LayerProblem
-from sim.fem.solver import solve_indentation
-from sim.fem.table import read_table, save_table, solve_table
-from sim.tissue import TissueModel
+from palpate.estimation.hertz import hertz_force
+from palpate.estimation.layer import dimitriadis_bracket, dimitriadis_coefficients
+from palpate.sim.fem.law import curve_from_table
+from palpate.sim.fem.problem import LayerProblem
+from palpate.sim.fem.solver import solve_indentation
+from palpate.sim.fem.table import read_table, save_table, solve_table
+from palpate.sim.tissue import TissueModel
 
 FloatArray = NDArray[np.float64]
 PAPER = LayerProblem.from_dimensions(3.5e-3, 10e-3, 40e-3, poisson=0.45)

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from config.loader import InputError
-from config.scene import ORIENTATION_ROLL_DEG, SceneConfig
-from config.schema import StackConfig
-from estimation.elastica import fast
-from estimation.stiffness import SampleSummary, summarize
 from palpate.calibration import calibrated, is_reference
 from palpate.campaigns.executors import SerialExecutor, process_pool
+from palpate.config.loader import InputError
+from palpate.config.scene import ORIENTATION_ROLL_DEG, SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.estimation.elastica import fast
+from palpate.estimation.stiffness import SampleSummary, summarize
 from palpate.live import LiveView
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 

@@ -17,14 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from config.loader import InputError
-from config.sample import SampleConfig
-from config.scene import SceneConfig
-from config.schema import StackConfig, TipGratingConfig
-from estimation.design import DesignEvaluation
-from estimation.design.tipgrating import TipGratingChoice
 from palpate.campaigns.campaign import median_abs_relative_error, run_campaign
 from palpate.campaigns.executors import open_executor
+from palpate.config.loader import InputError
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig, TipGratingConfig
+from palpate.estimation.design import DesignEvaluation
+from palpate.estimation.design.tipgrating import TipGratingChoice
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}

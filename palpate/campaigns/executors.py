@@ -31,7 +31,7 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
 from typing import Any, TypeVar
 
-from config.loader import InputError
+from palpate.config.loader import InputError
 
 T = TypeVar("T")
 

@@ -16,20 +16,20 @@ import math
 from pathlib import Path
 from typing import Any, TypeVar
 
-from config.schema import StackConfig
-from estimation.compliance import ComplianceFit
-from estimation.jointfit import JointFit
-from estimation.misalignment import Lean
-from estimation.relaxation import RelaxationFit
-from estimation.southwell import SouthwellFit
-from estimation.stiffness import StiffnessEstimate
 from palpate.campaigns.runs import set_aside
+from palpate.config.schema import StackConfig
+from palpate.estimation.compliance import ComplianceFit
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.misalignment import Lean
+from palpate.estimation.relaxation import RelaxationFit
+from palpate.estimation.southwell import SouthwellFit
+from palpate.estimation.stiffness import StiffnessEstimate
+from palpate.robot.indentation import TrialMarks
+from palpate.robot.probe_result import ProbeResult, Touch
+from palpate.robot.trial.estimate import exposed_length_at
+from palpate.robot.trial.log import TrialLog, TrialLogError, read_log
+from palpate.robot.trial.record import recorded_verdict
 from palpate.simulation.trial import TrialOutcome, TrialSpec, trial_geometry
-from robot.indentation import TrialMarks
-from robot.probe_result import ProbeResult, Touch
-from robot.trial.estimate import exposed_length_at
-from robot.trial.log import TrialLog, TrialLogError, read_log
-from robot.trial.record import recorded_verdict
 
 T = TypeVar("T")
 

@@ -29,7 +29,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from config.loader import InputError
+from palpate.config.loader import InputError
 
 if sys.platform != "win32":  # POSIX advisory locks; on Windows runs keep apart by their folders
     import fcntl

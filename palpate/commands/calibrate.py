@@ -22,21 +22,21 @@ import argparse
 import json
 from pathlib import Path
 
-from config import load_stack
-from config.loader import InputError
-from config.schema import MM
-from estimation.compliance import ComplianceFit
 from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.config import load_stack
+from palpate.config.loader import InputError
+from palpate.config.schema import MM
+from palpate.estimation.compliance import ComplianceFit
 from palpate.reports.replay import replay
-from robot.trial.log import read_log
-from sensor.calibration import (
+from palpate.robot.trial.log import read_log
+from palpate.sensor.calibration import (
     CalibrationFit,
     csv_columns,
     fit_strain_coefficient,
     load_pairs_csv,
 )
-from sensor.framecal import calibrate_frames, read_frames
-from sensor.tipcal import fit_tip_csv, fit_tip_frames, is_tip_csv
+from palpate.sensor.framecal import calibrate_frames, read_frames
+from palpate.sensor.tipcal import fit_tip_csv, fit_tip_frames, is_tip_csv
 
 
 def register(parser: argparse.ArgumentParser) -> None:

@@ -16,37 +16,41 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from config import load, load_stack, resolve
-from config.loader import InputError, write_yaml
-from config.scene import SceneConfig
-from config.schema import StackConfig
-from estimation.design import (
-    DesignConstraints,
-    DesignSpace,
-    design_sensor,
-)
-from estimation.design.tipgrating import TipGratingChoice, choose_tip_grating
-from estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
-from estimation.section import composite_section
 from palpate.argtypes import non_negative_int, positive_int
 from palpate.campaigns.campaign import campaign_trials, default_workers
 from palpate.campaigns.designcheck import (
     DEFAULT_TOLERANCE,
     UNITS,
     CheckSettings,
+    DesignVerdict,
     design_scene,
     design_verdict,
     designed_stack,
     run_check,
 )
 from palpate.campaigns.executors import add_executor_arguments
+from palpate.config import load, load_stack, resolve
+from palpate.config.loader import InputError, write_yaml
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.estimation.design import (
+    DesignConstraints,
+    DesignResult,
+    DesignSpace,
+    design_sensor,
+)
+from palpate.estimation.design.tipgrating import TipGratingChoice, choose_tip_grating
+from palpate.estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
+from palpate.estimation.section import composite_section
 from palpate.progress import progress_bar
 from palpate.reports.design import CheckRun, payload, print_report
+from palpate.sensor.strain import strain_noise
 from palpate.simulation.trial import TrialOutcome
-from sensor.strain import strain_noise
-from wire.dynamixel import TICKS_PER_REV
+from palpate.wire.dynamixel import TICKS_PER_REV
 
 EXIT_NO_DESIGN = 2
 
@@ -305,10 +309,32 @@ def _two_digits_down(x: float) -> float:
     return math.floor(x / scale) * scale
 
 
-def run(args: argparse.Namespace) -> int:
+@dataclass(frozen=True)
+class DesignOutcome:
+    """What ``palpate design`` found: the search's result, its constraints, the simulated
+    check (its trials, none when skipped), the tip grating and weight checks, and the verdict
+    (``usable``, ``reasons``, ``conditions``); :meth:`as_dict` is what ``--json`` prints."""
+
+    result: DesignResult
+    constraints: DesignConstraints
+    check: CheckRun
+    tip: TipGratingChoice | None
+    weight: WeightCheck | None
+    verdict: DesignVerdict
+
+    def as_dict(self) -> dict[str, Any]:
+        w = self.weight
+        extra = {**_tip_payload(self.tip), **({} if w is None else {"weight": w.as_dict()})}
+        return {**self.verdict.as_dict(), **payload(self.result, self.constraints, self.check),
+                **extra}  # fmt: skip
+
+
+def evaluate(args: argparse.Namespace) -> DesignOutcome:
+    """The search, the designed robot configuration (written with ``--write``), the weight
+    check and the simulated check, from the command's arguments (``palpate.design`` builds
+    them from keywords)."""
     stack = load_stack(args.config)
-    scene_path = args.scene if args.scene else resolve("scenes/bench.yaml")
-    base = load(SceneConfig, scene_path)
+    base = load(SceneConfig, args.scene if args.scene else resolve("scenes/bench.yaml"))
     if args.moduli < 1 or args.lengths < 1:
         raise InputError("--moduli and --lengths must be >= 1")
     if args.contact_uncertainty_mm < 0:
@@ -338,7 +364,6 @@ def run(args: argparse.Namespace) -> int:
             write_yaml(sim_stack, args.write, _written_note(args))
         if not args.no_sim:
             outcomes, wall = _run_sim(scene, sim_stack, args)
-    run = CheckRun(outcomes, wall, args.unit, args.executor)
     verdict = design_verdict(
         result.success,
         None if args.no_sim else outcomes,
@@ -346,14 +371,18 @@ def run(args: argparse.Namespace) -> int:
         "" if weight is None else _sag_text(weight),
         args.tolerance_pct / 100,
     )
+    check = CheckRun(outcomes, wall, args.unit, args.executor)
+    return DesignOutcome(result, constraints, check, tip, weight, verdict)
+
+
+def run(args: argparse.Namespace) -> int:
+    found = evaluate(args)
     if args.json:
-        extra = {**_tip_payload(tip), **({} if weight is None else {"weight": weight.as_dict()})}
-        body = {**verdict.as_dict(), **payload(result, constraints, run), **extra}
-        print(json.dumps(body, indent=2))
+        print(json.dumps(found.as_dict(), indent=2))
     else:
-        print(verdict.headline())
-        print_report(result, constraints, run)
-        _print_tip(tip, weight, args.write)
-    if not result.success:
+        print(found.verdict.headline())
+        print_report(found.result, found.constraints, found.check)
+        _print_tip(found.tip, found.weight, args.write)
+    if not found.result.success:
         return EXIT_NO_DESIGN
-    return 0 if verdict.usable is not False else 1
+    return 0 if found.verdict.usable is not False else 1

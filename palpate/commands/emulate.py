@@ -18,14 +18,14 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from config import load, load_stack, resolve
-from config.bench import load_bench
-from config.scene import SceneConfig
 from palpate.argtypes import positive_float
+from palpate.config import load, load_stack, resolve
+from palpate.config.bench import load_bench
+from palpate.config.scene import SceneConfig
+from palpate.sensor.parser import layout_from_config
+from palpate.sim.board import BoardEmulator, constant_source
+from palpate.sim.dynamixel.bus import EmulatedBus
 from palpate.simulation.twin import SimulatedBench, stations_for
-from sensor.parser import layout_from_config
-from sim.board import BoardEmulator, constant_source
-from sim.dynamixel.bus import EmulatedBus
 
 log = logging.getLogger(__name__)
 

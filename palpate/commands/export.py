@@ -12,10 +12,10 @@ import argparse
 import logging
 from pathlib import Path
 
-from config.loader import InputError
-from robot.trial.export import export
-from robot.trial.log import TrialLogError
-from robot.trial.recording import read_recording
+from palpate.config.loader import InputError
+from palpate.robot.trial.export import export
+from palpate.robot.trial.log import TrialLogError
+from palpate.robot.trial.recording import read_recording
 
 log = logging.getLogger(__name__)
 

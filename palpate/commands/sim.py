@@ -12,11 +12,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from config import InputError, load, load_stack, resolve
-from config.scene import SceneConfig
-from config.schema import StackConfig
 from palpate.argtypes import non_negative_int, positive_int
-from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.calibration import config_lines
 from palpate.campaigns.campaign import (
     CampaignRun,
     SampleRow,
@@ -29,11 +26,15 @@ from palpate.campaigns.campaign import (
 from palpate.campaigns.executors import add_executor_arguments, open_executor
 from palpate.campaigns.resume import resume_outcomes
 from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
-from palpate.cli import EXIT_FAULT, EXIT_OK
+from palpate.config import InputError, load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.exitcodes import EXIT_FAULT, EXIT_OK
 from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
 from palpate.reports import verdicts
-from palpate.reports.campaign_table import kpa_fields, print_table, sample_records
+from palpate.reports.campaign_table import print_table
+from palpate.reports.payload import campaign_report
 from palpate.reports.results import CampaignResults
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec
@@ -268,7 +269,7 @@ def _open_run(c: _Campaign, args: argparse.Namespace, locks: contextlib.ExitStac
 
 def _compare(campaigns: list[_Campaign], args: argparse.Namespace) -> None:
     from palpate.reports.methods import compare_methods, comparison_payload, print_comparison
-    from robot.trial.setup import sensor_section
+    from palpate.robot.trial.setup import sensor_section
 
     for c in campaigns:
         table = compare_methods(c.outcomes, c.stack, sensor_section(c.stack))
@@ -304,47 +305,21 @@ def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
 def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     """Print one campaign's table (unless ``--json``), write its results into the run folder
     (``palpate.reports.results``) and return its JSON payload."""
-    scene, outcomes, wall = c.scene, c.outcomes, c.wall
-    outlier_above = scene.campaign.outlier_above_kpa * 1e3
-    rows = summarize_campaign(outcomes, outlier_above)
-    records = sample_records(outcomes, rows, outlier_above)
-    sim_time = sum(o.sim_time for o in outcomes)
+    rows = summarize_campaign(c.outcomes, c.scene.campaign.outlier_above_kpa * 1e3)
     figures = [] if args.no_plots else _figures(c, rows)
-    trials = [o.as_dict() for o in outcomes]
-    payload: dict[str, object] = {
-        "scene": scene.name,
+    run = {
         "run_dir": str(c.run_dir),
         "log_dir": str(c.log_dir),
         "transport": c.transport,
         "seed": args.seed,
-        "trials": trials,
-        "samples": [
-            {**rec, "joint_median_kpa": kpa_fields(r.summary.__dict__).get("median_kpa")}
-            | {"tissue_model": tissue_description(scene, c.stack, r.sample)}
-            for r, rec in zip(rows, records, strict=True)
-        ],
-        "median_abs_relative_error": median_abs_relative_error(outcomes),
-        "method": (
-            "joint fit (contact-point-free; joint_kpa, ok trials in the medians); the paper's "
-            "single-point estimate (Eqs. 13-14) per trial as paper_kpa"
-        ),
-        "median_abs_relative_error_paper": median_abs_relative_error(outcomes, "paper"),
-        "wall_s": wall,
-        "simulated_s": sim_time,
-        "speedup": sim_time / wall if wall > 0 else None,
-        "figures": figures,
     }
-    payload.update(verdicts.verdict_payload(outcomes, c.scene.campaign.classify_at))
-    found = calibrate(
-        (rig_key(o.spec.kind, o.spec.tube), o.calibration)
-        for o in outcomes
-        if o.calibration is not None
-    )
-    if found:
-        payload["calibration"] = {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()}
-    files = c.results.finish(trials, records, payload)
+    report = campaign_report(c.scene, c.stack, c.outcomes, run=run, wall=c.wall, figures=figures)
+    payload = report.as_dict()
+    files = c.results.finish(payload["trials"], report.samples, payload)
     if not args.json:
-        _print_report(c, args, records, found, figures + [str(f) for f in files])
+        _print_report(
+            c, args, report.samples, report.calibration, figures + [str(f) for f in files]
+        )
     return payload
 
 

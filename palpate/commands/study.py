@@ -21,12 +21,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
-from config import load, load_stack, resolve
-from config.loader import InputError
-from config.scene import SceneConfig
 from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
 from palpate.campaigns.executors import add_executor_arguments, open_executor
 from palpate.campaigns.study import Bounded, GroupStats, MethodStats, TrialErrors, summarize_study
+from palpate.config import load, load_stack, resolve
+from palpate.config.loader import InputError
+from palpate.config.scene import SceneConfig
 from palpate.progress import progress_bar
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import TrialOutcome

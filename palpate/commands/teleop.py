@@ -22,21 +22,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from config import CONFIG_DIR, load, load_stack, resolve
-from config.bench import load_bench
-from config.loader import InputError
-from config.scene import CampaignConfig, SceneConfig
-from config.schema import StackConfig
-from config.targets import save_target
 from palpate.commands.teleop_screen import draw, key_name, render, screen_width
+from palpate.config import CONFIG_DIR, load, load_stack, resolve
+from palpate.config.bench import load_bench
+from palpate.config.loader import InputError
+from palpate.config.scene import CampaignConfig, SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.config.targets import save_target
 from palpate.lab.hardware import open_hardware, run_on_hardware
 from palpate.live import LiveView, Publisher, add_live_argument, live_view
+from palpate.robot.indentation import State
+from palpate.robot.rig import ServoFbgRig
+from palpate.robot.teleop import Teleop
+from palpate.robot.trial.setup import detector_for, guards_for, rig_settings
+from palpate.sensor.clock import Clock, SystemClock
 from palpate.simulation.twin import SimulatedBench
-from robot.indentation import State
-from robot.rig import ServoFbgRig
-from robot.teleop import Teleop
-from robot.trial.setup import detector_for, guards_for, rig_settings
-from sensor.clock import Clock, SystemClock
 
 DRAW_PERIOD_S = 0.05
 

@@ -11,7 +11,7 @@ import curses
 import math
 from typing import Any
 
-from robot.teleop import TeleopView
+from palpate.robot.teleop import TeleopView
 
 HELP = (
     "up/k advance  down/j retract  left/h right/l roll  t/T tube  +/- step  [/] speed",

@@ -16,10 +16,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from config.bench import LoadedBench, load_bench
-from estimation.stiffness import summarize
-from estimation.verdict import STATUSES
 from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.config.bench import LoadedBench, load_bench
+from palpate.estimation.stiffness import summarize
+from palpate.estimation.verdict import STATUSES
 from palpate.lab.hardware import open_hardware, port_problem, run_on_hardware
 from palpate.lab.trial import (
     SKIPPED,
@@ -30,8 +30,8 @@ from palpate.lab.trial import (
 )
 from palpate.live import add_live_argument, live_view
 from palpate.reports.results import CampaignResults
-from sensor.clock import Clock
-from sensor.reader import SerialLike
+from palpate.sensor.clock import Clock
+from palpate.sensor.reader import SerialLike
 
 
 def register(parser: argparse.ArgumentParser) -> None:

@@ -19,15 +19,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from config.faults import FaultCase
-from config.schema import ServoBusConfig
-from robot.trial.log import TrialLogWriter
-from sim.board import BoardEmulator, BoardFaults
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.faults import FaultyBus, PacketFaults
-from sim.world import Surface, World
-from wire import dynamixel as tables
+from palpate.config.faults import FaultCase
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.trial.log import TrialLogWriter
+from palpate.sim.board import BoardEmulator, BoardFaults
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.faults import FaultyBus, PacketFaults
+from palpate.sim.world import Surface, World
+from palpate.wire import dynamixel as tables
 
 HARDWARE_ERROR_BITS: dict[str, int] = {
     "input_voltage": tables.HW_INPUT_VOLTAGE,

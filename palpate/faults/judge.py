@@ -34,15 +34,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from config.faults import FaultCase
-from config.scene import SceneConfig
-from config.schema import StackConfig
+from palpate.config.faults import FaultCase
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
 from palpate.faults.injector import GroundTruth
 from palpate.reports.replay import replay
+from palpate.robot.trial.log import read_log
+from palpate.sim.board import BoardFaults
 from palpate.simulation.trial import TrialOutcome, TrialSpec
-from robot.trial.log import read_log
-from sim.board import BoardFaults
-from wire import dynamixel as tables
+from palpate.wire import dynamixel as tables
 
 TRAVEL_SLACK = 0.1e-3  # m past the travel guard: a tick or two at approach speed, tracking lag
 KILL_STOP_SLACK = 0.1e-3  # m a held servo may still travel toward its last goal after a kill

@@ -25,18 +25,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from config.faults import FaultCase
-from config.loader import ConfigError, from_mapping
-from config.scene import SceneConfig
-from config.schema import StackConfig
 from palpate.campaigns.campaign import campaign_trials
 from palpate.campaigns.executors import process_pool
 from palpate.campaigns.runs import locked, new_run_dir
+from palpate.config.faults import FaultCase
+from palpate.config.loader import ConfigError, from_mapping
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
 from palpate.faults.injector import FaultInjector, GroundTruth
 from palpate.faults.judge import FaultJob, FaultTrialResult, judge, judge_killed
+from palpate.sim.board import BoardFaults
 from palpate.simulation.preflight import check_campaign, check_reachable
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
-from sim.board import BoardFaults
 
 log = logging.getLogger(__name__)
 
@@ -220,7 +220,7 @@ def fault_table(results: Sequence[FaultTrialResult]) -> list[FaultRow]:
 
 def run_command(args: Any) -> int:
     """``palpate sim --faults``: exit 0 when every trial stopped safely and kept its data."""
-    from config import load, load_stack, resolve
+    from palpate.config import load, load_stack, resolve
 
     if getattr(args, "resume", False):
         raise ValueError("--resume: the fault campaign always runs anew (it judges every trial)")

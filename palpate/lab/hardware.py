@@ -25,13 +25,13 @@ from dataclasses import dataclass
 from types import FrameType
 from typing import Any
 
-from config.schema import StackConfig
-from robot.drive import DriveController
-from robot.dynamixel.driver import DynamixelBus
-from robot.motors import ServoFaultError, ServoTransportError
-from sensor.clock import Clock, SystemClock
-from sensor.ports import DIALOUT_HINT, os_errno
-from sensor.reader import FrameReader, SensorPortError, SerialLike
+from palpate.config.schema import StackConfig
+from palpate.robot.drive import DriveController
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.motors import ServoFaultError, ServoTransportError
+from palpate.sensor.clock import Clock, SystemClock
+from palpate.sensor.ports import DIALOUT_HINT, os_errno
+from palpate.sensor.reader import FrameReader, SensorPortError, SerialLike
 
 log = logging.getLogger(__name__)
 

@@ -15,14 +15,14 @@ import re
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from config.bench import BenchTrialConfig, LoadedBench
-from config.loader import ConfigError, InputError
-from config.sample import AssumedConfig
-from config.schema import MM, TubeConfig
-from config.targets import TargetConfig, TargetsFile, load_targets
-from robot.drive import JointLimitError, JointState, RollerGearDrive
-from robot.indentation import TrialPlan
-from robot.trial.setup import trial_plan
+from palpate.config.bench import BenchTrialConfig, LoadedBench
+from palpate.config.loader import ConfigError, InputError
+from palpate.config.sample import AssumedConfig
+from palpate.config.schema import MM, TubeConfig
+from palpate.config.targets import TargetConfig, TargetsFile, load_targets
+from palpate.robot.drive import JointLimitError, JointState, RollerGearDrive
+from palpate.robot.indentation import TrialPlan
+from palpate.robot.trial.setup import trial_plan
 
 
 @dataclass(frozen=True)

@@ -19,30 +19,28 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from config.bench import LoadedBench
-from config.sample import UNKNOWN, AssumedConfig
-from config.schema import MM, StackConfig, TubeConfig
-from estimation.compliance import ComplianceFit
-from estimation.jointfit import JointFit
-from estimation.relaxation import RelaxationFit
-from estimation.section import Section
-from estimation.stiffness import StiffnessEstimate
-from estimation.verdict import Verdict
 from palpate.calibration import calibrate, rig_key, with_compliance
+from palpate.config.bench import LoadedBench
+from palpate.config.sample import UNKNOWN, AssumedConfig
+from palpate.config.schema import MM, StackConfig, TubeConfig
+from palpate.estimation.compliance import ComplianceFit
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.relaxation import RelaxationFit
+from palpate.estimation.section import Section
+from palpate.estimation.stiffness import StiffnessEstimate
+from palpate.estimation.verdict import Verdict
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
 from palpate.live import LiveView, Publisher
-from robot.dynamixel.stats import BusStats
-from robot.indentation import PLANNED_ENDS
-from robot.rig import ServoFbgRig
-from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
-from robot.trial.inputs import belief_fields, probe_inputs
-from robot.trial.log import TrialLogWriter
-from robot.trial.record import estimate_record, header_common, relaxed_row
-from robot.trial.run import end_record, run_trial
-from robot.trial.setup import (
-    detector_for,
-    guards_for,
+from palpate.robot.dynamixel.stats import BusStats
+from palpate.robot.indentation import PLANNED_ENDS
+from palpate.robot.rig import ServoFbgRig
+from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from palpate.robot.trial.inputs import belief_fields, probe_inputs
+from palpate.robot.trial.record import header_common, relaxed_row
+from palpate.robot.trial.run import TrialResult
+from palpate.robot.trial.session import TrialSetup, run_session_trial
+from palpate.robot.trial.setup import (
     position_tolerance,
     prober_for,
     rig_settings,
@@ -249,34 +247,40 @@ def _run_one(
         c, stack, tick, sync_to_clock=sync_to_clock, exposed_length=trial.exposed_length
     )
     rig = ServoFbgRig.for_stack(hw.drive, hw.reader, stack, hw.clock, settings)
-    chain = rig.zero()
     section = sensor_section(stack)
     inputs = bench_inputs(trial, loaded, stack)
-    path = log_dir / f"{trial.trial_id}.jsonl"
-    with TrialLogWriter(path, _header(trial, loaded, section, inputs), mcap=True) as log:
-        guards = guards_for(c, stack, rig.tick)
-        # the robot probes the surface first when the campaign says so (null: it does)
-        radius = (trial.assumed or AssumedConfig()).surface_radius(None)
-        prober = prober_for(c, stack, trial.tube, radius) if trial.kind == "robot" else None
-        detector = detector_for(c, chain)
-        result = run_trial(
-            rig, hw.clock, trial.plan, guards, detector, log, prober=prober, on_tick=publisher
-        )
-        if result.probe is not None:  # told what probing measured, as the replay of its log is
-            inputs = dataclasses.replace(inputs, **probe_inputs(result.probe.as_dict()))
-        estimate = estimate_trial(
+    # the robot probes the surface first when the campaign says so (null: it does)
+    radius = (trial.assumed or AssumedConfig()).surface_radius(None)
+
+    def estimate(result: TrialResult) -> TrialEstimate:
+        told = inputs  # and what probing measured, as the replay of its log is told
+        if result.probe is not None:
+            told = dataclasses.replace(inputs, **probe_inputs(result.probe.as_dict()))
+        return estimate_trial(
             result,
             kind=trial.kind,
             exposed_length=trial.exposed_length,
             flush_translation=trial.tube.flush_translation,
             stack=stack,
             section=section,
-            poisson=inputs.poisson,
-            inputs=inputs,
+            poisson=told.poisson,
+            inputs=told,
         )
-        log.write(estimate_record(estimate))
-        log.write(end_record(result))
-    return _outcome(trial, result.state.value, result.reason, estimate, result.duration, path), rig
+
+    setup = TrialSetup(
+        trial.plan,
+        c,
+        stack,
+        estimate=estimate,
+        log_path=log_dir / f"{trial.trial_id}.jsonl",
+        header=_header(trial, loaded, section, inputs),
+        prober=prober_for(c, stack, trial.tube, radius) if trial.kind == "robot" else None,
+        on_tick=publisher,
+    )
+    done = run_session_trial(rig, hw.clock, setup)
+    r = done.result
+    path = Path(str(done.log_path))
+    return _outcome(trial, r.state.value, r.reason, done.estimate, r.duration, path), rig
 
 
 def _outcome(

@@ -11,8 +11,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from estimation.verdict import STATUSES
 from palpate.campaigns.campaign import SampleRow, summarize_campaign
+from palpate.estimation.verdict import STATUSES
 from palpate.reports import verdicts
 from palpate.simulation.trial import TrialOutcome
 

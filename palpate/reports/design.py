@@ -7,8 +7,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from estimation.design import DesignConstraints, DesignEvaluation, DesignResult
 from palpate.campaigns.designcheck import METHODS, UNITS, error_summary, relative_error
+from palpate.estimation.design import DesignConstraints, DesignEvaluation, DesignResult
 from palpate.simulation.trial import TrialOutcome
 
 

@@ -25,13 +25,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
-from config.loader import InputError
-from estimation.belief import Hypothesis
+from palpate.config.loader import InputError
+from palpate.estimation.belief import Hypothesis
 from palpate.reports.replay import known_moduli
-from robot.trial.inputs import header_sensor
-from robot.trial.log import TrialLog, read_log
-from robot.trial.relaxed import HOLD_STATE, RECORD_STATES
-from robot.trial.states import record_states
+from palpate.robot.trial.inputs import header_sensor
+from palpate.robot.trial.log import TrialLog, read_log
+from palpate.robot.trial.relaxed import HOLD_STATE, RECORD_STATES
+from palpate.robot.trial.states import record_states
 
 STATUS_COLOURS = {"ok": "tab:green", "suspect": "tab:orange", "none": "0.6"}
 

@@ -24,10 +24,10 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from config.schema import StackConfig
-from estimation.section import Section
+from palpate.config.schema import StackConfig
+from palpate.estimation.section import Section
+from palpate.robot.trial.estimate import estimate_from_marks
 from palpate.simulation.trial import TrialOutcome
-from robot.trial.estimate import estimate_from_marks
 
 CONTACT_ERRORS_MM: tuple[float, ...] = (0.0, 0.1, -0.1, 0.3, -0.3)
 

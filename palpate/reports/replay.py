@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from config.loader import from_mapping
-from config.schema import SensorConfig, StackConfig, TubeConfig
-from estimation.section import Section
-from robot.trial.estimate import (
+from palpate.config.loader import from_mapping
+from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
+from palpate.estimation.section import Section
+from palpate.robot.trial.estimate import (
     EstimatorInputs,
     estimate_from_marks,
     exposed_length_at,
@@ -29,9 +29,9 @@ from robot.trial.estimate import (
     tip_load_at_buckling,
     verdict_for,
 )
-from robot.trial.inputs import VERSION, probe_inputs
-from robot.trial.log import TrialLog, TrialLogError, read_log
-from robot.trial.record import estimator_keys
+from palpate.robot.trial.inputs import VERSION, probe_inputs
+from palpate.robot.trial.log import TrialLog, TrialLogError, read_log
+from palpate.robot.trial.record import estimator_keys
 
 MAX_PROBLEMS = 5  # bad lines named in the message (all are counted)
 

@@ -9,7 +9,7 @@ import statistics
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
-from estimation.verdict import STATUSES
+from palpate.estimation.verdict import STATUSES
 from palpate.simulation.trial import TrialOutcome
 
 

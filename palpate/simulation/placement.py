@@ -26,10 +26,10 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from config.sample import SampleConfig
-from config.schema import TubeConfig
-from robot import kinematics
-from sim.world import Surface
+from palpate.config.sample import SampleConfig
+from palpate.config.schema import TubeConfig
+from palpate.robot import kinematics
+from palpate.sim.world import Surface
 
 Vector = NDArray[np.float64]
 _AZIMUTHS = 721  # grid of the azimuth search

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from config.loader import ConfigError
-from config.scene import SceneConfig
-from config.schema import StackConfig
+from palpate.config.loader import ConfigError
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
 from palpate.simulation.world import TrialSpec, trial_geometry
 
 

@@ -12,24 +12,24 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from config.scene import SceneConfig
-from config.schema import StackConfig
-from estimation.compliance import ComplianceFit
-from estimation.jointfit import JointFit
-from estimation.misalignment import Lean
-from estimation.relaxation import RelaxationFit
-from estimation.southwell import SouthwellFit
-from estimation.stiffness import StiffnessEstimate
-from estimation.verdict import Verdict
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.estimation.compliance import ComplianceFit
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.misalignment import Lean
+from palpate.estimation.relaxation import RelaxationFit
+from palpate.estimation.southwell import SouthwellFit
+from palpate.estimation.stiffness import StiffnessEstimate
+from palpate.estimation.verdict import Verdict
+from palpate.robot.indentation import TrialMarks
+from palpate.robot.probe_result import ProbeResult
+from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from palpate.robot.trial.inputs import belief_fields
+from palpate.robot.trial.record import relaxed_row
+from palpate.robot.trial.run import TrialResult
+from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.world import TrialGeometry, TrialSpec, trial_sample
-from robot.indentation import TrialMarks
-from robot.probe_result import ProbeResult
-from robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
-from robot.trial.inputs import belief_fields
-from robot.trial.record import relaxed_row
-from robot.trial.run import TrialResult
-from robot.trial.setup import sensor_section
-from wire.dynamixel import TICKS_PER_REV
+from palpate.wire.dynamixel import TICKS_PER_REV
 
 
 @dataclass

@@ -19,10 +19,32 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
-from config.sample import AssumedConfig
-from config.scene import CampaignConfig, FidelityConfig, SceneConfig
-from config.schema import ServoBusConfig, StackConfig
+from palpate.config.sample import AssumedConfig
+from palpate.config.scene import CampaignConfig, FidelityConfig, SceneConfig
+from palpate.config.schema import ServoBusConfig, StackConfig
 from palpate.live import LiveView
+from palpate.robot.drive import DriveController
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.indentation import Observation, Prober, State, TrialPlan
+from palpate.robot.rig import RigSettings, ServoFbgRig
+from palpate.robot.trial.log import TrialLogWriter
+from palpate.robot.trial.record import header_common
+from palpate.robot.trial.session import TrialSetup, run_session_trial
+from palpate.robot.trial.setup import (
+    prober_for,
+    rig_settings,
+    sensor_section,
+    trial_plan,
+)
+from palpate.sensor.parser import layout_from_config
+from palpate.sensor.reader import FrameReader
+from palpate.sim.board import BoardEmulator, BoardFaults
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.direct import direct_transport
+from palpate.sim.dynamixel.timing import BusTiming
+from palpate.sim.inprocess import FramePipe, InProcessPort, MemorySerial
+from palpate.sim.world import World
 from palpate.simulation.result import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
 from palpate.simulation.world import (
     ServoJoints,
@@ -34,30 +56,6 @@ from palpate.simulation.world import (
     trial_stack,
     trial_world,
 )
-from robot.drive import DriveController
-from robot.dynamixel.driver import DynamixelBus
-from robot.indentation import Observation, Prober, State, TrialPlan
-from robot.rig import RigSettings, ServoFbgRig
-from robot.trial.log import TrialLogWriter
-from robot.trial.record import estimate_record, header_common
-from robot.trial.run import end_record, run_trial
-from robot.trial.setup import (
-    detector_for,
-    guards_for,
-    prober_for,
-    rig_settings,
-    sensor_section,
-    trial_plan,
-)
-from sensor.parser import layout_from_config
-from sensor.reader import FrameReader
-from sim.board import BoardEmulator, BoardFaults
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.direct import direct_transport
-from sim.dynamixel.timing import BusTiming
-from sim.inprocess import FramePipe, InProcessPort, MemorySerial
-from sim.world import World
 
 # The simulated trial's public names; the spec, the geometry and the tissue are simworld's.
 __all__ = [
@@ -191,26 +189,30 @@ def run_sim_trial(
         with DriveController(driver, stack.drive) as drive, reader:
             board.start()
             rig = ServoFbgRig.for_stack(drive, reader, stack, clock, settings)
-            chain = rig.zero()
-            with _trial_log(log_dir, spec, scene, stack, plan, geo, hook) as log:
-                guards = guards_for(c, stack, rig.tick)
-                detector = detector_for(c, chain)
-                prober = _prober(spec, scene, stack, geo.tube)
-                result = run_trial(
-                    rig, clock, plan, guards, detector, log, on_tick=on_tick, prober=prober
-                )
-                estimate = estimate_sim_trial(result, spec, scene, stack, geo)
-                indentation = world.indentation
-                truth = None if indentation is None else indentation.misalignment
-                if log is not None:
-                    # the world's truth the controller never sees, for the report (and --resume)
-                    log.write({"kind": "world", "true_misalignment": truth})
-                    log.write(estimate_record(estimate))
-                    log.write(end_record(result))
-    log_path = None if log is None else str(log.path)
-    outcome = outcome_of(spec, geo, result, estimate, log_path, series)
-    outcome.true_misalignment = truth
+            setup = TrialSetup(
+                plan,
+                c,
+                stack,
+                estimate=lambda result: estimate_sim_trial(result, spec, scene, stack, geo),
+                log_path=None if log_dir is None else log_dir / f"{spec.trial_id}.jsonl",
+                header=_header(spec, scene, stack, plan, geo),
+                mcap=scene.mcap,
+                prober=_prober(spec, scene, stack, geo.tube),
+                on_tick=on_tick,
+                on_log=None if hook is None else hook.log_opened,
+                # the world's truth the controller never sees, for the report (and --resume)
+                before_estimate=lambda _: [{"kind": "world", "true_misalignment": _truth(world)}],
+            )
+            done = run_session_trial(rig, clock, setup)
+    outcome = outcome_of(spec, geo, done.result, done.estimate, done.log_path, series)
+    outcome.true_misalignment = _truth(world)
     return outcome
+
+
+def _truth(world: World) -> float | None:
+    """The misalignment the world's indentation had (rad), None before any."""
+    indentation = world.indentation
+    return None if indentation is None else indentation.misalignment
 
 
 def bus_timing(fidelity: FidelityConfig, servos: ServoBusConfig) -> BusTiming | None:
@@ -301,27 +303,6 @@ def _series_recorder(
             series[k].append(s)
 
     return on_tick
-
-
-@contextlib.contextmanager
-def _trial_log(
-    log_dir: Path | None,
-    spec: TrialSpec,
-    scene: SceneConfig,
-    stack: StackConfig,
-    plan: TrialPlan,
-    geo: TrialGeometry,
-    hook: EmulatorHook | None,
-) -> Iterator[TrialLogWriter | None]:
-    """The trial's log in ``log_dir`` (None: no log), closed however the trial ends."""
-    if log_dir is None:
-        yield None
-        return
-    header = _header(spec, scene, stack, plan, geo)
-    with TrialLogWriter(log_dir / f"{spec.trial_id}.jsonl", header, mcap=scene.mcap) as log:
-        if hook is not None:
-            hook.log_opened(log)
-        yield log
 
 
 def _header(

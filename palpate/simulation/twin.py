@@ -27,25 +27,25 @@ from typing import Any, Self
 
 import numpy as np
 
-from config.bench import LoadedBench
-from config.loader import ConfigError, InputError
-from config.sample import SampleConfig
-from config.scene import SceneConfig
-from config.schema import MM, StackConfig, TubeConfig
-from config.targets import load_targets
+from palpate.config.bench import LoadedBench
+from palpate.config.loader import ConfigError, InputError
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import MM, StackConfig, TubeConfig
+from palpate.config.targets import load_targets
+from palpate.robot import kinematics
+from palpate.robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
+from palpate.robot.dynamixel.units import rad_from_ticks
+from palpate.robot.trial.setup import sensor_section
+from palpate.sensor.parser import layout_from_config
+from palpate.sim.board import BoardEmulator, BoardSample
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.inprocess import InProcessPort, MemorySerial
+from palpate.sim.sample_law import relaxation
+from palpate.sim.world import Surface, World
 from palpate.simulation.world import tissue_model
-from robot import kinematics
-from robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
-from robot.dynamixel.units import rad_from_ticks
-from robot.trial.setup import sensor_section
-from sensor.parser import layout_from_config
-from sim.board import BoardEmulator, BoardSample
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.inprocess import InProcessPort, MemorySerial
-from sim.sample_law import relaxation
-from sim.world import Surface, World
-from wire.dynamixel import TICKS_PER_REV
+from palpate.wire.dynamixel import TICKS_PER_REV
 
 
 def surface_at(tube: TubeConfig, roll: float, translation: float, tip_radius: float) -> Surface:

@@ -17,22 +17,22 @@ from typing import Any, Literal
 
 import numpy as np
 
-from config.loader import InputError
-from config.sample import SampleConfig
-from config.scene import FidelityConfig, SceneConfig
-from config.schema import StackConfig, TubeConfig
+from palpate.config.loader import InputError
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import FidelityConfig, SceneConfig
+from palpate.config.schema import StackConfig, TubeConfig
+from palpate.robot import kinematics
+from palpate.robot.drive import TRANSLATION, RollerGearDrive
+from palpate.robot.dynamixel.units import rad_from_ticks
+from palpate.robot.trial.estimate import exposed_length_at
+from palpate.robot.trial.setup import sensor_section
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.equilibrium import TissueLaw
+from palpate.sim.gravity import BeamWeight
+from palpate.sim.sample_law import describe, relaxation, world_tissue
+from palpate.sim.world import Surface, World
 from palpate.simulation.placement import place_sample
-from robot import kinematics
-from robot.drive import TRANSLATION, RollerGearDrive
-from robot.dynamixel.units import rad_from_ticks
-from robot.trial.estimate import exposed_length_at
-from robot.trial.setup import sensor_section
-from sim.dynamixel.bus import EmulatedBus
-from sim.equilibrium import TissueLaw
-from sim.gravity import BeamWeight
-from sim.sample_law import describe, relaxation, world_tissue
-from sim.world import Surface, World
-from wire.dynamixel import TICKS_PER_REV
+from palpate.wire.dynamixel import TICKS_PER_REV
 
 BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
 VERTICAL = np.array([0.0, 0.0, -1.0])

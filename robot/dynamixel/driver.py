@@ -34,11 +34,11 @@ from typing import Any, Self, TypeVar
 
 import dynamixel_sdk as sdk
 
-from config.schema import ServoBusConfig
-from robot.dynamixel import units
-from robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
-from robot.dynamixel.port import PortRecovery, TimedPortHandler
-from robot.dynamixel.replies import (
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.dynamixel import units
+from palpate.robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
+from palpate.robot.dynamixel.port import PortRecovery, TimedPortHandler
+from palpate.robot.dynamixel.replies import (
     GOAL_ADDR,
     GOAL_LEN,
     STATE_LEN,
@@ -48,15 +48,15 @@ from robot.dynamixel.replies import (
     hardware_fault,
     status_fault,
 )
-from robot.dynamixel.stats import BusStats
-from robot.motors import (
+from palpate.robot.dynamixel.stats import BusStats
+from palpate.robot.motors import (
     MotorState,
     ServoFaultError,
     ServoIdentityError,
     ServoTransportError,
 )
-from sensor.ports import PORT_ERRORS, open_failure
-from wire import dynamixel as tables
+from palpate.sensor.ports import PORT_ERRORS, open_failure
+from palpate.wire import dynamixel as tables
 
 R = TypeVar("R")
 CONNECT_PATIENCE_S = 0.5

@@ -25,19 +25,19 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from config.schema import DriveConfig, TubeConfig
-from config.targets import TargetConfig
-from estimation.detect_buckling import BucklingDetector
-from robot import kinematics
-from robot.drive import JointState, RollerGearDrive
-from robot.indentation import (
+from palpate.config.schema import DriveConfig, TubeConfig
+from palpate.config.targets import TargetConfig
+from palpate.estimation.detect_buckling import BucklingDetector
+from palpate.robot import kinematics
+from palpate.robot.drive import JointState, RollerGearDrive
+from palpate.robot.indentation import (
     Command,
     Guards,
     Observation,
     State,
     limit_violation,
 )
-from robot.teleop.interface import (
+from palpate.robot.teleop.interface import (
     ESTOP_KEY,
     KEYMAP,
     MAX_NAME,

@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from robot.trial.log import read_log
-from robot.trial.recording import McapRecorder, axial_loads
+from palpate.robot.trial.log import read_log
+from palpate.robot.trial.recording import McapRecorder, axial_loads
 
 
 def export(log_path: str | Path, out: str | Path | None = None) -> Path:

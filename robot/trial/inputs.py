@@ -14,12 +14,12 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
-from config.loader import from_mapping
-from config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
-from config.schema import MM, SensorConfig
-from estimation.belief import Belief
-from estimation.corrections import ContactLaw
-from estimation.section import Section
+from palpate.config.loader import from_mapping
+from palpate.config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
+from palpate.config.schema import MM, SensorConfig
+from palpate.estimation.belief import Belief
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.section import Section
 
 VERSION = 2
 DEFAULT_POISSON = 0.45  # the nominal value of an unknown Poisson ratio (the paper's)

@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
-from config.loader import InputError
-from robot.trial.logschema import LogRecordError, check_record
-from robot.trial.recording import McapRecorder, axial_loads
+from palpate.config.loader import InputError
+from palpate.robot.trial.logschema import LogRecordError, check_record
+from palpate.robot.trial.recording import McapRecorder, axial_loads
 
 FORMAT = "palpate-trial-log"
 VERSION = 1

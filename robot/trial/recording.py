@@ -34,10 +34,10 @@ from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,u
 from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
 from mcap_ros2.decoder import DecoderFactory  # type: ignore[import-untyped,unused-ignore]
 
-from config.loader import from_mapping
-from config.schema import TubeConfig
-from robot.trial import cdr
-from robot.trial.ros2 import (
+from palpate.config.loader import from_mapping
+from palpate.config.schema import TubeConfig
+from palpate.robot.trial import cdr
+from palpate.robot.trial.ros2 import (
     SCHEMAS,
     TOPICS,
     messages,
@@ -241,8 +241,8 @@ def axial_loads(recorder: McapRecorder) -> list[float] | None:
     tips = [x.tip_force for x in recorder.samples]
     if any(math.isfinite(f) for f in tips):
         return tips
-    from robot.trial.inputs import header_sensor
-    from robot.trial.states import on_beam, record_lengths, states_at
+    from palpate.robot.trial.inputs import header_sensor
+    from palpate.robot.trial.states import on_beam, record_lengths, states_at
 
     try:
         sensor, section, inputs = header_sensor(recorder.header)

@@ -14,8 +14,8 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
-from estimation.detect_buckling import BucklingDetector
-from robot.indentation import (
+from palpate.estimation.detect_buckling import BucklingDetector
+from palpate.robot.indentation import (
     PLANNED_ENDS,
     Command,
     Guards,
@@ -27,9 +27,9 @@ from robot.indentation import (
     TrialMarks,
     TrialPlan,
 )
-from robot.probe_result import ProbeResult
-from robot.trial.log import TrialLogWriter
-from sensor.clock import Clock
+from palpate.robot.probe_result import ProbeResult
+from palpate.robot.trial.log import TrialLogWriter
+from palpate.sensor.clock import Clock
 
 
 class Rig(Protocol):

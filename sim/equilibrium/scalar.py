@@ -20,15 +20,15 @@ from collections.abc import Callable
 
 import numpy as np
 
-from estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
-from sim.equilibrium.law import (
+from palpate.estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
+from palpate.sim.equilibrium.law import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,
     ContactEffects,
     FloatArray,
     TissueLaw,
 )
-from sim.equilibrium.state import ContactState, status_message
+from palpate.sim.equilibrium.state import ContactState, status_message
 
 
 def _as_float(x: object) -> float:

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from config import ConfigError, StackConfig, from_mapping, load, load_stack
-from config.schema import SensorConfig
+from palpate.config import ConfigError, StackConfig, from_mapping, load, load_stack
+from palpate.config.schema import SensorConfig
 
 
 def write(tmp_path: Path, text: str) -> Path:

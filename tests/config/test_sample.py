@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from config.loader import ConfigError, from_mapping
-from config.sample import AssumedConfig, SampleConfig
-from config.scene import SceneConfig
+from palpate.config.loader import ConfigError, from_mapping
+from palpate.config.sample import AssumedConfig, SampleConfig
+from palpate.config.scene import SceneConfig
 
 
 def test_assumed_takes_a_value_a_range_or_unknown() -> None:

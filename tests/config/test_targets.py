@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from config import resolve
-from config.loader import ConfigError
-from config.targets import TargetConfig, load_targets, save_target
+from palpate.config import resolve
+from palpate.config.loader import ConfigError
+from palpate.config.targets import TargetConfig, load_targets, save_target
 
 
 def test_the_shipped_example_loads() -> None:

@@ -12,15 +12,15 @@ import dynamixel_sdk as sdk
 import pytest
 import serial
 
-from config import resolve
 from palpate.cli import main
-from robot.dynamixel.driver import DynamixelBus, Motor
-from robot.motors import ServoTransportError
-from sensor.ports import open_failure
-from sensor.reader import FrameReader, SensorPortError
-from sim.dynamixel.bus import EmulatedBus, Reply
-from sim.dynamixel.protocol import Packet
-from wire.frame import layout_of
+from palpate.config import resolve
+from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.motors import ServoTransportError
+from palpate.sensor.ports import open_failure
+from palpate.sensor.reader import FrameReader, SensorPortError
+from palpate.sim.dynamixel.bus import EmulatedBus, Reply
+from palpate.sim.dynamixel.protocol import Packet
+from palpate.wire.frame import layout_of
 
 ROBOT = resolve("robot.yaml").read_text(encoding="utf-8")
 SCENE = resolve("scenes/robot.yaml").read_text(encoding="utf-8")

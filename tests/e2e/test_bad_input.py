@@ -11,9 +11,9 @@ from typing import Any
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.simulation.trial import TrialSpec, run_sim_trial
 
 STACK = load_stack()
@@ -160,7 +160,7 @@ def test_bench_lengths_are_range_checked_naming_the_key(
 
 
 def test_yaml_exponent_without_a_dot_is_a_number(tmp_path: Path) -> None:
-    from config.scene import SceneConfig as Scene
+    from palpate.config.scene import SceneConfig as Scene
 
     scene = tmp_path / "s.yaml"
     scene.write_text("campaign: {outlier_above_kpa: 3e3}\n", encoding="utf-8")

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import statistics
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.campaigns.campaign import campaign_trials, run_campaign
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.papertables import comparison
 
 

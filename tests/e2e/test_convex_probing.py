@@ -9,12 +9,12 @@ import math
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.sample import UNKNOWN, AssumedConfig
-from config.scene import SceneConfig
+from palpate.config import load, load_stack, resolve
+from palpate.config.sample import UNKNOWN, AssumedConfig
+from palpate.config.scene import SceneConfig
+from palpate.robot.trial.inputs import belief_fields
 from palpate.simulation.result import estimator_inputs
 from palpate.simulation.trial import TrialSpec, run_sim_trial, trial_geometry, trial_sample
-from robot.trial.inputs import belief_fields
 
 STACK = load_stack()
 SCENE = load(SceneConfig, resolve("scenes/oblique/convex.yaml"))

@@ -77,7 +77,7 @@ def test_bad_arguments_exit_2(
 
 
 def test_design_writes_a_robot_file_the_stack_reads(tmp_path: Path) -> None:
-    from config import load_stack
+    from palpate.config import load_stack
 
     out = tmp_path / "lung.yaml"
     code = main(

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.methods import compare_methods
 from palpate.reports.replay import replay
+from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
-from robot.trial.setup import sensor_section
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.campaigns.campaign import campaign_trials, run_campaign
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
-from robot.trial.log import read_log
+from palpate.robot.trial.log import read_log
 
 MISMATCH = resolve("scenes/mismatch")
 

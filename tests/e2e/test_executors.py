@@ -10,8 +10,6 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.campaigns.campaign import campaign_trials, run_campaign, summarize_campaign
 from palpate.campaigns.executors import (
     EXECUTORS,
@@ -20,6 +18,8 @@ from palpate.campaigns.executors import (
     open_executor,
 )
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 STACK = load_stack()

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.faults import FaultCase
-from config.scene import SceneConfig
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.faults import FaultCase
+from palpate.config.scene import SceneConfig
 from palpate.faults import (
     FaultJob,
     GroundTruth,

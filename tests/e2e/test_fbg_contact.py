@@ -12,11 +12,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.robot.rig import RigSettings
+from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.trial import TrialSpec, run_sim_trial
-from robot.rig import RigSettings
-from robot.trial.setup import sensor_section
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

@@ -9,12 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.fitplot import estimates_with_intervals, record_fit
+from palpate.robot.trial.log import read_log
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
-from robot.trial.log import read_log
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))

@@ -16,10 +16,10 @@ import pytest
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from estimation.section import sensor_section
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.estimation.section import sensor_section
 from palpate.live import HOST, TOPICS, LiveView
 from palpate.simulation.trial import TrialSpec, run_sim_trial
 
@@ -127,7 +127,7 @@ def test_the_drawn_tube_ends_at_the_kinematics_tip(tube: str) -> None:
     import numpy as np
 
     from palpate.live import _beam_points, _tube
-    from robot.kinematics import forward
+    from palpate.robot.kinematics import forward
 
     config = STACK.tube(tube)
     points, tip, rotation = _tube(config, 0.7, 0.05)

@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.campaigns.campaign import campaign_trials
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
+from palpate.robot.trial.states import LOADING_STATES
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
-from robot.trial.states import LOADING_STATES
 
 LUNG = load(SceneConfig, resolve("scenes/lung/lung.yaml"))
 STACK = load_stack(LUNG.robot)
@@ -57,7 +57,7 @@ def test_the_log_carries_the_tip_load_and_replays_identically(fibrotic: TrialOut
 
 
 def test_the_recordings_wrench_is_the_tip_gratings_load(fibrotic: TrialOutcome) -> None:
-    from robot.trial.recording import read_recording
+    from palpate.robot.trial.recording import read_recording
 
     assert fibrotic.log_path is not None
     log = Path(fibrotic.log_path)
@@ -71,8 +71,8 @@ def test_the_recordings_wrench_is_the_tip_gratings_load(fibrotic: TrialOutcome) 
 def test_without_its_tip_grating_the_board_and_reader_disagree_cleanly() -> None:
     """A sensor file with a tip grating and a board whose frames lack it: the reader's layout
     has the tip bit, so the frames are rejected as bad headers, never misread."""
-    from sensor.parser import FrameParser, layout_from_config
-    from wire.frame import encode, frame_from_si
+    from palpate.sensor.parser import FrameParser, layout_from_config
+    from palpate.wire.frame import encode, frame_from_si
 
     layout = layout_from_config(STACK.sensor, STACK.board)
     assert layout.has_tip
@@ -89,12 +89,12 @@ def test_a_bench_rehearsal_on_the_twin_reads_the_tip_grating(tmp_path: Path) -> 
     the session on the ptys reads its load from the tip grating and estimates it."""
     import dataclasses
 
-    from config.bench import load_bench
-    from config.loader import write_yaml
     from palpate.commands.trial import run_session
+    from palpate.config.bench import load_bench
+    from palpate.config.loader import write_yaml
     from palpate.lab.trial import plan_bench_trials
+    from palpate.sim.clock import VirtualClock
     from palpate.simulation.twin import SimulatedBench, surface_at
-    from sim.clock import VirtualClock
 
     contact_mm = STACK.sensor.exposed_length_mm  # the tube flush at 0: the contact's translation
     quick = dataclasses.replace(
@@ -149,8 +149,8 @@ def test_palpate_emulate_streams_the_tip_grating_of_the_designed_sensor() -> Non
     import subprocess
     import sys
 
-    from sensor.parser import layout_from_config
-    from sensor.reader import FrameReader
+    from palpate.sensor.parser import layout_from_config
+    from palpate.sensor.reader import FrameReader
 
     proc = subprocess.Popen(
         [sys.executable, "-m", "palpate", "emulate", "--config", "robot-lung.yaml",
@@ -182,7 +182,7 @@ def test_a_sample_stiffer_than_the_designed_range_keeps_its_number_as_suspect(
     its number (the answer is "stiffer than 20 kPa")."""
     import dataclasses
 
-    from config.sample import SampleConfig
+    from palpate.config.sample import SampleConfig
 
     stiff = SampleConfig(
         name="S60", modulus_kpa=60.0, poisson=0.45, thickness_mm=20.0, material="neo-hookean",

@@ -8,8 +8,8 @@ import math
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.simulation.trial import TrialSpec, run_sim_trial
 
 STACK = load_stack()
@@ -85,8 +85,8 @@ def test_a_sample_that_is_not_there_ends_unreachable_with_torque_on() -> None:
 
 
 def test_probings_budget_comes_from_the_drive_and_stays_below_the_state_timeout() -> None:
-    from robot.indentation import STATE_TIMEOUT
-    from robot.probing import probe_budget
+    from palpate.robot.indentation import STATE_TIMEOUT
+    from palpate.robot.probing import probe_budget
 
     offsets = (0.125, 0.5, -0.5)
     slow = probe_budget(offsets, 3e-3, 2.5e-3, 5e-3, math.radians(90), 0.4)

@@ -9,15 +9,15 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from config.schema import ServoBusConfig
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.trial.log import read_log
+from palpate.sim.board import BoardEmulator, BoardFaults
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.world import World
 from palpate.simulation.trial import TrialSpec, run_sim_trial
-from robot.trial.log import read_log
-from sim.board import BoardEmulator, BoardFaults
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.world import World
 
 STACK = load_stack()
 TILTED = load(SceneConfig, resolve("scenes/tilted.yaml"))
@@ -126,8 +126,8 @@ def test_the_rolls_between_touches_never_load_the_beam(monkeypatch: pytest.Monke
     roll guarded only by that interlock does not stop in time on this drive (90 deg/s stops in
     11 deg of roll, about a millimetre into a 25 deg tilt; docs/orientation.md, Limits): tried
     on the tilted scene, it bowed the beam to 4100 ue and left 16 of 108 trials not done."""
-    from robot import probing
-    from robot.indentation import Observation
+    from palpate.robot import probing
+    from palpate.robot.indentation import Observation
 
     bows: list[float] = []
     step = probing.ProbeRoutine.step

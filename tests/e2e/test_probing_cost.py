@@ -11,16 +11,16 @@ import statistics
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from config.schema import ServoBusConfig
-from estimation.section import euler_load
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import ServoBusConfig
+from palpate.estimation.section import euler_load
+from palpate.robot.trial.setup import sensor_section
+from palpate.sim.board import BoardEmulator, BoardFaults
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.world import World, WorldState
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
-from robot.trial.setup import sensor_section
-from sim.board import BoardEmulator, BoardFaults
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.world import World, WorldState
 
 STACK = load_stack()
 TILTED = load(SceneConfig, resolve("scenes/tilted.yaml"))

@@ -29,12 +29,12 @@ from pathlib import Path
 import pytest
 import yaml
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from config.targets import load_targets
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.config.targets import load_targets
 from palpate.simulation.twin import SimulatedBench
-from wire.dynamixel import TICKS_PER_REV
+from palpate.wire.dynamixel import TICKS_PER_REV
 
 needs_tmux = pytest.mark.skipif(
     shutil.which("tmux") is None, reason="tmux is not installed: the terminal tests need it"

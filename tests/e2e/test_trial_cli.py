@@ -18,18 +18,18 @@ from pathlib import Path
 import pytest
 import serial
 
-from config import load, resolve
-from config.bench import LoadedBench, load_bench
-from config.scene import SceneConfig
 from palpate.cli import main
 from palpate.commands.trial import run_session
+from palpate.config import load, resolve
+from palpate.config.bench import LoadedBench, load_bench
+from palpate.config.scene import SceneConfig
 from palpate.lab.hardware import HardwareError, explain, open_hardware
 from palpate.lab.trial import SKIPPED, BenchOutcome, plan_bench_trials
 from palpate.reports.replay import replay
+from palpate.robot.motors import ServoTransportError
+from palpate.robot.trial.log import read_log
+from palpate.sim.clock import VirtualClock
 from palpate.simulation.twin import SimulatedBench, stations_for, surface_at
-from robot.motors import ServoTransportError
-from robot.trial.log import read_log
-from sim.clock import VirtualClock
 
 ROBOT_SCENE = load(SceneConfig, resolve("scenes/robot.yaml"))
 # A quick stage, powered up 2 mm behind the stand-off pose, so a trial takes ~3 s simulated; a

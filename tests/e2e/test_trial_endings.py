@@ -17,13 +17,13 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader  # type: ignore[import-untyped,unused-ignore]
 
-from config.bench import load_bench
 from palpate.cli import main
+from palpate.config.bench import load_bench
 from palpate.lab.hardware import Terminated
+from palpate.robot.trial.log import read_log
+from palpate.robot.trial.recording import read_recording
+from palpate.sim.clock import VirtualClock
 from palpate.simulation.twin import SimulatedBench, surface_at
-from robot.trial.log import read_log
-from robot.trial.recording import read_recording
-from sim.clock import VirtualClock
 from tests.e2e.test_trial_cli import ONE, ROBOT_SCENE, bench_file, run_on
 
 # the shipped home pose (0 mm, the tube's flush translation: no sensor out) and a quick stage

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.campaigns.resume import outcome_from_log
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 

@@ -6,11 +6,11 @@ import dataclasses
 
 import numpy as np
 
-from estimation.belief import Belief
-from estimation.corrections import ContactLaw
-from estimation.jointfit import joint_fit
-from estimation.jointfit.beliefcheck import CONTRADICTED, alternatives
-from estimation.verdict import TrialFacts, judge
+from palpate.estimation.belief import Belief
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.jointfit import joint_fit
+from palpate.estimation.jointfit.beliefcheck import CONTRADICTED, alternatives
+from palpate.estimation.verdict import TrialFacts, judge
 
 R = 3.5e-3
 SIGMA = 2e-3  # N, the FBG force channel's noise at 1 pm

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from estimation.elastica import P_CRIT
-from estimation.elastica.constants import X1
-from estimation.section import composite_section, euler_load
+from palpate.estimation.elastica import P_CRIT
+from palpate.estimation.elastica.constants import X1
+from palpate.estimation.section import composite_section, euler_load
 
 PAPER = {
     "fiber_radius": 0.115e-3,
@@ -30,7 +30,7 @@ def test_paper_four_wire_formulas() -> None:
     assert sec.I_fiber == pytest.approx(math.pi * r_f**2 * (r_f**2 / 4 + dy_f**2), rel=1e-14)
     assert sec.I_wires == pytest.approx(math.pi * r_w**2 * (r_w**2 + 4 * dy_w**2), rel=1e-14)
     assert pytest.approx(67e9 * sec.I_fiber + 55e9 * sec.I_wires, rel=1e-14) == sec.EI
-    # dy_fbg "about 0.15 mm" (DESIGN.md); fiber centre 0.215 mm above the row.
+    # dy_fbg "about 0.15 mm" (the paper's sensor); fiber centre 0.215 mm above the row.
     assert sec.fiber_offset == pytest.approx(0.15327e-3, rel=1e-4)
     assert sec.neutral_axis + sec.fiber_offset == pytest.approx(r_w + r_f, rel=1e-14)
 

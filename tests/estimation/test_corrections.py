@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from estimation.corrections import (
+from palpate.estimation.corrections import (
     ContactLaw,
     shape_values,
     validity_warnings,
 )
-from estimation.hertz import hertz_force
-from estimation.layer import (
+from palpate.estimation.hertz import hertz_force
+from palpate.estimation.layer import (
     BONDED_B0_PER_MOMENT,
     SLIDING_A0,
     SLIDING_B0,
@@ -23,8 +23,8 @@ from estimation.layer import (
     layer_coefficients,
     layer_kernel,
 )
-from estimation.sneddon import sneddon_y, sneddon_y_at
-from sim.tissue import TissueModel
+from palpate.estimation.sneddon import sneddon_y, sneddon_y_at
+from palpate.sim.tissue import TissueModel
 
 R = 3.5e-3
 DEPTHS = np.array([1e-6, 1e-5, 1e-4, 3e-4, 1e-3])

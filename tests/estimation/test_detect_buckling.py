@@ -5,16 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from config.schema import SensorConfig
-from estimation.detect_buckling import (
+from palpate.config.schema import SensorConfig
+from palpate.estimation.detect_buckling import (
     CusumDetector,
     NormThreshold,
     cusum,
     first_mode_pattern,
     first_mode_strains,
 )
-from estimation.elastica.constants import MODE_SLOPE_INTEGRAL, X1
-from sensor.strain import grating_intervals, strain_noise
+from palpate.estimation.elastica.constants import MODE_SLOPE_INTEGRAL, X1
+from palpate.sensor.strain import grating_intervals, strain_noise
 
 L = 0.042
 DY = 0.153e-3
@@ -135,8 +135,8 @@ def test_detector_errors() -> None:
 
 def test_first_mode_agrees_with_the_elastica_and_the_strain_fit_inverts_it() -> None:
     """Cross-check against ``estimation.beam`` (the full elastica) near onset."""
-    beam_mod = pytest.importorskip("estimation.beam")
-    from estimation.strain_fit import fit_strains
+    beam_mod = pytest.importorskip("palpate.estimation.beam")
+    from palpate.estimation.strain_fit import fit_strains
 
     EI, EA = 1.18e-4, 9696.0
     beam = beam_mod.Beam(EI, EA, DY, L)

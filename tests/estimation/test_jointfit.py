@@ -7,10 +7,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from estimation.corrections import ContactLaw
-from estimation.jointfit import JointFit, joint_fit
-from estimation.jointfit.grid import closed_form, grid_fits
-from estimation.jointfit.profile import profiles
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.jointfit import JointFit, joint_fit
+from palpate.estimation.jointfit.grid import closed_form, grid_fits
+from palpate.estimation.jointfit.profile import profiles
 
 LAW = ContactLaw(3.5e-3, 0.45, 10e-3, bonded=True, large_indentation=True)
 EA = 9.7e3

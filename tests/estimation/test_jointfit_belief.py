@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from estimation.belief import Belief
-from estimation.corrections import ContactLaw
-from estimation.jointfit import joint_fit
-from estimation.jointfit.envelope import BEFORE_WARNING
+from palpate.estimation.belief import Belief
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.jointfit import joint_fit
+from palpate.estimation.jointfit.envelope import BEFORE_WARNING
 
 R = 3.5e-3
 EA = 9.7e3
@@ -154,7 +154,7 @@ def test_every_value_the_belief_leaves_open_keeps_its_own_region() -> None:
     closed forms' own error can make the record prefer a wrong value (docs/lung.md)."""
     import numpy as np
 
-    from estimation.jointfit.profile import read_family
+    from palpate.estimation.jointfit.profile import read_family
 
     grid = np.linspace(0.0, 1e-3, 11)
     bowl = (grid - 5e-4) ** 2 * 1e8  # RSS rising away from the grid's middle

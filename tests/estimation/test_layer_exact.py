@@ -9,13 +9,18 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from estimation.corrections import ContactLaw
-from estimation.layer import SLIDING_A0, dimitriadis_bracket, dimitriadis_coefficients, layer_kernel
-from estimation.layer_exact import LayerSolveError, kernel_transform, solve_contact
-from estimation.layer_table import layer_factor, paraboloid_bracket
-from estimation.sneddon import sneddon_bracket, sneddon_y
-from sim.fem.generate import SHIPPED
-from sim.fem.table import SHIPPED_DIR, read_table
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.layer import (
+    SLIDING_A0,
+    dimitriadis_bracket,
+    dimitriadis_coefficients,
+    layer_kernel,
+)
+from palpate.estimation.layer_exact import LayerSolveError, kernel_transform, solve_contact
+from palpate.estimation.layer_table import layer_factor, paraboloid_bracket
+from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
+from palpate.sim.fem.generate import SHIPPED
+from palpate.sim.fem.table import SHIPPED_DIR, read_table
 
 R = 3.5e-3
 

@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from estimation.beamstate import onset_mode
-from estimation.jointfit import JointFit
-from estimation.misalignment import DETECT_CHI2, Lean, capacity, lateral_shape, measure_lean
-from estimation.section import euler_load
-from estimation.verdict import TrialFacts, judge
+from palpate.estimation.beamstate import onset_mode
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.misalignment import DETECT_CHI2, Lean, capacity, lateral_shape, measure_lean
+from palpate.estimation.section import euler_load
+from palpate.estimation.verdict import TrialFacts, judge
 
 EI, EA, DY = 1.18e-4, 9.7e3, 1.53e-4  # the shipped sensor's section (N m^2, N, m)
 L = 0.042

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from estimation.corrections import ContactLaw
-from estimation.relaxation import RelaxationRecord, fit_relaxation, memory_basis
-from sim.viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid, force_history
+from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.relaxation import RelaxationRecord, fit_relaxation, memory_basis
+from palpate.sim.viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid, force_history
 
 LAW = ContactLaw(2e-3, 0.45, 10e-3, True)
 E_INF = 400e3

@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from estimation.hertz import hertz_modulus
-from estimation.section import euler_load
-from estimation.stiffness import (
+from palpate.estimation.hertz import hertz_modulus
+from palpate.estimation.section import euler_load
+from palpate.estimation.stiffness import (
     EULER_FIXED_PINNED,
     PAPER_OUTLIER_ABOVE,
     StiffnessEstimate,

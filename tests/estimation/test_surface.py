@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from estimation.surface import (
+from palpate.estimation.surface import (
     SurfaceGeometry,
     fit_plane,
     fit_sphere,

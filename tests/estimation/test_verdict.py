@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from estimation.jointfit import JointFit
-from estimation.verdict import TrialFacts, Verdict, judge
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.verdict import TrialFacts, Verdict, judge
 
 R = 3.5e-3
 BEST = {"thickness": 0.01, "bonded": True, "poisson": 0.45, "compliance": 0.0}

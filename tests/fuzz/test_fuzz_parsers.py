@@ -16,11 +16,11 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from config.scene import SceneConfig
-from config.schema import StackConfig
 from palpate.benchmarks import fuzzconfig, fuzzfiles
 from palpate.benchmarks import fuzztargets as fuzz
-from sim.dynamixel import protocol
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.sim.dynamixel import protocol
 
 seeds = st.integers(0, 2**32 - 1)
 

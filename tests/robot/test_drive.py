@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from config.schema import DriveConfig, ServoBusConfig
-from robot.drive import (
+from palpate.config.schema import DriveConfig, ServoBusConfig
+from palpate.robot.drive import (
     INNER_ROLL,
     OUTER_ROLL,
     TRANSLATION,
@@ -19,10 +19,10 @@ from robot.drive import (
     JointState,
     RollerGearDrive,
 )
-from robot.dynamixel import units
-from robot.dynamixel.driver import DynamixelBus
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
+from palpate.robot.dynamixel import units
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
 
 CFG = DriveConfig(
     outer_roll_ratio=2.0, inner_roll_ratio=1.5, lead_mm_per_rev=8.0, coupling_mm_per_rad=0.7

@@ -15,16 +15,16 @@ from pathlib import Path
 import dynamixel_sdk as sdk
 import pytest
 
-from config.schema import ServoBusConfig, ServoConfig
-from robot.dynamixel.driver import DynamixelBus, Motor
-from robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
-from sensor.ports import Backoff
-from sim.clock import VirtualClock
-from sim.dynamixel import protocol
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.faults import FaultyBus
-from sim.inprocess import InProcessPort
-from wire import dynamixel as tables
+from palpate.config.schema import ServoBusConfig, ServoConfig
+from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
+from palpate.sensor.ports import Backoff
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel import protocol
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.faults import FaultyBus
+from palpate.sim.inprocess import InProcessPort
+from palpate.wire import dynamixel as tables
 
 CFG = ServoBusConfig(retries=2, timeout_ms=1000.0)
 NAMES = ("outer_roll", "inner_roll", "translation")

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from robot.indentation import (
+from palpate.robot.indentation import (
     Command,
     Guards,
     IndentationMachine,
@@ -24,9 +24,9 @@ from robot.indentation import (
     Transition,
     TrialPlan,
 )
-from robot.trial.log import TrialLogWriter, read_log
-from robot.trial.run import end_record, run_trial
-from sim.clock import VirtualClock
+from palpate.robot.trial.log import TrialLogWriter, read_log
+from palpate.robot.trial.run import end_record, run_trial
+from palpate.sim.clock import VirtualClock
 
 
 @dataclass

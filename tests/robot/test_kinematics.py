@@ -9,8 +9,8 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from config.schema import DEFAULT_TUBES, TubeConfig
-from robot.kinematics import best_roll, forward, inverse, solve_for_tube, tangent
+from palpate.config.schema import DEFAULT_TUBES, TubeConfig
+from palpate.robot.kinematics import best_roll, forward, inverse, solve_for_tube, tangent
 
 R_TIP = 3.5e-3
 LIMITS = (0.0, 0.08)

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from config.sample import SampleConfig
-from config.schema import StackConfig
+from palpate.config.sample import SampleConfig
+from palpate.config.schema import StackConfig
+from palpate.robot import kinematics
 from palpate.simulation.placement import place_sample
-from robot import kinematics
 
 STACK = StackConfig()
 R_TIP = 3.5e-3

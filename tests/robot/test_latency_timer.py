@@ -10,11 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from config.schema import ServoBusConfig
-from robot.dynamixel.driver import DynamixelBus, Motor
-from robot.dynamixel.latency import latency_timer_ms, latency_timer_path, latency_warning
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.dynamixel.latency import latency_timer_ms, latency_timer_path, latency_warning
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
 
 CFG = ServoBusConfig(retries=1, timeout_ms=200.0)
 NAMES = ("outer_roll", "inner_roll", "translation")

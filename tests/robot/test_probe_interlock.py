@@ -6,11 +6,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from robot.indentation import Command, Observation
-from robot.probing import TOUCH_BOW, ProbeRoutine
-from robot.trial.setup import prober_for, trial_plan
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.robot.indentation import Command, Observation
+from palpate.robot.probing import TOUCH_BOW, ProbeRoutine
+from palpate.robot.trial.setup import prober_for, trial_plan
 
 STACK = load_stack()
 TILTED = load(SceneConfig, resolve("scenes/tilted.yaml"))

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from robot.probe_plan import nearest_turn
-from robot.probing import Touch, _near_side_last
+from palpate.robot.probe_plan import nearest_turn
+from palpate.robot.probing import Touch, _near_side_last
 
 
 def touch(roll: float, advance: float) -> Touch:

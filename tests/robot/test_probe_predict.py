@@ -10,12 +10,12 @@ import math
 import numpy as np
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from estimation.surface import SurfaceGeometry
-from robot.probe_plan import _distance_to_line, _model
-from robot.probing import ProbeRoutine, Touch
-from robot.trial.setup import prober_for, trial_plan
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.estimation.surface import SurfaceGeometry
+from palpate.robot.probe_plan import _distance_to_line, _model
+from palpate.robot.probing import ProbeRoutine, Touch
+from palpate.robot.trial.setup import prober_for, trial_plan
 
 STACK = load_stack()
 TILTED = load(SceneConfig, resolve("scenes/tilted.yaml"))

@@ -8,9 +8,9 @@ import math
 
 import pytest
 
-from estimation.surface import SurfaceFit
-from robot.probe_fit import allowed_residual
-from robot.probe_fit import scaled_sigma as _scaled_sigma
+from palpate.estimation.surface import SurfaceFit
+from palpate.robot.probe_fit import allowed_residual
+from palpate.robot.probe_fit import scaled_sigma as _scaled_sigma
 
 SIGMA = 10e-6  # m, the touches' assumed uncertainty
 

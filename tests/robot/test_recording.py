@@ -10,15 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
 from palpate.cli import main
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.robot.trial.export import export
+from palpate.robot.trial.inputs import header_sensor
+from palpate.robot.trial.log import TrialLog, read_log
+from palpate.robot.trial.recording import Recording, read_recording
+from palpate.robot.trial.states import record_states
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
-from robot.trial.export import export
-from robot.trial.inputs import header_sensor
-from robot.trial.log import TrialLog, read_log
-from robot.trial.recording import Recording, read_recording
-from robot.trial.states import record_states
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -125,8 +125,8 @@ def test_the_fast_encoders_are_byte_for_byte_the_definitions() -> None:
     """robot.trial.cdr's packed messages equal mcap-ros2-support's definition-driven encoding."""
     from mcap_ros2._dynamic import serialize_dynamic
 
-    from robot.trial import cdr
-    from robot.trial.ros2 import SCHEMAS
+    from palpate.robot.trial import cdr
+    from palpate.robot.trial.ros2 import SCHEMAS
 
     def encode(name: str, message: dict[str, object]) -> bytes:
         return bytes(serialize_dynamic(name, SCHEMAS[name])[name](message))
@@ -155,8 +155,8 @@ def test_the_fast_encoders_are_byte_for_byte_the_definitions() -> None:
 def test_a_robot_trial_records_the_tip_pose_as_the_forward_kinematics(tmp_path: Path) -> None:
     from transforms3d.quaternions import quat2mat
 
-    from config.scene import SceneConfig as Scene
-    from robot.kinematics import forward
+    from palpate.config.scene import SceneConfig as Scene
+    from palpate.robot.kinematics import forward
 
     robot = load(Scene, resolve("scenes/robot.yaml"))
     spec = TrialSpec(
@@ -184,8 +184,8 @@ def test_a_robot_trial_records_the_tip_pose_as_the_forward_kinematics(tmp_path: 
 def test_the_transform_encoder_is_byte_for_byte_the_definition() -> None:
     from mcap_ros2._dynamic import serialize_dynamic
 
-    from robot.trial import cdr
-    from robot.trial.ros2 import SCHEMAS
+    from palpate.robot.trial import cdr
+    from palpate.robot.trial.ros2 import SCHEMAS
 
     name = "tf2_msgs/msg/TFMessage"
     encode = serialize_dynamic(name, SCHEMAS[name])[name]

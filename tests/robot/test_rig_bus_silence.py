@@ -7,17 +7,17 @@ from __future__ import annotations
 
 import math
 
-from config.schema import FbgConfig
-from robot.drive import JointState
-from robot.indentation import Command
-from robot.motors import ServoTransportError
-from robot.rig import RigSettings, ServoFbgRig
-from sensor.reader import FrameReader
-from sensor.strain import StrainChain
-from sim.board import BoardEmulator, constant_source
-from sim.clock import VirtualClock
-from sim.inprocess import MemorySerial
-from wire.frame import FrameLayout
+from palpate.config.schema import FbgConfig
+from palpate.robot.drive import JointState
+from palpate.robot.indentation import Command
+from palpate.robot.motors import ServoTransportError
+from palpate.robot.rig import RigSettings, ServoFbgRig
+from palpate.sensor.reader import FrameReader
+from palpate.sensor.strain import StrainChain
+from palpate.sim.board import BoardEmulator, constant_source
+from palpate.sim.clock import VirtualClock
+from palpate.sim.inprocess import MemorySerial
+from palpate.wire.frame import FrameLayout
 
 LAYOUT = FrameLayout(3)
 TICK = 0.004

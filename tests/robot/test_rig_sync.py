@@ -9,15 +9,15 @@ from collections.abc import Iterator
 
 import pytest
 
-from config.schema import FbgConfig
-from robot.drive import JointState
-from robot.rig import RigSettings, ServoFbgRig
-from sensor.reader import FrameReader
-from sensor.strain import StrainChain
-from sim.board import BoardEmulator, constant_source
-from sim.clock import VirtualClock
-from sim.inprocess import MemorySerial
-from wire.frame import Frame, FrameLayout
+from palpate.config.schema import FbgConfig
+from palpate.robot.drive import JointState
+from palpate.robot.rig import RigSettings, ServoFbgRig
+from palpate.sensor.reader import FrameReader
+from palpate.sensor.strain import StrainChain
+from palpate.sim.board import BoardEmulator, constant_source
+from palpate.sim.clock import VirtualClock
+from palpate.sim.inprocess import MemorySerial
+from palpate.wire.frame import Frame, FrameLayout
 
 LAYOUT = FrameLayout(3)
 WAVELENGTHS = (1530e-9, 1535e-9, 1540e-9)

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from config.schema import DEFAULT_TUBES, DriveConfig
-from config.targets import load_targets, save_target
-from estimation.detect_buckling import NormThreshold
 from palpate.commands.teleop_screen import render
-from robot.indentation import (
+from palpate.config.schema import DEFAULT_TUBES, DriveConfig
+from palpate.config.targets import load_targets, save_target
+from palpate.estimation.detect_buckling import NormThreshold
+from palpate.robot.indentation import (
     Guards,
     IndentationMachine,
     Observation,
@@ -20,7 +20,7 @@ from robot.indentation import (
     TrialPlan,
     limit_violation,
 )
-from robot.teleop import Effect, JogSettings, Teleop
+from palpate.robot.teleop import Effect, JogSettings, Teleop
 
 DRIVE = DriveConfig()  # translation 0..80 mm, roll -200..200 deg, home 0
 GUARDS = Guards(max_travel_past_contact=2.5e-3, strain_limit=5e-3, stream_timeout=0.1)

@@ -6,10 +6,10 @@ import math
 
 import pytest
 
-from config.loader import ConfigError, from_mapping
-from config.sample import AssumedConfig
-from config.schema import StackConfig
-from robot.trial.inputs import EstimatorInputs, belief_fields
+from palpate.config.loader import ConfigError, from_mapping
+from palpate.config.sample import AssumedConfig
+from palpate.config.schema import StackConfig
+from palpate.robot.trial.inputs import EstimatorInputs, belief_fields
 
 TRUTH = {"thickness": 6e-3, "bonded": False, "poisson": 0.45}
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from palpate.commands import calibrate
-from sensor.calibration import fit_strain_coefficient, load_pairs_csv
+from palpate.sensor.calibration import fit_strain_coefficient, load_pairs_csv
 
 K = 0.424e-12 / 1e-6
 

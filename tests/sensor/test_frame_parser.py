@@ -6,8 +6,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sensor.parser import FrameParser
-from wire.frame import MARKER, Frame, FrameLayout, encode
+from palpate.sensor.parser import FrameParser
+from palpate.wire.frame import MARKER, Frame, FrameLayout, encode
 
 LAYOUT = FrameLayout(3)
 SIZE = LAYOUT.size

@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 import serial
 
-from config.schema import BoardConfig, SensorConfig
-from sensor.parser import layout_from_config
-from sensor.reader import REOPEN_BACKOFF_S, FrameReader, SensorPortError
-from sim.clock import VirtualClock
-from wire.frame import Frame, FrameLayout, encode
+from palpate.config.schema import BoardConfig, SensorConfig
+from palpate.sensor.parser import layout_from_config
+from palpate.sensor.reader import REOPEN_BACKOFF_S, FrameReader, SensorPortError
+from palpate.sim.clock import VirtualClock
+from palpate.wire.frame import Frame, FrameLayout, encode
 
 LAYOUT = FrameLayout(3)
 

@@ -7,13 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from config.schema import MM, StackConfig
-from estimation.beam import Beam
-from estimation.section import sensor_section
-from sensor.framecal import calibrate_frames, read_frames
-from sensor.strain import grating_intervals
-from wire.dynamixel import TICKS_PER_REV
-from wire.frameblock import FrameBlock, encode_block
+from palpate.config.schema import MM, StackConfig
+from palpate.estimation.beam import Beam
+from palpate.estimation.section import sensor_section
+from palpate.sensor.framecal import calibrate_frames, read_frames
+from palpate.sensor.strain import grating_intervals
+from palpate.wire.dynamixel import TICKS_PER_REV
+from palpate.wire.frameblock import FrameBlock, encode_block
 
 STACK = StackConfig()
 L = 44e-3

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from config.schema import FbgConfig, SensorConfig
-from sensor.strain import (
+from palpate.config.schema import FbgConfig, SensorConfig
+from palpate.sensor.strain import (
     StrainChain,
     capture_baseline,
     grating_intervals,

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from config import load_stack, resolve
 from palpate.cli import main
-from sensor.tipcal import fit_tip_csv, fit_tip_frames
-from wire.frame import Status
-from wire.frameblock import FrameBlock, encode_block
+from palpate.config import load_stack, resolve
+from palpate.sensor.tipcal import fit_tip_csv, fit_tip_frames
+from palpate.wire.frame import Status
+from palpate.wire.frameblock import FrameBlock, encode_block
 
 STACK = load_stack(resolve("robot-lung.yaml"))
 TRUE = 7.3  # pm/mN

@@ -7,16 +7,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from config.loader import ConfigError, from_mapping
-from config.scene import FidelityConfig
-from config.schema import FbgConfig, StackConfig, TipGratingConfig
-from sensor.reader import FrameReader
-from sensor.tipforce import TipForceChain, force_sigma
-from sim.board import BoardEmulator, BoardSample
-from sim.clock import VirtualClock
-from sim.readout import TipReadout
-from wire.frame import OPTION_TIP, decode, encode, frame_from_si, layout_of, parse_header
-from wire.frameblock import decode_block
+from palpate.config.loader import ConfigError, from_mapping
+from palpate.config.scene import FidelityConfig
+from palpate.config.schema import FbgConfig, StackConfig, TipGratingConfig
+from palpate.sensor.reader import FrameReader
+from palpate.sensor.tipforce import TipForceChain, force_sigma
+from palpate.sim.board import BoardEmulator, BoardSample
+from palpate.sim.clock import VirtualClock
+from palpate.sim.readout import TipReadout
+from palpate.wire.frame import OPTION_TIP, decode, encode, frame_from_si, layout_of, parse_header
+from palpate.wire.frameblock import decode_block
 
 PEAKS = [1.530e-6, 1.535e-6, 1.540e-6]
 

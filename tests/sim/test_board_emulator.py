@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sensor.reader import FrameReader
-from sim.board import BoardEmulator, BoardFaults, BoardSample, constant_source
-from sim.clock import VirtualClock
-from sim.inprocess import FramePipe, MemorySerial
-from wire.frame import FrameLayout, Status
+from palpate.sensor.reader import FrameReader
+from palpate.sim.board import BoardEmulator, BoardFaults, BoardSample, constant_source
+from palpate.sim.clock import VirtualClock
+from palpate.sim.inprocess import FramePipe, MemorySerial
+from palpate.wire.frame import FrameLayout, Status
 
 LAYOUT = FrameLayout(3)
 WAVELENGTHS = (1530e-9, 1535e-9, 1540e-9)

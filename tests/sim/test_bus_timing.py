@@ -9,17 +9,17 @@ from typing import Any
 
 import pytest
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from config.schema import ServoBusConfig
 from palpate.benchmarks.busrate import measured_rate, model_rate
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.direct import direct_transport
+from palpate.sim.dynamixel.timing import BusTiming
+from palpate.sim.inprocess import InProcessPort
 from palpate.simulation.trial import TrialSpec, bus_timing, run_sim_trial
-from robot.dynamixel.driver import DynamixelBus
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.direct import direct_transport
-from sim.dynamixel.timing import BusTiming
-from sim.inprocess import InProcessPort
 
 CFG = ServoBusConfig(max_goal_step_deg=360.0, timeout_ms=500.0)
 

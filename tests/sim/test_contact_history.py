@@ -7,16 +7,16 @@ import itertools
 import numpy as np
 import pytest
 
-from config import load_stack
-from config.sample import SampleConfig
-from config.scene import FidelityConfig
-from estimation.section import sensor_section
-from sim.contact_history import ViscoelasticContact, step_law
-from sim.contact_table import GridPhysics, equilibrium_on_grid
-from sim.equilibrium import ContactEffects, TissueLaw
-from sim.sample_law import world_tissue
-from sim.viscoelastic import StandardLinearSolid, ViscoelasticState, force_history
-from sim.world import Surface, World
+from palpate.config import load_stack
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import FidelityConfig
+from palpate.estimation.section import sensor_section
+from palpate.sim.contact_history import ViscoelasticContact, step_law
+from palpate.sim.contact_table import GridPhysics, equilibrium_on_grid
+from palpate.sim.equilibrium import ContactEffects, TissueLaw
+from palpate.sim.sample_law import world_tissue
+from palpate.sim.viscoelastic import StandardLinearSolid, ViscoelasticState, force_history
+from palpate.sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor

@@ -10,11 +10,11 @@ from collections.abc import Iterator
 import dynamixel_sdk as sdk
 import pytest
 
-from sim.clock import VirtualClock
-from sim.dynamixel import protocol as p
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.servo import EmulatedServo
-from wire import dynamixel as tables
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel import protocol as p
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.servo import EmulatedServo
+from palpate.wire import dynamixel as tables
 
 PH = sdk.PacketHandler(2.0)
 

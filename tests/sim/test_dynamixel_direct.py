@@ -11,13 +11,13 @@ from typing import Any
 
 import pytest
 
-from config.schema import ServoBusConfig
-from robot.dynamixel.driver import DynamixelBus
-from sim.clock import VirtualClock
-from sim.dynamixel.bus import EmulatedBus
-from sim.dynamixel.direct import DirectPacketHandler, DirectPort, direct_transport
-from sim.inprocess import InProcessPort
-from wire import dynamixel as tables
+from palpate.config.schema import ServoBusConfig
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.sim.clock import VirtualClock
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.dynamixel.direct import DirectPacketHandler, DirectPort, direct_transport
+from palpate.sim.inprocess import InProcessPort
+from palpate.wire import dynamixel as tables
 
 CFG = ServoBusConfig(retries=2, timeout_ms=50.0)
 

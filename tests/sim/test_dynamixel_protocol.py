@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sim.dynamixel import protocol as p
+from palpate.sim.dynamixel import protocol as p
 
 # bytes biased toward the header and stuffing bytes
 wire_bytes = st.lists(st.sampled_from([0xFF, 0xFD, 0x00, 0x55, 0x12]) | st.integers(0, 255)).map(

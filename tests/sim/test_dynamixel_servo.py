@@ -7,9 +7,9 @@ import math
 
 import pytest
 
-from sim.dynamixel.motion import profile_motion
-from sim.dynamixel.servo import EmulatedServo
-from wire import dynamixel as tables
+from palpate.sim.dynamixel.motion import profile_motion
+from palpate.sim.dynamixel.servo import EmulatedServo
+from palpate.wire import dynamixel as tables
 
 GOAL = tables.X_SERIES_CONTROL_TABLE["Goal_Position"][0]
 TICKS_PER_S_PER_UNIT = 0.229 * 4096 / 60

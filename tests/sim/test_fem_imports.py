@@ -1,4 +1,4 @@
-"""The world's tissue physics never calls the estimator's contact laws (DESIGN.md)."""
+"""The world's tissue physics never calls the estimator's contact laws (docs/world.md)."""
 
 from __future__ import annotations
 
@@ -30,14 +30,20 @@ LAWS = (
 )
 
 
+def ours(name: str) -> str:
+    """An import's name within the stack: ``palpate.estimation.hertz`` -> ``estimation.hertz``
+    (the layers are installed under ``palpate``)."""
+    return name.removeprefix("palpate.")
+
+
 def imported_modules(path: Path) -> set[str]:
     names: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
         if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
+            names.update(ours(alias.name) for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module:
-            names.add(node.module)
-            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+            names.add(ours(node.module))
+            names.update(ours(f"{node.module}.{alias.name}") for alias in node.names)
     return names
 
 
@@ -57,8 +63,8 @@ def test_the_worlds_fe_path_imports_no_contact_law_at_module_level(path: Path) -
     the rest of the path never names the laws at all."""
     tree = ast.parse(path.read_text(), filename=str(path))
     top = [n for n in tree.body if isinstance(n, ast.Import | ast.ImportFrom)]
-    names = {a.name for n in top if isinstance(n, ast.Import) for a in n.names}
-    names |= {n.module for n in top if isinstance(n, ast.ImportFrom) and n.module}
+    names = {ours(a.name) for n in top if isinstance(n, ast.Import) for a in n.names}
+    names |= {ours(n.module) for n in top if isinstance(n, ast.ImportFrom) and n.module}
     assert not {n for n in names if n.startswith(LAWS)}, f"{path.name}: {sorted(names)}"
 
 
@@ -70,14 +76,14 @@ def test_the_scan_sees_the_package() -> None:
 WORLD_PATH = """
 import sys
 import numpy as np
-from config.sample import SampleConfig
-from config.scene import FidelityConfig
-from config import load_stack
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import FidelityConfig
+from palpate.config import load_stack
 from robot_free_section import section
-from sim.contact_history import ViscoelasticContact
-from sim.contact_table import GridPhysics, equilibrium_on_grid
-from sim.equilibrium import ContactEffects
-from sim.sample_law import relaxation, world_tissue
+from palpate.sim.contact_history import ViscoelasticContact
+from palpate.sim.contact_table import GridPhysics, equilibrium_on_grid
+from palpate.sim.equilibrium import ContactEffects
+from palpate.sim.sample_law import relaxation, world_tissue
 stack = load_stack()
 sample = SampleConfig(name="S", modulus_kpa=500.0, material="neo-hookean",
                       relaxation_time_s=1.0, relaxed_ratio=0.8)
@@ -91,11 +97,12 @@ equilibrium_on_grid(physics, tuple(np.linspace(0, 1.5e-3, 31).tolist()), 42e-3)
 history = ViscoelasticContact(physics, relaxation(sample, fidelity))
 for k in range(1, 20):
     history.at(0.01 * k, 5e-5 * k, 42e-3)
-print(" ".join(sorted(m for m in sys.modules if m.startswith("estimation"))))
+print(" ".join(sorted(m.removeprefix("palpate.") for m in sys.modules
+                     if m.startswith("palpate.estimation"))))
 """
 
 SECTION = """
-from estimation.section import composite_section
+from palpate.estimation.section import composite_section
 def section(sensor):
     return composite_section(sensor.fiber_radius, sensor.fiber_modulus, sensor.wire_radius,
                              sensor.wire_modulus, sensor.wire_count)

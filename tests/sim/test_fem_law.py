@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
 
-from estimation.hertz import hertz_force
-from sim.fem.generate import SHIPPED
-from sim.fem.law import FeTissueLaw, pchip_slopes
-from sim.fem.table import load_table
+from palpate.estimation.hertz import hertz_force
+from palpate.sim.fem.generate import SHIPPED
+from palpate.sim.fem.law import FeTissueLaw, pchip_slopes
+from palpate.sim.fem.table import load_table
 
 R_TIP = 3.5e-3
 E = 5e5

@@ -12,11 +12,11 @@ import math
 import numpy as np
 import pytest
 
-from estimation.hertz import hertz_force
-from estimation.layer import dimitriadis_coefficients
-from estimation.sneddon import sneddon_bracket, sneddon_y
-from sim.fem.problem import LayerProblem
-from sim.fem.solver import SolverOptions, solve_indentation
+from palpate.estimation.hertz import hertz_force
+from palpate.estimation.layer import dimitriadis_coefficients
+from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
+from palpate.sim.fem.problem import LayerProblem
+from palpate.sim.fem.solver import SolverOptions, solve_indentation
 
 THICK = {"thickness_ratio": 200.0, "radius_ratio": 200.0}
 
@@ -67,7 +67,7 @@ def test_thin_bonded_layer_first_order_term(poisson: float) -> None:
 
 
 def test_thin_sliding_layer_first_order_term_does_not_depend_on_poisson() -> None:
-    """On a frictionless base the exact law does not depend on nu (DESIGN.md); Dimitriadis'
+    """On a frictionless base the exact law does not depend on nu (docs/tissue-fe.md); Dimitriadis'
     non-bonded coefficient does (0.66 at nu = 0, 0.88 at nu = 0.5): the FE lies in between
     and is the same at both ends."""
     slopes = [first_order_slope(thin_layer(nu, "sliding")) for nu in (0.0, 0.5)]

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.fem import table as table_mod
-from sim.fem.problem import LayerProblem
-from sim.fem.table import ForceTable, load_table, read_table, save_table, table_key
+from palpate.sim.fem import table as table_mod
+from palpate.sim.fem.problem import LayerProblem
+from palpate.sim.fem.table import ForceTable, load_table, read_table, save_table, table_key
 
 TINY = LayerProblem(thickness_ratio=1.0, radius_ratio=4.0, n_depths=3, depth_max=0.09, resolution=2)
 
@@ -102,7 +102,7 @@ def test_lookup_order_shipped_then_cache_then_solve(
 
 def test_shipped_tables_are_current() -> None:
     """Every shipped problem has its table in the package, complete, under the current key."""
-    from sim.fem.generate import SHIPPED
+    from palpate.sim.fem.generate import SHIPPED
 
     for name, problem in SHIPPED.items():
         table = read_table(problem, table_mod.SHIPPED_DIR)

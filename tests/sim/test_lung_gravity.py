@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from config import load, load_stack, resolve
-from config.scene import SceneConfig
-from estimation.elastica.constants import P_CRIT
 from palpate.campaigns.campaign import campaign_trials
-from robot import kinematics
-from robot.trial.setup import sensor_section
-from sim.gravity import BeamWeight, sensing_axis
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.estimation.elastica.constants import P_CRIT
+from palpate.robot import kinematics
+from palpate.robot.trial.setup import sensor_section
+from palpate.sim.gravity import BeamWeight, sensing_axis
 
 LUNG = load(SceneConfig, resolve("scenes/lung/lung.yaml"))
 STACK = load_stack(LUNG.robot)

@@ -8,15 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from config import load_stack
-from config.scene import FidelityConfig
-from estimation.section import sensor_section
-from sim.contact_table import GridPhysics, equilibrium_on_grid
-from sim.equilibrium import ContactEffects
-from sim.gravity import BeamWeight, offset_to_mode, sensing_axis
-from sim.oblique import ObliqueContact, tangential_ratio
-from sim.tissue import TissueModel
-from sim.world import Surface, World
+from palpate.config import load_stack
+from palpate.config.scene import FidelityConfig
+from palpate.estimation.section import sensor_section
+from palpate.sim.contact_table import GridPhysics, equilibrium_on_grid
+from palpate.sim.equilibrium import ContactEffects
+from palpate.sim.gravity import BeamWeight, offset_to_mode, sensing_axis
+from palpate.sim.oblique import ObliqueContact, tangential_ratio
+from palpate.sim.tissue import TissueModel
+from palpate.sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor

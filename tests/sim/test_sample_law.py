@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from config import load, load_stack, resolve
-from config.sample import SampleConfig
-from config.scene import FidelityConfig, SceneConfig
-from sim.fem import FeTissueLaw, table_key
-from sim.fem.generate import SHIPPED
-from sim.fem.table import SHIPPED_DIR, read_table
-from sim.sample_law import (
+from palpate.config import load, load_stack, resolve
+from palpate.config.sample import SampleConfig
+from palpate.config.scene import FidelityConfig, SceneConfig
+from palpate.sim.fem import FeTissueLaw, table_key
+from palpate.sim.fem.generate import SHIPPED
+from palpate.sim.fem.table import SHIPPED_DIR, read_table
+from palpate.sim.sample_law import (
     HALF_SPACE_RATIO,
     RigidBlock,
     contact_condition,
@@ -23,7 +23,7 @@ from sim.sample_law import (
     relaxation,
     world_tissue,
 )
-from sim.tissue import TissueModel
+from palpate.sim.tissue import TissueModel
 
 R = 3.5e-3
 SAMPLE = SampleConfig(name="S", modulus_kpa=500.0)
@@ -170,7 +170,7 @@ def test_the_paper_scenes_use_the_independent_world() -> None:
 
 
 def test_a_power_law_sample_gets_the_power_law_relaxation() -> None:
-    from sim.viscoelastic import PowerLawSolid
+    from palpate.sim.viscoelastic import PowerLawSolid
 
     on = FidelityConfig(viscoelastic=True)
     sample = SampleConfig(

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sim.tissue import CHI_MAX, TissueModel
+from palpate.sim.tissue import CHI_MAX, TissueModel
 
 R_TIP = 3.5e-3
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.special import dawsn
 
-from sim.viscoelastic import (
+from palpate.sim.viscoelastic import (
     PowerLawSolid,
     StandardLinearSolid,
     ViscoelasticState,

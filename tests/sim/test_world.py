@@ -7,14 +7,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from config import load_stack
-from config.scene import FidelityConfig
-from estimation.beam import Beam
-from estimation.section import sensor_section
-from sim.contact_table import ContactTable, equilibrium_on_grid
-from sim.equilibrium import solve_contact
-from sim.tissue import TissueModel
-from sim.world import Surface, World
+from palpate.config import load_stack
+from palpate.config.scene import FidelityConfig
+from palpate.estimation.beam import Beam
+from palpate.estimation.section import sensor_section
+from palpate.sim.contact_table import ContactTable, equilibrium_on_grid
+from palpate.sim.equilibrium import solve_contact
+from palpate.sim.tissue import TissueModel
+from palpate.sim.world import Surface, World
 
 STACK = load_stack()
 SENSOR = STACK.sensor

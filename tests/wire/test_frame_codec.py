@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from wire.frame import (
+from palpate.wire.frame import (
     MARKER,
     Frame,
     FrameError,
@@ -20,7 +20,7 @@ from wire.frame import (
     frame_from_si,
     parse_header,
 )
-from wire.frameblock import FrameBlock, crc32_rows, decode_block, encode_block
+from palpate.wire.frameblock import FrameBlock, crc32_rows, decode_block, encode_block
 
 # A frame written out by hand from the table in docs/frame-protocol.md.
 GOLDEN = Frame(seq=1, timestamp_us=2, encoder=-3, flags=4, peak_fm=(1_530_000_000, 2, 3))

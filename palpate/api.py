@@ -1,0 +1,191 @@
+"""The stack from Python: what the commands do, as functions returning typed results.
+
+    import palpate
+
+    scene = palpate.load_scene("scenes/bench.yaml")          # a file, or a shipped scene
+    report = palpate.simulate(scene, limit=4)                # a simulated campaign
+    for trial in report.trials:                              # typed outcomes
+        print(trial.spec.trial_id, trial.modulus("joint"), trial.verdict)
+    report.as_dict()["samples"]                              # what ``palpate sim --json`` prints
+
+Every result has the fields of the matching command's ``--json`` (``as_dict()``); moduli are in
+Pa on the objects and in kPa in the dictionaries (``joint_kpa``: the joint fit, ``paper_kpa``:
+the paper's single-point estimate). Bad input raises :class:`palpate.config.InputError` (a
+``ValueError``) naming the file (or ``<python>``) and the key. docs/python-api.md shows each
+call; examples/ holds whole scripts.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # the heavy modules load when a function needs them: `import palpate` is cheap
+    from palpate.commands.design import DesignOutcome
+    from palpate.config.scene import SceneConfig
+    from palpate.config.schema import StackConfig
+    from palpate.reports.payload import CampaignReport
+    from palpate.robot.trial.log import TrialLog
+    from palpate.robot.trial.recording import Recording
+    from palpate.simulation.trial import TrialOutcome, TrialSpec
+
+PYTHON = "<python>"  # the source named in errors about a scene built in code
+
+
+def load_scene(path: str | Path) -> SceneConfig:
+    """A scene file (the format of config/scenes/*.yaml), checked; a name that is not a file
+    is looked up among the shipped ones (``"scenes/bench.yaml"``)."""
+    from palpate.config import load, resolve
+    from palpate.config.scene import SceneConfig
+
+    return load(SceneConfig, resolve(path))
+
+
+def scene_from_dict(data: Mapping[str, Any]) -> SceneConfig:
+    """A scene built in code: the mapping a scene file holds (``name``, ``samples``,
+    ``campaign``, ...), checked like a file (errors name ``<python>`` and the key)."""
+    from palpate.config import from_mapping
+    from palpate.config.scene import SceneConfig
+
+    return from_mapping(SceneConfig, dict(data), PYTHON)
+
+
+def load_robot(path: str | Path = "robot.yaml") -> StackConfig:
+    """A robot configuration (robot, sensor, drive, tubes, board); the shipped one by default."""
+    from palpate.config import load_stack
+
+    return load_stack(path)
+
+
+def trials(
+    scene: SceneConfig, *, seed: int = 0, robot: StackConfig | None = None
+) -> list[TrialSpec]:
+    """The campaign's trials in order (each seeded from ``seed``), checked to be reachable."""
+    from palpate.campaigns.campaign import campaign_trials
+    from palpate.simulation.preflight import check_campaign, check_reachable
+
+    stack = robot if robot is not None else load_robot(scene.robot)
+    check_campaign(scene, stack, PYTHON, scene.robot)
+    specs = campaign_trials(scene, stack, seed)
+    check_reachable(specs, stack, PYTHON, scene.robot)
+    return specs
+
+
+def simulate(
+    scene: SceneConfig,
+    *,
+    limit: int | None = None,
+    seed: int = 0,
+    workers: int = 1,
+    out: str | Path | None = None,
+    robot: StackConfig | None = None,
+) -> CampaignReport:
+    """Run the scene's campaign in simulation (its first ``limit`` trials); ``out``: a folder
+    for the trials' logs (``out/logs``) and the results files (``results.json``,
+    ``trials.csv``, ``samples.csv``), None for none. The report's ``as_dict()`` is what
+    ``palpate sim --json`` prints."""
+    from palpate.campaigns.campaign import run_campaign
+    from palpate.reports.payload import campaign_report, run_folder_files
+
+    stack = robot if robot is not None else load_robot(scene.robot)
+    specs = trials(scene, seed=seed, robot=stack)[:limit]
+    folder = None if out is None else Path(out)
+    log_dir = None if folder is None else folder / "logs"
+    if log_dir is not None:
+        log_dir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    outcomes = run_campaign(specs, scene, stack, log_dir=log_dir, workers=workers)
+    run = {
+        "run_dir": None if folder is None else str(folder),
+        "log_dir": None if log_dir is None else str(log_dir),
+        "transport": scene.transport,
+        "seed": seed,
+    }
+    report = campaign_report(scene, stack, outcomes, run=run, wall=time.perf_counter() - t0)
+    if folder is not None:
+        run_folder_files(report, folder)
+    return report
+
+
+def simulate_trial(
+    scene: SceneConfig,
+    trial: int | str = 0,
+    *,
+    seed: int = 0,
+    log_dir: str | Path | None = None,
+    robot: StackConfig | None = None,
+) -> TrialOutcome:
+    """One trial of the scene's campaign (by index or trial id), its log in ``log_dir``."""
+    from palpate.config import InputError
+    from palpate.simulation.trial import run_sim_trial
+
+    stack = robot if robot is not None else load_robot(scene.robot)
+    specs = trials(scene, seed=seed, robot=stack)
+    if isinstance(trial, str):
+        chosen = [s for s in specs if s.trial_id == trial]
+        if not chosen:
+            raise InputError(f"no trial {trial!r} in scene {scene.name!r}")
+        spec = chosen[0]
+    elif 0 <= trial < len(specs):
+        spec = specs[trial]
+    else:
+        raise InputError(f"trial index {trial} outside 0-{len(specs) - 1} of {scene.name!r}")
+    folder = None if log_dir is None else Path(log_dir)
+    if folder is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+    return run_sim_trial(spec, scene, stack, log_dir=folder)
+
+
+def replay(log: str | Path) -> dict[str, Any]:
+    """Both estimates re-run on a trial log, compared with the recorded ones: what ``palpate
+    replay --json`` prints (``paper_kpa``, ``joint_kpa``, ``joint_ci_kpa``, the recorded ones,
+    ``identical``, the truth where the log has it)."""
+    from palpate.reports.replay import replay as replay_log
+
+    return replay_log(Path(log))
+
+
+def read_log(path: str | Path) -> TrialLog:
+    """A trial log (``.jsonl``): its header, records by kind (``log.of_kind("sample")``), end."""
+    from palpate.robot.trial.log import read_log as read
+
+    return read(Path(path))
+
+
+def read_recording(path: str | Path) -> Recording:
+    """A trial's MCAP recording, every message decoded (no ROS needed)."""
+    from palpate.robot.trial.recording import read_recording as read
+
+    return read(path)
+
+
+def design(
+    modulus_range: tuple[float, float], *, unit: str = "kPa", **options: Any
+) -> DesignOutcome:
+    """``palpate design``: a sensor for ``modulus_range`` (in ``unit``), its checks and its
+    simulated check, with the verdict (``.verdict.usable``, ``.reasons``). ``options`` are the
+    command's options by name (``tip_grating=True``, ``moduli=3``, ``no_sim=True``,
+    ``thickness_mm=10``, ...); ``.as_dict()`` is what ``--json`` prints."""
+    from palpate.commands import design as command
+
+    lo, hi = modulus_range
+    argv = ["--modulus-range", f"{lo!r}:{hi!r}", "--unit", unit]
+    for key, value in options.items():
+        flag = "--" + key.replace("_", "-")
+        if value is True:
+            argv.append(flag)
+        elif value is not False and value is not None:
+            argv += [flag, str(value)]
+    parser = argparse.ArgumentParser(prog="palpate.design", exit_on_error=False)
+    command.register(parser)
+    try:
+        args = parser.parse_args(argv)
+    except (argparse.ArgumentError, SystemExit) as exc:
+        from palpate.config import InputError
+
+        raise InputError(f"palpate.design: {exc}") from None
+    args.json = True
+    return command.evaluate(args)

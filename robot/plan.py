@@ -1,0 +1,89 @@
+"""What the indentation machine (``robot.indentation``) is given and gives back: its states and
+how a trial ends, the plan, the commands, the transitions it logs and the marks the estimator
+reads. Plain data: the trial loop, the log and the estimate use them without the machine."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from typing import Protocol
+
+from palpate.robot.guards import Observation
+from palpate.robot.probe_result import ProbeResult
+
+
+class State(enum.Enum):
+    IDLE = "idle"
+    HOMING = "homing"
+    POSITIONING = "positioning"
+    PROBING = "probing"
+    APPROACH = "approach"
+    CONTACT = "contact"
+    INDENTING = "indenting"
+    BUCKLED = "buckled"
+    HOLDING = "holding"
+    RETRACTING = "retracting"
+    DONE = "done"
+    FAULT = "fault"
+    ABORTED = "aborted"
+    UNREACHABLE = "unreachable"
+
+
+TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})
+PLANNED_ENDS = frozenset({State.DONE, State.UNREACHABLE})  # torque stays on: nothing went wrong
+
+
+@dataclass(frozen=True)
+class TrialPlan:
+    """Where to go: from inverse kinematics and the campaign (SI: m, rad, m/s)."""
+
+    roll: float
+    contact_advance: float  # advance where the tip sphere is expected to touch (m)
+    home_advance: float = 0.0
+    standoff: float = 2e-3  # stop this far before the expected contact, then approach slowly
+    approach_window: float = 3e-3  # no contact this far past the expected contact -> fault
+    post_buckling_travel: float = 0.3e-3  # keep indenting after detection, for the record
+    fast_speed: float = 5e-3
+    approach_speed: float = 1e-3
+    indent_speed: float = 0.5e-3
+    roll_tolerance: float = 2e-3
+    position_tolerance: float = 5e-6
+    hold_time: float = 0.0  # s at rest after the post-buckling travel (a creep test); 0: none
+
+
+@dataclass(frozen=True)
+class Command:
+    advance: float  # goal, m
+    roll: float  # goal, rad
+    speed: float  # m/s for the advance
+    torque: bool = True
+    rezero: bool = False  # take the strain zero again on the frames of the last ticks at rest
+
+
+class Prober(Protocol):
+    """The probing step (``robot.probing.ProbeRoutine``): each tick a command, then its result
+    (or a ``str``: why it failed)."""
+
+    def step(self, obs: Observation) -> Command | ProbeResult | str: ...
+
+
+@dataclass(frozen=True)
+class Transition:
+    t: float
+    source: State
+    target: State
+    reason: str
+    advance: float
+    strains: tuple[float, ...]
+
+
+@dataclass
+class TrialMarks:
+    """What the estimator needs: encoder values at contact and at detected buckling."""
+
+    x_contact: float | None = None
+    x_buckling: float | None = None
+    t_contact: float | None = None
+    t_buckling: float | None = None
+    strains_at_buckling: tuple[float, ...] = ()
+    reason: str = ""
