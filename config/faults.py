@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from palpate.config.loader import limits
+from palpate.config.optics import MM
+from palpate.config.units import SI
 
 ServoName = Literal["outer_roll", "inner_roll", "translation"]
 # Hardware Error Status bits by name (wire.dynamixel.HW_*).
@@ -40,6 +42,7 @@ class FaultCase:
     board: dict[str, Any] | None = None  # sim.board.BoardFaults keys
     stream_stops: bool = False  # the board goes silent at the trigger (unplugged)
     early_contact_mm: float = field(default=0.0, metadata=limits(ge=0, le=50))
+    early_contact = SI("early_contact_mm", MM)  # m (palpate.config.units)
     tube_tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
     kill: bool = False  # SIGKILL the process running the trial at the trigger
 

@@ -8,13 +8,16 @@ samples for the robot campaign.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Literal
 
 from palpate.config.faults import FaultsConfig
 from palpate.config.loader import limits
+from palpate.config.optics import MM, PM, UE
 from palpate.config.sample import PAPER_SAMPLES, SampleConfig
 from palpate.config.schema import DEFAULT_CONTROL_RATE_HZ
+from palpate.config.units import SI, SIOptional, SITuple
 
 Orientation = Literal["downward", "sideways", "upward"]
 ORIENTATION_ROLL_DEG: dict[str, float] = {"downward": 0.0, "sideways": 90.0, "upward": 180.0}
@@ -64,6 +67,13 @@ class FidelityConfig:
     # interpolates linearly between them: a cheaper world, for speed-over-accuracy levels.
     contact_grid_um: float | None = field(default=None, metadata=limits(gt=0, le=1000))
 
+    # the SI views of the unit-suffixed fields (palpate.config.units)
+    fbg_noise = SI("fbg_noise_pm", PM)  # m of wavelength
+    contact_uncertainty = SI("contact_uncertainty_mm", MM)
+    tube_tip_stiffness = SIOptional("tube_tip_stiffness_n_per_mm", 1.0 / MM)  # N/m
+    latency_timer = SI("latency_timer_ms", 1e-3)  # s
+    contact_grid = SIOptional("contact_grid_um", 1e-6)  # m
+
 
 @dataclass(frozen=True)
 class CampaignConfig:
@@ -104,7 +114,7 @@ class CampaignConfig:
     @property
     def classify_at(self) -> float | None:
         """The diagnostic threshold in Pa, or None."""
-        return None if self.classify_at_kpa is None else self.classify_at_kpa * 1e3
+        return None if self.classify_at_kpa is None else self.classify_at_kpa * 1e3  # kPa -> Pa
 
     # Find the surface normal by light touches before indenting (robot.probing), then re-plan
     # the roll and advance orthogonal to it; null: on for robot campaigns, off on the vertical
@@ -130,6 +140,22 @@ class CampaignConfig:
     @property
     def orientation_rolls_deg(self) -> tuple[float, ...]:
         return tuple(ORIENTATION_ROLL_DEG[o] for o in self.orientations)
+
+    # the SI views of the unit-suffixed fields (palpate.config.units)
+    exposed_lengths = SITuple("exposed_lengths_mm", MM)
+    exposed_length = SI("exposed_length_mm", MM)
+    standoff = SI("standoff_mm", MM)
+    approach_speed = SI("approach_speed_mm_per_s", MM)  # m/s
+    indent_speed = SI("indent_speed_mm_per_s", MM)
+    indent_speeds = SITuple("indent_speeds_mm_per_s", MM)
+    post_buckling = SI("post_buckling_mm", MM)
+    max_travel_past_contact = SI("max_travel_past_contact_mm", MM)
+    detector_threshold = SI("detector_threshold_ue", UE)  # strain
+    outlier_above = SI("outlier_above_kpa", 1e3)  # Pa
+    misalignment_tolerance = SI("misalignment_tolerance_deg", math.pi / 180)  # rad
+    miss_tolerance = SI("miss_tolerance_mm", MM)
+    probe_sagitta = SI("probe_sagitta_mm", MM)
+    probe_touch = SI("probe_touch_ue", UE)
 
 
 @dataclass(frozen=True)

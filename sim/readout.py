@@ -19,7 +19,7 @@ class GratingReadout:
 
     def __init__(self, sensor: SensorConfig, fbg: FbgConfig, fidelity: FidelityConfig) -> None:
         self._base = tuple(fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in sensor.used_gratings)
-        self._noise = fidelity.fbg_noise_pm * 1e-12
+        self._noise = fidelity.fbg_noise
         ref_nm = fbg.reference_wavelength_nm
         self._reference = None if ref_nm is None else ref_nm * 1e-9
         # peak noises, then the reference's, drawn in one call (the same stream as separate ones)
@@ -66,7 +66,7 @@ class TipReadout:
         self._sensitivity = tip.sensitivity
         self._range = tip.range
         self._thermal = tip.temperature_coefficient
-        self._noise = fidelity.fbg_noise_pm * 1e-12
+        self._noise = fidelity.fbg_noise
 
     @classmethod
     def of(cls, tip: TipGratingConfig | None, fidelity: FidelityConfig) -> TipReadout | None:

@@ -395,5 +395,5 @@ def _contact_effects(
         tube_stiffness=stiffness,
         imperfection=fidelity.imperfection_w0_over_l,
     )
-    sd = fidelity.contact_uncertainty_mm * 1e-3
+    sd = fidelity.contact_uncertainty
     return effects, float(rng.normal(0.0, sd)) if sd > 0 else 0.0

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
+from palpate.config.optics import MM
 from palpate.config.schema import SensorConfig
 from palpate.estimation.beam import Beam
 from palpate.estimation.elastica import E_OVER_L_MAX, accurate, fast, shooting
@@ -152,7 +153,7 @@ def _sensor_table() -> Table:
         note="Fiber r = 0.115 mm, 67 GPa on 4 NiTi wires r = 0.1 mm, 55 GPa (paper Sec. II).",
     )
     for length_mm in (42, 44, 46, 48, 50):
-        beam = Beam.from_section(sec, length_mm * 1e-3)
+        beam = Beam.from_section(sec, length_mm * MM)
         table.rows.append(
             [
                 length_mm,

@@ -17,6 +17,7 @@ import numpy as np
 from palpate.calibration import calibrated, is_reference
 from palpate.campaigns.executors import SerialExecutor, process_pool
 from palpate.config.loader import InputError
+from palpate.config.optics import MM
 from palpate.config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.estimation.elastica import fast
@@ -52,10 +53,10 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
                 tube=tube,
                 orientation=orientation,
                 roll=math.radians(ORIENTATION_ROLL_DEG[orientation]),
-                exposed_length=length_mm * 1e-3,
+                exposed_length=length_mm * MM,  # the id names it in mm
                 seed=seed * 1_000_003 + len(specs),
                 reference=references[s.name],
-                indent_speed=v * 1e-3 if c.indent_speeds_mm_per_s else None,
+                indent_speed=v * MM if c.indent_speeds_mm_per_s else None,
             )
         )
 

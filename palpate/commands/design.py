@@ -35,6 +35,7 @@ from palpate.campaigns.designcheck import (
 from palpate.campaigns.executors import add_executor_arguments
 from palpate.config import load, load_stack, resolve
 from palpate.config.loader import InputError, write_yaml
+from palpate.config.optics import MM
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.estimation.design import (
@@ -186,7 +187,7 @@ def _inputs(
 ) -> tuple[tuple[float, float], DesignConstraints, DesignSpace]:
     unit = UNITS[args.unit]
     lo, hi = _pair(args.modulus_range, "--modulus-range")
-    thickness = None if math.isinf(args.thickness_mm) else args.thickness_mm * 1e-3
+    thickness = None if math.isinf(args.thickness_mm) else args.thickness_mm * MM
     s = stack.sensor
     constraints = DesignConstraints(
         poisson=args.poisson,
@@ -198,7 +199,7 @@ def _inputs(
             scene.fidelity.fbg_noise_pm, stack.fbg.strain_coefficient_pm_per_ue
         ),
         imperfection=args.imperfection,
-        post_buckling_travel=scene.campaign.post_buckling_mm * 1e-3,
+        post_buckling_travel=scene.campaign.post_buckling,
         grating_centres_from_tip=s.grating_centres_from_tip(),
         grating_length=s.grating_length,
     )

@@ -284,9 +284,7 @@ def _compare_paper(campaigns: list[_Campaign], args: argparse.Namespace) -> None
 
     payloads = []
     for c in campaigns:
-        data = comparison(
-            c.outcomes, c.scene.campaign.kind, c.scene.campaign.outlier_above_kpa * 1e3
-        )
+        data = comparison(c.outcomes, c.scene.campaign.kind, c.scene.campaign.outlier_above)
         payloads.append({"scene": c.scene.name, "seed": args.seed, **data})
         if not args.json:
             print_comparison(data, c.scene.name, args.seed)
@@ -305,7 +303,7 @@ def _figures(c: _Campaign, rows: list[SampleRow]) -> list[str]:
 def _report(c: _Campaign, args: argparse.Namespace) -> dict[str, object]:
     """Print one campaign's table (unless ``--json``), write its results into the run folder
     (``palpate.reports.results``) and return its JSON payload."""
-    rows = summarize_campaign(c.outcomes, c.scene.campaign.outlier_above_kpa * 1e3)
+    rows = summarize_campaign(c.outcomes, c.scene.campaign.outlier_above)
     figures = [] if args.no_plots else _figures(c, rows)
     run = {
         "run_dir": str(c.run_dir),

@@ -122,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
     code = run_on_hardware("trial", body)
     if code:
         return code
-    samples = _summaries(outcomes, loaded.bench.campaign.outlier_above_kpa * 1e3)
+    samples = _summaries(outcomes, loaded.bench.campaign.outlier_above)
     found = calibrate(
         (rig_key(o.trial.kind, o.trial.tube.name), o.calibration)
         for o in outcomes

@@ -126,7 +126,7 @@ class FaultInjector:
         self, clock: VirtualClock, bus: EmulatedBus, board: BoardEmulator, world: World
     ) -> None:
         self._clock, self._board, self._world = clock, board, world
-        early = self.case.early_contact_mm * 1e-3
+        early = self.case.early_contact
         if early:  # the tissue is closer than the plan expects
             s = world.surface
             world.surface = Surface(point=s.point + early * s.normal, normal=s.normal)

@@ -131,7 +131,7 @@ def _truth_within_limits(job: FaultJob, truth: GroundTruth, problems: list[str])
     limit = job.stack.fbg.strain_limit
     if truth.max_strain > limit:
         ok = _fail(problems, f"true strain {truth.max_strain * 1e6:.0f} ue over the limit")
-    travel = job.scene.campaign.max_travel_past_contact_mm * 1e-3 + TRAVEL_SLACK
+    travel = job.scene.campaign.max_travel_past_contact + TRAVEL_SLACK
     if truth.max_past_contact > travel:
         ok = _fail(problems, f"true travel past contact {truth.max_past_contact * 1e3:.3f} mm")
     return ok

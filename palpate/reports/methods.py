@@ -24,6 +24,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from palpate.config.optics import MM
 from palpate.config.schema import StackConfig
 from palpate.estimation.section import Section
 from palpate.robot.trial.estimate import estimate_from_marks
@@ -107,7 +108,7 @@ def compare_methods(
                 continue
             t0 = time.perf_counter()
             est = estimate_from_marks(
-                m.x_contact + error_mm * 1e-3,
+                m.x_contact + error_mm * MM,
                 m.x_buckling,
                 m.strains_at_buckling,
                 o.exposed_length_at_buckling,

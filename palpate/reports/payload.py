@@ -55,7 +55,7 @@ def campaign_report(
 ) -> CampaignReport:
     """The report of ``outcomes``; ``run``: where and how it ran (``run_dir``, ``log_dir``,
     ``transport``, ``seed``: the payload's first keys), ``wall``: its wall time (s)."""
-    outlier_above = scene.campaign.outlier_above_kpa * 1e3
+    outlier_above = scene.campaign.outlier_above
     rows = summarize_campaign(outcomes, outlier_above)
     records = sample_records(outcomes, rows, outlier_above)
     sim_time = sum(o.sim_time for o in outcomes)

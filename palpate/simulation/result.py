@@ -220,7 +220,7 @@ def estimator_inputs(
         compliance=compliance,
         compliance_calibrated=calibrated,
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
-        travel_window=c.max_travel_past_contact_mm * 1e-3,
+        travel_window=c.max_travel_past_contact,
         designed_range=stack.sensor.designed_range,
         rigid=sample.rigid,
         orientation_verified=probe is None or probe.normal is not None,

@@ -165,7 +165,7 @@ def run_sim_trial(
     """Run one simulated trial end to end and estimate the modulus; ``live``: its live view."""
     c = trial_campaign(spec, scene)
     geo = trial_geometry(stack, spec, trial_sample(scene, spec))
-    retract = geo.contact_translation - c.standoff_mm * 1e-3 - 1e-3
+    retract = geo.contact_translation - c.standoff - 1e-3
     stack = trial_stack(scene, stack, geo, retract)
     plan = trial_plan(c, stack, roll=geo.plan_roll, contact=geo.contact_translation, home=retract)
     clock = VirtualClock()
@@ -220,7 +220,7 @@ def bus_timing(fidelity: FidelityConfig, servos: ServoBusConfig) -> BusTiming | 
     if fidelity.bus_timing == "ideal":
         return None
     baud = fidelity.bus_baudrate if fidelity.bus_baudrate is not None else servos.baudrate
-    return BusTiming(baudrate=baud, latency_timer_s=fidelity.latency_timer_ms * 1e-3)
+    return BusTiming(baudrate=baud, latency_timer_s=fidelity.latency_timer)
 
 
 SIM_REPLY_TIMEOUT_MS = 2000.0

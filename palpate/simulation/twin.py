@@ -139,7 +139,7 @@ class SimulatedBench:
         self.stack = stack
         self.scene = scene
         if not stations:
-            place = surface or facing_surface(stack, scene.campaign.exposed_length_mm * 1e-3)
+            place = surface or facing_surface(stack, scene.campaign.exposed_length)
             stations = [Station(chosen, place, tube or stack.tubes[0].name)]
         self.stations = list(stations)
         self._station = 0
