@@ -174,7 +174,7 @@ class SceneConfig:
     fidelity: FidelityConfig = FidelityConfig()
     campaign: CampaignConfig = CampaignConfig()
     faults: FaultsConfig = field(default_factory=FaultsConfig)  # for ``palpate sim --faults``
-    # Each trial's MCAP recording beside its log (robot/trial/recording.py; docs/recordings.md):
+    # Each trial's MCAP recording beside its log (robot/records/recording.py; docs/recordings.md):
     # about a sixth of a simulated trial's CPU; ``palpate sim --no-mcap`` turns it off.
     mcap: bool = True
 

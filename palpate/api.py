@@ -28,8 +28,8 @@ if TYPE_CHECKING:  # the heavy modules load when a function needs them: `import 
     from palpate.config.scene import SceneConfig
     from palpate.config.schema import StackConfig
     from palpate.reports.payload import CampaignReport
-    from palpate.robot.trial.log import TrialLog
-    from palpate.robot.trial.recording import Recording
+    from palpate.robot.records.log import TrialLog
+    from palpate.robot.records.recording import Recording
     from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 PYTHON = "<python>"  # the source named in errors about a scene built in code
@@ -150,14 +150,14 @@ def replay(log: str | Path) -> dict[str, Any]:
 
 def read_log(path: str | Path) -> TrialLog:
     """A trial log (``.jsonl``): its header, records by kind (``log.of_kind("sample")``), end."""
-    from palpate.robot.trial.log import read_log as read
+    from palpate.robot.records.log import read_log as read
 
     return read(Path(path))
 
 
 def read_recording(path: str | Path) -> Recording:
     """A trial's MCAP recording, every message decoded (no ROS needed)."""
-    from palpate.robot.trial.recording import read_recording as read
+    from palpate.robot.records.recording import read_recording as read
 
     return read(path)
 

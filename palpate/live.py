@@ -45,8 +45,8 @@ from palpate.estimation.section import Section, sensor_section
 from palpate.robot.guards import Observation
 from palpate.robot.indentation import State
 from palpate.robot.kinematics import forward
-from palpate.robot.trial.cdr import Transform
-from palpate.robot.trial.ros2 import tip_transforms
+from palpate.robot.records.cdr import Transform
+from palpate.robot.records.ros2 import tip_transforms
 from palpate.sensor.strain import grating_intervals
 
 log = logging.getLogger(__name__)
@@ -213,7 +213,7 @@ class _Feed:
         tube_points, tip, rotation = _tube(self.tube, obs.roll, obs.advance)
         beam = _beam_points(length, shortening)  # in the tube tip's frame (x along the tangent)
         if v.tf.has_sinks():
-            # the recording's transforms (robot.trial.ros2), the sensor tip at the bent beam's end
+            # the recording's transforms (robot.records.ros2), the sensor tip at the bent beam's end
             known = None if self.tube is None else tip_transforms(self.tube, obs.roll, obs.advance)
             identity = (0.0, 0.0, 0.0, 1.0)
             to_tip: Transform = known[0] if known else ("base", "tube_tip", (0, 0, 0), identity)

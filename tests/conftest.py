@@ -30,7 +30,7 @@ def _no_leaked_numpy_error_state() -> object:
 
 @pytest.fixture
 def log_header() -> dict[str, object]:
-    """The smallest trial-log header the log schema accepts (robot.trial.logschema): what a
+    """The smallest trial-log header the log schema accepts (robot.records.logschema): what a
     reader relies on, nothing more."""
     return {
         "spec": {"kind": "bench", "exposed_length": 0.042},

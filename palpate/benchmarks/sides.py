@@ -79,9 +79,9 @@ BOUNDARIES = (
     Boundary("palpate.sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
     Boundary("palpate.robot.trial.session", "run_trial", "trial loop", CONTROL),
     Boundary("palpate.robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
-    Boundary("palpate.robot.trial.recording:McapRecorder", "write", "MCAP recording", CONTROL),
+    Boundary("palpate.robot.records.recording:McapRecorder", "write", "MCAP recording", CONTROL),
     Boundary(
-        "palpate.robot.trial.recording:McapRecorder", "close", "MCAP close (tip force)", CONTROL
+        "palpate.robot.records.recording:McapRecorder", "close", "MCAP close (tip force)", CONTROL
     ),
     Boundary("palpate.robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
     Boundary("palpate.robot.trial.states", "infer_states", "beam states", ESTIMATOR),

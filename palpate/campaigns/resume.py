@@ -26,8 +26,8 @@ from palpate.estimation.southwell import SouthwellFit
 from palpate.estimation.stiffness import StiffnessEstimate
 from palpate.robot.indentation import TrialMarks
 from palpate.robot.probe_result import ProbeResult, Touch
+from palpate.robot.records.log import TrialLog, TrialLogError, read_log
 from palpate.robot.trial.estimate import exposed_length_at
-from palpate.robot.trial.log import TrialLog, TrialLogError, read_log
 from palpate.robot.trial.record import recorded_verdict
 from palpate.simulation.trial import TrialOutcome, TrialSpec, trial_geometry
 

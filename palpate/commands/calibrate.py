@@ -28,7 +28,7 @@ from palpate.config.loader import InputError
 from palpate.config.schema import MM
 from palpate.estimation.compliance import ComplianceFit
 from palpate.reports.replay import replay
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 from palpate.sensor.calibration import (
     CalibrationFit,
     csv_columns,

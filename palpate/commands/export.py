@@ -2,7 +2,7 @@
 
 Each ``LOG`` (a ``.jsonl`` trial log of ``palpate sim`` or ``palpate trial``) becomes a
 recording of the same name with ``.mcap`` for ``.jsonl`` (``S1.jsonl`` -> ``S1.mcap``) beside
-it, or in ``--out``: the messages its trial would have recorded (``robot.trial.recording``;
+it, or in ``--out``: the messages its trial would have recorded (``robot.records.recording``;
 docs/recordings.md). Exit 0 when every log converted, 2 when one is
 not a trial log (named, with what is wrong); the others are still converted."""
 
@@ -13,9 +13,10 @@ import logging
 from pathlib import Path
 
 from palpate.config.loader import InputError
-from palpate.robot.trial.export import export
-from palpate.robot.trial.log import TrialLogError
-from palpate.robot.trial.recording import read_recording
+from palpate.robot.records.export import export
+from palpate.robot.records.log import TrialLogError
+from palpate.robot.records.recording import read_recording
+from palpate.robot.trial.tipforce import axial_loads
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
     for path in args.logs:
         target = None if args.out is None else args.out / path.with_suffix(".mcap").name
         try:
-            written = export(path, target)
+            written = export(path, target, axial_loads)
         except (TrialLogError, OSError) as exc:
             failed.append(str(exc) if str(path) in str(exc) else f"{path}: {exc}")
             continue

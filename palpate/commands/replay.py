@@ -13,7 +13,7 @@ from pathlib import Path
 
 from palpate.config.loader import InputError
 from palpate.reports.replay import replay
-from palpate.robot.trial.log import TrialLogError
+from palpate.robot.records.log import TrialLogError
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -33,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(str(exc)) from None
     if args.plot is not None and not report.get("damaged"):
         from palpate.reports.fitplot import record_fit
-        from palpate.robot.trial.log import read_log
+        from palpate.robot.records.log import read_log
 
         try:
             report["plot"] = str(record_fit(read_log(args.log), args.plot))

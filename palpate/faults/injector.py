@@ -21,7 +21,7 @@ from typing import Any
 
 from palpate.config.faults import FaultCase
 from palpate.config.schema import ServoBusConfig
-from palpate.robot.trial.log import TrialLogWriter
+from palpate.robot.records.log import TrialLogWriter
 from palpate.sim.board import BoardEmulator, BoardFaults
 from palpate.sim.clock import VirtualClock
 from palpate.sim.dynamixel.bus import EmulatedBus

@@ -39,7 +39,7 @@ from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.faults.injector import GroundTruth
 from palpate.reports.replay import replay
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 from palpate.sim.board import BoardFaults
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 from palpate.wire import dynamixel as tables

@@ -28,8 +28,8 @@ from matplotlib.lines import Line2D
 from palpate.config.loader import InputError
 from palpate.estimation.belief import Hypothesis
 from palpate.reports.replay import known_moduli
+from palpate.robot.records.log import TrialLog, read_log
 from palpate.robot.trial.inputs import header_sensor
-from palpate.robot.trial.log import TrialLog, read_log
 from palpate.robot.trial.relaxed import HOLD_STATE, RECORD_STATES
 from palpate.robot.trial.states import record_states
 

@@ -21,6 +21,7 @@ import numpy as np
 from palpate.config.loader import from_mapping
 from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
 from palpate.estimation.section import Section
+from palpate.robot.records.log import TrialLog, TrialLogError, read_log
 from palpate.robot.trial.estimate import (
     EstimatorInputs,
     estimate_from_marks,
@@ -30,7 +31,6 @@ from palpate.robot.trial.estimate import (
     verdict_for,
 )
 from palpate.robot.trial.inputs import VERSION, probe_inputs
-from palpate.robot.trial.log import TrialLog, TrialLogError, read_log
 from palpate.robot.trial.record import estimator_keys
 
 MAX_PROBLEMS = 5  # bad lines named in the message (all are counted)

@@ -26,8 +26,8 @@ from palpate.live import LiveView
 from palpate.robot.drive import DriveController
 from palpate.robot.dynamixel.driver import DynamixelBus
 from palpate.robot.indentation import Observation, Prober, State, TrialPlan
+from palpate.robot.records.log import TrialLogWriter
 from palpate.robot.rig import RigSettings, ServoFbgRig
-from palpate.robot.trial.log import TrialLogWriter
 from palpate.robot.trial.record import header_common
 from palpate.robot.trial.session import TrialSetup, run_session_trial
 from palpate.robot.trial.setup import (

@@ -8,5 +8,8 @@ simulator (only the wiring differs: ``palpate.lab.trial`` and ``palpate.simulati
 - :mod:`.estimate`: the estimates of a finished trial: the paper's (encoder marks, Eqs. 13-14)
   and the joint fit of the loading record; ``palpate replay`` re-runs the same functions.
 - :mod:`.record`: the records of a trial log that are not per tick (header, estimate, end).
-- :mod:`.log`: the log file itself (append-only JSON lines, crash-safe) and its reader.
+- :mod:`.session`: one trial as the bench and the simulator run it (zero, log, run, estimate).
+- :mod:`.tipforce`: the tip force a recording derives at its close.
+
+The log file, its schema and the MCAP recording are serialisation: ``robot.records``.
 """

@@ -2,7 +2,7 @@
 the end (the per-tick ``sample`` and ``transition`` records are :mod:`robot.trial.run`'s).
 
 The simulator and the bench write the same keys here, so ``palpate replay`` reads either log
-the same way (see :mod:`robot.trial.log` for the file format). Every key the estimator adds is
+the same way (see :mod:`robot.records.log` for the file format). Every key the estimator adds is
 written here, and read back here (:func:`recorded_verdict`), tolerant of logs that predate it:
 
 - header ``estimator``: the joint fit's inputs (``robot.trial.inputs.EstimatorInputs``, with

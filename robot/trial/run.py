@@ -28,7 +28,7 @@ from palpate.robot.indentation import (
     TrialPlan,
 )
 from palpate.robot.probe_result import ProbeResult
-from palpate.robot.trial.log import TrialLogWriter
+from palpate.robot.records.log import TrialLogWriter
 from palpate.sensor.clock import Clock
 
 

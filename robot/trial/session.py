@@ -2,7 +2,7 @@
 
 Zero the strains at rest, open the trial's log (and its recording), run the state machine to its
 end, estimate, and close the log with the estimate and the end record: whatever happens in
-between, the log and its recording are closed (``robot.trial.log``). What differs between the
+between, the log and its recording are closed (``robot.records.log``). What differs between the
 bench and the simulator is only what they build before (the rig and a :class:`TrialSetup`)::
 
     setup = TrialSetup(plan, campaign, stack, estimate=..., log_path=..., header=...)
@@ -25,11 +25,12 @@ from palpate.config.scene import CampaignConfig
 from palpate.config.schema import StackConfig
 from palpate.robot.guards import Observation
 from palpate.robot.indentation import Prober, State, TrialPlan
+from palpate.robot.records.log import TrialLogWriter
 from palpate.robot.trial.estimate import TrialEstimate
-from palpate.robot.trial.log import TrialLogWriter
 from palpate.robot.trial.record import estimate_record
 from palpate.robot.trial.run import Rig, TrialResult, end_record, run_trial
 from palpate.robot.trial.setup import detector_for, guards_for
+from palpate.robot.trial.tipforce import axial_loads
 from palpate.sensor.clock import Clock
 from palpate.sensor.strain import StrainChain
 
@@ -110,7 +111,8 @@ def _log(setup: TrialSetup) -> Iterator[TrialLogWriter | None]:
     if setup.log_path is None:
         yield None
         return
-    with TrialLogWriter(setup.log_path, setup.header or {}, mcap=setup.mcap) as log:
+    header, path = setup.header or {}, setup.log_path
+    with TrialLogWriter(path, header, mcap=setup.mcap, loads=axial_loads) as log:
         if setup.on_log is not None:
             setup.on_log(log)
         yield log

@@ -15,8 +15,8 @@ from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.faults import child_command, fault_jobs
-from palpate.robot.trial.log import read_log
-from palpate.robot.trial.recording import read_recording
+from palpate.robot.records.log import read_log
+from palpate.robot.records.recording import read_recording
 
 SCENE_PATH = resolve("scenes/faults.yaml")
 SCENE = load(SceneConfig, SCENE_PATH)
@@ -79,7 +79,7 @@ def test_sigkill_mid_trial_keeps_every_record_written(
 def test_a_torn_last_line_is_counted_not_fatal(
     tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
 ) -> None:
-    from palpate.robot.trial.log import TrialLogWriter
+    from palpate.robot.records.log import TrialLogWriter
 
     path = tmp_path / "t.jsonl"
     with TrialLogWriter(path, {"trial": "x", **log_header}) as w:
@@ -100,7 +100,7 @@ def test_a_torn_last_line_is_counted_not_fatal(
 def test_a_bad_line_inside_is_damage_not_a_crash(
     tmp_path: Path, log_header: dict[str, object], log_sample: dict[str, object]
 ) -> None:
-    from palpate.robot.trial.log import TrialLogWriter
+    from palpate.robot.records.log import TrialLogWriter
 
     path = tmp_path / "t.jsonl"
     with TrialLogWriter(path, {"trial": "x", **log_header}) as w:

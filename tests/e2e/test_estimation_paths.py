@@ -13,7 +13,7 @@ from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 
 MISMATCH = resolve("scenes/mismatch")
 

@@ -13,7 +13,7 @@ from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.reports.fitplot import estimates_with_intervals, record_fit
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 
 STACK = load_stack()

@@ -57,7 +57,7 @@ def test_the_log_carries_the_tip_load_and_replays_identically(fibrotic: TrialOut
 
 
 def test_the_recordings_wrench_is_the_tip_gratings_load(fibrotic: TrialOutcome) -> None:
-    from palpate.robot.trial.recording import read_recording
+    from palpate.robot.records.recording import read_recording
 
     assert fibrotic.log_path is not None
     log = Path(fibrotic.log_path)

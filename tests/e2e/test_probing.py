@@ -12,7 +12,7 @@ import pytest
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import ServoBusConfig
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 from palpate.sim.board import BoardEmulator, BoardFaults
 from palpate.sim.clock import VirtualClock
 from palpate.sim.dynamixel.bus import EmulatedBus

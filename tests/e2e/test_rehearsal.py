@@ -16,7 +16,7 @@ import pytest
 from mcap.reader import make_reader  # type: ignore[import-untyped,unused-ignore]
 
 from palpate.benchmarks.rehearsal import cpu_load, rehearse
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 
 
 @pytest.mark.slow

@@ -12,7 +12,7 @@ from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 from palpate.simulation.trial import TrialSpec, run_sim_trial
 
 STACK = load_stack()

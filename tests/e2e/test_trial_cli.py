@@ -27,7 +27,7 @@ from palpate.lab.hardware import HardwareError, explain, open_hardware
 from palpate.lab.trial import SKIPPED, BenchOutcome, plan_bench_trials
 from palpate.reports.replay import replay
 from palpate.robot.motors import ServoTransportError
-from palpate.robot.trial.log import read_log
+from palpate.robot.records.log import read_log
 from palpate.sim.clock import VirtualClock
 from palpate.simulation.twin import SimulatedBench, stations_for, surface_at
 

@@ -20,8 +20,8 @@ from mcap.reader import make_reader  # type: ignore[import-untyped,unused-ignore
 from palpate.cli import main
 from palpate.config.bench import load_bench
 from palpate.lab.hardware import Terminated
-from palpate.robot.trial.log import read_log
-from palpate.robot.trial.recording import read_recording
+from palpate.robot.records.log import read_log
+from palpate.robot.records.recording import read_recording
 from palpate.sim.clock import VirtualClock
 from palpate.simulation.twin import SimulatedBench, surface_at
 from tests.e2e.test_trial_cli import ONE, ROBOT_SCENE, bench_file, run_on

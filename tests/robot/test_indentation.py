@@ -24,7 +24,7 @@ from palpate.robot.indentation import (
     Transition,
     TrialPlan,
 )
-from palpate.robot.trial.log import TrialLogWriter, read_log
+from palpate.robot.records.log import TrialLogWriter, read_log
 from palpate.robot.trial.run import end_record, run_trial
 from palpate.sim.clock import VirtualClock
 

@@ -1,4 +1,4 @@
-"""MCAP recordings beside the trial log (``robot.trial.recording``), read back without ROS:
+"""MCAP recordings beside the trial log (``robot.records.recording``), read back without ROS:
 every channel typed with its ROS 2 definition, a message per log record, times that never
 decrease, the export of an existing log, and the tip force from the estimator's beam states."""
 
@@ -13,11 +13,12 @@ import pytest
 from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.robot.trial.export import export
+from palpate.robot.records.export import export
+from palpate.robot.records.log import TrialLog, read_log
+from palpate.robot.records.recording import Recording, read_recording
 from palpate.robot.trial.inputs import header_sensor
-from palpate.robot.trial.log import TrialLog, read_log
-from palpate.robot.trial.recording import Recording, read_recording
 from palpate.robot.trial.states import record_states
+from palpate.robot.trial.tipforce import axial_loads
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 
 STACK = load_stack()
@@ -103,7 +104,7 @@ def test_the_tip_force_is_the_estimators_axial_load(trial) -> None:  # type: ign
 
 def test_an_existing_log_exports_to_the_same_recording(trial, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     out, _, rec = trial
-    target = export(Path(str(out.log_path)), tmp_path / "again.mcap")
+    target = export(Path(str(out.log_path)), tmp_path / "again.mcap", axial_loads)
     again = read_recording(target)
     assert again.types == rec.types
     assert {t: again.count(t) for t in again.messages} == {t: rec.count(t) for t in rec.messages}
@@ -122,11 +123,11 @@ def test_export_names_a_file_that_is_not_a_trial_log(tmp_path: Path) -> None:
 
 
 def test_the_fast_encoders_are_byte_for_byte_the_definitions() -> None:
-    """robot.trial.cdr's packed messages equal mcap-ros2-support's definition-driven encoding."""
+    """robot.records.cdr's packed messages equal mcap-ros2-support's definition-driven encoding."""
     from mcap_ros2._dynamic import serialize_dynamic
 
-    from palpate.robot.trial import cdr
-    from palpate.robot.trial.ros2 import SCHEMAS
+    from palpate.robot.records import cdr
+    from palpate.robot.records.ros2 import SCHEMAS
 
     def encode(name: str, message: dict[str, object]) -> bytes:
         return bytes(serialize_dynamic(name, SCHEMAS[name])[name](message))
@@ -184,8 +185,8 @@ def test_a_robot_trial_records_the_tip_pose_as_the_forward_kinematics(tmp_path: 
 def test_the_transform_encoder_is_byte_for_byte_the_definition() -> None:
     from mcap_ros2._dynamic import serialize_dynamic
 
-    from palpate.robot.trial import cdr
-    from palpate.robot.trial.ros2 import SCHEMAS
+    from palpate.robot.records import cdr
+    from palpate.robot.records.ros2 import SCHEMAS
 
     name = "tf2_msgs/msg/TFMessage"
     encode = serialize_dynamic(name, SCHEMAS[name])[name]

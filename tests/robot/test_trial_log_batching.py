@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from palpate.robot.trial.log import TrialLogWriter
+from palpate.robot.records.log import TrialLogWriter
 
 
 def _on_disk(path: Path) -> list[dict[str, object]]:

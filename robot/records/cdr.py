@@ -5,7 +5,7 @@ message; a trial records three a tick (the wrench when it ends), which made the 
 fifth of a simulated trial's CPU. These messages have fixed layouts, so they are packed here
 directly (2 us; alignment relative to the payload after the 4-byte encapsulation header, as CDR
 has it). Tests hold them byte for byte to ``mcap-ros2-support``'s encoder, and decode the
-recordings with its decoder, against the definitions in ``robot.trial.ros2``.
+recordings with its decoder, against the definitions in ``robot.records.ros2``.
 """
 
 from __future__ import annotations

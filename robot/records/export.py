@@ -1,22 +1,28 @@
 """An existing trial log as an MCAP recording (``palpate export``): the same messages its trial
-would have recorded as it ran (``robot.trial.recording``)."""
+would have recorded as it ran (``robot.records.recording``)."""
 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
-from palpate.robot.trial.log import read_log
-from palpate.robot.trial.recording import McapRecorder, axial_loads
+from palpate.robot.records.log import read_log
+from palpate.robot.records.recording import McapRecorder
 
 
-def export(log_path: str | Path, out: str | Path | None = None) -> Path:
+def export(
+    log_path: str | Path,
+    out: str | Path | None = None,
+    loads: Callable[[McapRecorder], list[float] | None] | None = None,
+) -> Path:
     """The MCAP recording of an existing trial log (``<log>.mcap`` unless ``out``): the same
-    messages its trial would have recorded. Raises ``TrialLogError`` for an unreadable log."""
+    messages its trial would have recorded, the tip force from ``loads``
+    (``robot.trial.tipforce.axial_loads``). Raises ``TrialLogError`` for an unreadable log."""
     log = read_log(log_path)
     target = Path(out) if out is not None else Path(log_path).with_suffix(".mcap")
     recorder = McapRecorder(target, log.header)
     for record in log.records:
         recorder.write(record, json.dumps(record, separators=(",", ":"), allow_nan=False))
-    recorder.close(axial_loads)
+    recorder.close(loads)
     return target

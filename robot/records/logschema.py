@@ -5,7 +5,7 @@
 are tolerated, so a writer may add fields (and a reader ignore them) without a new log version.
 A new record kind is one more entry. :func:`check_record` validates one record and raises
 :class:`LogRecordError` naming the field (``end.marks.x_buckling: expected a number or null,
-got 'abc'``); :mod:`robot.trial.log` applies it to every line it reads.
+got 'abc'``); :mod:`robot.records.log` applies it to every line it reads.
 
 The checks are the readers' needs: types, and ranges where the estimators have a domain (an
 exposed length, a Poisson ratio, a section's stiffness). Floats that were NaN or infinite are

@@ -11,7 +11,7 @@ samples after it; :attr:`TrialLogWriter.records` counts the lines on disk. A rea
 complete log (has ``end``) from a truncated one. (Batching: one flush per 25 ticks at 250 Hz
 instead of one per line, about 5 % of a bench trial's CPU.)
 
-Each record is checked against its kind's fields (:mod:`robot.trial.logschema`, the one list of
+Each record is checked against its kind's fields (:mod:`robot.records.logschema`, the one list of
 kinds and fields). A header that fails is an error naming the file and the key; any other line
 that fails is a bad line (its number and problem in :attr:`TrialLog.problems`), except a last
 line cut short by a crash (no newline at its end), which only makes the log truncated.
@@ -24,14 +24,14 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
 from palpate.config.loader import InputError
-from palpate.robot.trial.logschema import LogRecordError, check_record
-from palpate.robot.trial.recording import McapRecorder, axial_loads
+from palpate.robot.records.logschema import LogRecordError, check_record
+from palpate.robot.records.recording import McapRecorder
 
 FORMAT = "palpate-trial-log"
 VERSION = 1
@@ -59,6 +59,7 @@ class TrialLogWriter:
         fsync: bool = False,
         flush_every_s: float = 0.1,
         mcap: bool = False,
+        loads: Callable[[McapRecorder], list[float] | None] | None = None,
     ) -> None:
         if not flush_every_s >= 0:
             raise ValueError(f"flush_every_s must be >= 0, got {flush_every_s}")
@@ -72,8 +73,9 @@ class TrialLogWriter:
         self._pending_t0 = math.inf  # time ``t`` of the oldest pending sample
         self._fh: IO[str] | None = open(self.path, "x", encoding="utf-8")  # noqa: SIM115
         full = {"format": FORMAT, "version": VERSION, **header}
-        # the MCAP recording beside it (robot.trial.recording): every record, as it is written
+        # the MCAP recording beside it (robot.records.recording): every record, as it is written
         self.recording = McapRecorder(self.path.with_suffix(".mcap"), full) if mcap else None
+        self._loads = loads  # the tip force the recording derives at its close (robot.trial)
         self.write({"kind": "header", **full})
 
     def write(self, record: dict[str, Any]) -> None:
@@ -117,7 +119,7 @@ class TrialLogWriter:
             self._fh.close()
             self._fh = None
         if self.recording is not None:
-            self.recording.close(axial_loads)
+            self.recording.close(self._loads)
 
     def __enter__(self) -> TrialLogWriter:
         return self
@@ -156,7 +158,7 @@ class TrialLogError(InputError):
 
 
 def read_log(path: str | Path) -> TrialLog:
-    """Read a trial log and check every record (:mod:`robot.trial.logschema`); a bad line is
+    """Read a trial log and check every record (:mod:`robot.records.logschema`); a bad line is
     counted and kept out of ``records``. Raises :class:`TrialLogError` naming the file (and the
     header's key) when the file is not a trial log this version reads."""
     p = Path(path)

@@ -1,7 +1,7 @@
 """MCAP recordings of trials, beside the JSON Lines log (which stays the replay source).
 
-A :class:`McapRecorder` takes every record its trial log writes (``robot.trial.log``) and
-writes its ROS 2 messages (``robot.trial.ros2``) to ``<log>.mcap`` as the trial runs, flushed
+A :class:`McapRecorder` takes every record its trial log writes (``robot.records.log``) and
+writes its ROS 2 messages (``robot.records.ros2``) to ``<log>.mcap`` as the trial runs, flushed
 when the log flushes (every record that is not a sample, every 0.1 s of samples), so a crash
 keeps what the JSON log keeps. The file is written unchunked (every message a record of its
 own, readable up to the last byte written) and closed with MCAP's summary and footer; the
@@ -10,7 +10,7 @@ the trial ends the tip force is derived from every sample's strains (the estimat
 states, ``robot.trial.states``) and written as ``/tip/wrench``, and on the robot each sample's
 tip pose as ``/tf``.
 
-:func:`robot.trial.export.export` converts an existing log; :func:`read_recording` reads one
+:func:`robot.records.export.export` converts an existing log; :func:`read_recording` reads one
 back without ROS,
 through ``mcap``'s stream reader and ``mcap-ros2-support``'s CDR decoder, up to where a killed
 trial's file ends.
@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any, NamedTuple
 
-import numpy as np
 from mcap.exceptions import EndOfFile, McapError  # type: ignore[import-untyped,unused-ignore]
 from mcap.records import Channel, Message, Schema  # type: ignore[import-untyped,unused-ignore]
 from mcap.stream_reader import StreamReader  # type: ignore[import-untyped,unused-ignore]
@@ -36,8 +35,8 @@ from mcap_ros2.decoder import DecoderFactory  # type: ignore[import-untyped,unus
 
 from palpate.config.loader import from_mapping
 from palpate.config.schema import TubeConfig
-from palpate.robot.trial import cdr
-from palpate.robot.trial.ros2 import (
+from palpate.robot.records import cdr
+from palpate.robot.records.ros2 import (
     SCHEMAS,
     TOPICS,
     messages,
@@ -230,44 +229,3 @@ def _take(
         out.metadata[record.name] = dict(record.metadata)
     elif kind == "Footer":
         out.complete = True
-
-
-def axial_loads(recorder: McapRecorder) -> list[float] | None:
-    """The axial load (N) at every sample of ``recorder``: the tip grating's where the sensor
-    has one, else from its strains (the estimator's beam states), NaN where a sample has no
-    beam state (strains incomplete, or the sensor not yet out of the tube: such rows are never
-    handed to the beam model); None when the header lacks the sensor, the section or the
-    estimator's inputs."""
-    tips = [x.tip_force for x in recorder.samples]
-    if any(math.isfinite(f) for f in tips):
-        return tips
-    from palpate.robot.trial.inputs import header_sensor
-    from palpate.robot.trial.states import on_beam, record_lengths, states_at
-
-    try:
-        sensor, section, inputs = header_sensor(recorder.header)
-    except (KeyError, TypeError, ValueError):  # ConfigError is a ValueError
-        return None
-    gratings = len(sensor.used_gratings)
-    samples = recorder.samples
-    whole = [i for i, x in enumerate(samples) if _whole([x.advance, *x.strains], gratings + 1)]
-    loads = [math.nan] * len(samples)
-    if not whole:
-        return loads
-    advance = np.asarray([samples[i].advance for i in whole], dtype=np.float64)
-    lengths = record_lengths(advance, inputs)
-    keep = on_beam(lengths, sensor)
-    rows = [i for i, k in zip(whole, keep.tolist(), strict=True) if k]
-    if not rows:
-        return loads
-    strains = np.asarray([samples[i].strains for i in rows], dtype=np.float64)
-    states, _ = states_at(strains, lengths[keep], sensor, section)
-    for i, load in zip(rows, states.P.tolist(), strict=True):
-        loads[i] = load
-    return loads
-
-
-def _whole(strains: list[Any], gratings: int) -> bool:
-    return len(strains) == gratings and all(
-        isinstance(v, int | float) and math.isfinite(v) for v in strains
-    )

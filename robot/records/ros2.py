@@ -32,7 +32,7 @@ from typing import Any
 
 from palpate.config.schema import TubeConfig
 from palpate.robot.kinematics import tube_tip_in_bend_plane
-from palpate.robot.trial import cdr
+from palpate.robot.records import cdr
 
 SEP = "\n" + "=" * 80 + "\n"
 TIME = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
@@ -125,7 +125,7 @@ def _numbers(values: Sequence[Any]) -> list[float]:
 
 
 def sample_messages(record: dict[str, Any], stamp_ns: int) -> list[tuple[str, bytes]]:
-    """A ``sample`` record's two messages, CDR-encoded (``robot.trial.cdr``: they are written
+    """A ``sample`` record's two messages, CDR-encoded (``robot.records.cdr``: they are written
     every control tick)."""
     joints = cdr.joint_state(
         stamp_ns, "stage", JOINTS, _numbers([record["advance"], record["roll"]])

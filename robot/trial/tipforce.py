@@ -1,0 +1,53 @@
+"""The tip force a trial's recording derives at its close (``/tip/wrench``): the tip grating's
+load where the sensor has one, else the axial load of the estimator's beam states. Handed to
+``robot.records`` (the log writer and the export) as a function: the records serialise, this
+module computes."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from palpate.robot.records.recording import McapRecorder
+from palpate.robot.trial.inputs import header_sensor
+from palpate.robot.trial.states import on_beam, record_lengths, states_at
+
+
+def axial_loads(recorder: McapRecorder) -> list[float] | None:
+    """The axial load (N) at every sample of ``recorder``: the tip grating's where the sensor
+    has one, else from its strains (the estimator's beam states), NaN where a sample has no
+    beam state (strains incomplete, or the sensor not yet out of the tube: such rows are never
+    handed to the beam model); None when the header lacks the sensor, the section or the
+    estimator's inputs."""
+    tips = [x.tip_force for x in recorder.samples]
+    if any(math.isfinite(f) for f in tips):
+        return tips
+    try:
+        sensor, section, inputs = header_sensor(recorder.header)
+    except (KeyError, TypeError, ValueError):  # ConfigError is a ValueError
+        return None
+    gratings = len(sensor.used_gratings)
+    samples = recorder.samples
+    whole = [i for i, x in enumerate(samples) if _whole([x.advance, *x.strains], gratings + 1)]
+    loads = [math.nan] * len(samples)
+    if not whole:
+        return loads
+    advance = np.asarray([samples[i].advance for i in whole], dtype=np.float64)
+    lengths = record_lengths(advance, inputs)
+    keep = on_beam(lengths, sensor)
+    rows = [i for i, k in zip(whole, keep.tolist(), strict=True) if k]
+    if not rows:
+        return loads
+    strains = np.asarray([samples[i].strains for i in rows], dtype=np.float64)
+    states, _ = states_at(strains, lengths[keep], sensor, section)
+    for i, load in zip(rows, states.P.tolist(), strict=True):
+        loads[i] = load
+    return loads
+
+
+def _whole(strains: list[Any], gratings: int) -> bool:
+    return len(strains) == gratings and all(
+        isinstance(v, int | float) and math.isfinite(v) for v in strains
+    )
