@@ -133,6 +133,11 @@ class CampaignConfig:
         """The indentation speeds the campaign runs each trial at (mm/s)."""
         return self.indent_speeds_mm_per_s or (self.indent_speed_mm_per_s,)
 
+    @property
+    def on_tubes(self) -> bool:
+        """A robot campaign (the trials advance on the robot's tubes), not the bench column."""
+        return self.kind == "robot"
+
     def probing(self) -> bool | Literal["measure"]:
         """Whether trials probe: ``probe`` itself, or for null, robot campaigns only."""
         return self.kind == "robot" if self.probe is None else self.probe

@@ -17,9 +17,8 @@ from typing import Protocol
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import MM, StackConfig
+from palpate.config.stage import STAGE, rig_key
 from palpate.estimation.compliance import ComplianceFit, pooled
-
-STAGE = "bench-stage"  # the key of the bench-top stage's compliance
 
 
 class Calibrating(Protocol):
@@ -33,11 +32,6 @@ def is_reference(scene: SceneConfig, spec: object) -> bool:
     """Whether the trial ``spec`` (a ``TrialSpec``) indents a rigid reference of ``scene``."""
     name = getattr(spec, "sample", None)
     return any(s.rigid and s.name == name for s in scene.samples)
-
-
-def rig_key(kind: str, tube: str) -> str:
-    """Which compliance a trial uses: its tube's on the robot, the stage's on the bench."""
-    return tube if kind == "robot" else STAGE
 
 
 def calibrate(

@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 from palpate.argtypes import port_number
 from palpate.config.loader import InputError
 from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
+from palpate.config.stage import Stage
 from palpate.estimation.beamstate import infer_states
 from palpate.estimation.elastica import post_buckling
 from palpate.estimation.section import Section, sensor_section
@@ -137,10 +138,10 @@ class LiveView:
         self.scene = SceneUpdateChannel("/scene", context=ctx)
         self._closed = False
 
-    def trial(self, tube: TubeConfig | None, kind: str, exposed_length: float) -> Publisher:
-        """The publisher of one trial: ``tube`` None on the bench stage (fixed ``exposed_length``
-        m); on the robot the exposed length follows the translation."""
-        feed = _Feed(self, tube, kind, exposed_length)
+    def trial(self, stage: Stage) -> Publisher:
+        """The publisher of one trial on ``stage`` (``palpate.config.stage``): on the bench its
+        exposed length is fixed, on a tube it follows the translation."""
+        feed = _Feed(self, stage.tube, stage)
         return feed.publish
 
     def close(self) -> None:
@@ -159,8 +160,7 @@ class LiveView:
 class _Feed:
     view: LiveView
     tube: TubeConfig | None
-    kind: str
-    exposed_length: float
+    stage: Stage
     _last: float = -math.inf
     _last_scene: float = -math.inf
 
@@ -190,9 +190,7 @@ class _Feed:
             self._geometry(obs, length, shortening, stamp)
 
     def _length(self, advance: float) -> float:
-        if self.tube is None or self.kind == "bench":
-            return self.exposed_length
-        return advance - self.tube.flush_translation
+        return self.stage.exposed_length(advance)
 
     def _beam(self, strains: tuple[float, ...], length: float) -> tuple[float, float]:
         """(axial load N, end shortening m) of the tick's strains, NaN when they do not fit."""

@@ -62,7 +62,7 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
 
     for sample in scene.campaign_samples():
         for rep in range(c.repeats):
-            if c.kind == "bench":
+            if not c.on_tubes:
                 for length_mm in c.exposed_lengths_mm:
                     add(sample.name, "straight", "downward", length_mm, rep)
                 continue

@@ -27,8 +27,8 @@ from palpate.estimation.stiffness import StiffnessEstimate
 from palpate.robot.indentation import TrialMarks
 from palpate.robot.probe_result import ProbeResult, Touch
 from palpate.robot.records.log import TrialLog, TrialLogError, read_log
-from palpate.robot.trial.estimate import exposed_length_at
 from palpate.robot.trial.record import recorded_verdict
+from palpate.simulation.result import trial_stage
 from palpate.simulation.trial import TrialOutcome, TrialSpec, trial_geometry
 
 T = TypeVar("T")
@@ -77,10 +77,10 @@ def _outcome(
     spec: TrialSpec, stack: StackConfig, end: dict[str, Any], estimate: dict[str, Any], path: str
 ) -> TrialOutcome:
     marks = _marks(end["marks"])
+    geo = trial_geometry(stack, spec)
     length = None
-    if marks.x_buckling is not None:
-        flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
-        length = exposed_length_at(spec.kind, marks.x_buckling, spec.exposed_length, flush)
+    if marks.x_buckling is not None:  # as the trial computed it: on the tube the IK picked
+        length = trial_stage(spec, stack, geo).exposed_length(marks.x_buckling)
     duration = end["duration"]
     return TrialOutcome(
         spec=spec,
@@ -88,7 +88,7 @@ def _outcome(
         reason=str(end["reason"]),
         estimate=_paper(estimate),
         exposed_length_at_buckling=length,
-        ik_residual=trial_geometry(stack, spec).residual,
+        ik_residual=geo.residual,
         ticks=int(end["ticks"]),
         sim_time=math.nan if duration is None else float(duration),
         log_path=path,

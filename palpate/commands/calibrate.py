@@ -22,10 +22,11 @@ import argparse
 import json
 from pathlib import Path
 
-from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.calibration import calibrate, config_lines
 from palpate.config import load_stack
 from palpate.config.loader import InputError
 from palpate.config.schema import MM
+from palpate.config.stage import rig_key
 from palpate.estimation.compliance import ComplianceFit
 from palpate.reports.replay import replay
 from palpate.robot.records.log import read_log

@@ -28,6 +28,7 @@ from palpate.config.bench import load_bench
 from palpate.config.loader import InputError
 from palpate.config.scene import CampaignConfig, SceneConfig
 from palpate.config.schema import StackConfig
+from palpate.config.stage import Stage
 from palpate.config.targets import save_target
 from palpate.lab.hardware import open_hardware, run_on_hardware
 from palpate.live import LiveView, Publisher, add_live_argument, live_view
@@ -76,7 +77,7 @@ class Session:
     def follow_tube(self) -> None:
         """A publisher for the model's current tube (after a swap)."""
         if self.live is not None:
-            self.feed = self.live.trial(self.model.tube, "robot", 0.0)
+            self.feed = self.live.trial(Stage.on(self.model.tube, 0.0))
 
 
 @dataclass

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from palpate.calibration import calibrate, config_lines, rig_key
+from palpate.calibration import calibrate, config_lines
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.estimation.stiffness import summarize
 from palpate.estimation.verdict import STATUSES
@@ -124,9 +124,7 @@ def run(args: argparse.Namespace) -> int:
         return code
     samples = _summaries(outcomes, loaded.bench.campaign.outlier_above)
     found = calibrate(
-        (rig_key(o.trial.kind, o.trial.tube.name), o.calibration)
-        for o in outcomes
-        if o.calibration is not None
+        (o.trial.stage.rig_key, o.calibration) for o in outcomes if o.calibration is not None
     )
     trial_rows = [o.as_dict() for o in outcomes]
     payload = {

@@ -19,6 +19,7 @@ from palpate.config.bench import BenchTrialConfig, LoadedBench
 from palpate.config.loader import ConfigError, InputError
 from palpate.config.sample import AssumedConfig
 from palpate.config.schema import MM, TubeConfig
+from palpate.config.stage import Stage
 from palpate.config.targets import TargetConfig, TargetsFile, load_targets
 from palpate.robot.drive import JointLimitError, JointState, RollerGearDrive
 from palpate.robot.indentation import TrialPlan
@@ -40,6 +41,11 @@ class BenchTrial:
     plan: TrialPlan
     assumed: AssumedConfig | None = None  # the operator's belief about the sample
     rigid: bool = False  # a rigid reference: the trial calibrates the compliance
+
+    @property
+    def stage(self) -> Stage:
+        """The stage this trial advances on: the bench column or its tube."""
+        return Stage.of_tube(self.kind, self.tube, self.exposed_length)
 
     def describe(self) -> dict[str, Any]:
         p = self.plan
@@ -124,7 +130,7 @@ def _exposed_length(
 ) -> float:
     """The sensor's exposed length at the expected contact (m): the entry's (or the sensor's) on
     the bench stage, the advance past the tube's flush translation on the robot."""
-    if loaded.bench.campaign.kind == "bench":
+    if not loaded.bench.campaign.on_tubes:
         return (entry.exposed_length_mm or loaded.stack.sensor.exposed_length_mm) * MM
     length = contact - tube.flush_translation
     if length <= 0:

@@ -19,10 +19,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from palpate.calibration import calibrate, rig_key, with_compliance
+from palpate.calibration import calibrate, with_compliance
 from palpate.config.bench import LoadedBench
 from palpate.config.sample import UNKNOWN, AssumedConfig
-from palpate.config.schema import MM, StackConfig, TubeConfig
+from palpate.config.schema import MM, StackConfig
 from palpate.estimation.compliance import ComplianceFit
 from palpate.estimation.jointfit import JointFit
 from palpate.estimation.relaxation import RelaxationFit
@@ -159,9 +159,7 @@ def run_bench_trials(
         if not torque_on:
             hw.drive.bus.set_torque(True)
             torque_on = True
-        publisher = (
-            None if live is None else live.trial(_tube(trial), trial.kind, trial.exposed_length)
-        )
+        publisher = None if live is None else live.trial(trial.stage)
         before = bus_stats(hw)
         outcome, rig = _run_one(
             hw, trial, loaded, session.stack, log_dir, (sync_to_clock, publisher)
@@ -192,7 +190,7 @@ class Session:
     def add(self, trial: BenchTrial, outcome: BenchOutcome) -> None:
         if outcome.calibration is None:
             return
-        self.fits.append((rig_key(trial.kind, trial.tube.name), outcome.calibration))
+        self.fits.append((trial.stage.rig_key, outcome.calibration))
         self.stack = with_compliance(self.base, self.found)
 
     @property
@@ -206,8 +204,8 @@ def bench_inputs(trial: BenchTrial, loaded: LoadedBench, stack: StackConfig) -> 
     bonding unknown unless stated), the tube's (stage's) calibrated compliance in ``stack``,
     the campaign's limits. The misalignment is not measured at a stored pose (0)."""
     c = loaded.bench.campaign
-    robot = trial.kind == "robot"
-    compliance, calibrated = stack.compliance(trial.tube.name if robot else None)
+    stage = trial.stage
+    compliance, calibrated = stack.compliance(None if stage.tube is None else stage.tube.name)
     belief = belief_fields(trial.assumed, thickness=UNKNOWN, bonded=UNKNOWN, poisson=trial.poisson)
     return EstimatorInputs(
         kind=trial.kind,
@@ -224,10 +222,6 @@ def bench_inputs(trial: BenchTrial, loaded: LoadedBench, stack: StackConfig) -> 
         rigid=trial.rigid,
         **belief,
     )
-
-
-def _tube(trial: BenchTrial) -> TubeConfig | None:
-    return trial.tube if trial.kind == "robot" else None
 
 
 def _run_one(
@@ -274,7 +268,7 @@ def _run_one(
         estimate=estimate,
         log_path=log_dir / f"{trial.trial_id}.jsonl",
         header=_header(trial, loaded, section, inputs),
-        prober=prober_for(c, stack, trial.tube, radius) if trial.kind == "robot" else None,
+        prober=None if trial.stage.tube is None else prober_for(c, stack, trial.tube, radius),
         on_tick=publisher,
     )
     done = run_session_trial(rig, hw.clock, setup)
@@ -312,7 +306,7 @@ def _header(
 ) -> dict[str, Any]:
     """The log header; the keys ``palpate replay`` reads are those of a simulated trial."""
     stack = loaded.stack
-    tube = trial.tube if trial.kind == "robot" else None
+    tube = trial.stage.tube
     return {
         "trial": trial.trial_id,
         "source": "bench",

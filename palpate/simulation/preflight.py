@@ -28,7 +28,7 @@ def check_campaign(
             f"'tip' needs a tip force grating: {robot_source} has no sensor.tip_grating",
         )
     known = [t.name for t in stack.tubes]
-    if scene.campaign.kind != "robot":
+    if not scene.campaign.on_tubes:
         return
     for i, name in enumerate(scene.campaign.tubes):
         if name not in known:

@@ -14,6 +14,7 @@ from typing import Any
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
+from palpate.config.stage import Stage
 from palpate.estimation.compliance import ComplianceFit
 from palpate.estimation.jointfit import JointFit
 from palpate.estimation.misalignment import Lean
@@ -135,18 +136,25 @@ def _deg(x: float | None) -> float | None:
 def estimate_sim_trial(
     result: TrialResult, spec: TrialSpec, scene: SceneConfig, stack: StackConfig, geo: TrialGeometry
 ) -> TrialEstimate:
-    flush = stack.tube(spec.tube).flush_translation if spec.kind == "robot" else 0.0
     inputs = estimator_inputs(spec, scene, stack, geo, misalignment_of(result, geo), result.probe)
+    stage = inputs.stage  # one flush translation for both estimates: the tube the IK picked
     return estimate_trial(
         result,
-        kind=spec.kind,
-        exposed_length=spec.exposed_length,
-        flush_translation=flush,
+        kind=stage.kind,
+        exposed_length=stage.exposed,
+        flush_translation=stage.flush,
         stack=stack,
         section=sensor_section(stack),
         poisson=inputs.poisson,
         inputs=inputs,
     )
+
+
+def trial_stage(spec: TrialSpec, stack: StackConfig, geo: TrialGeometry) -> Stage:
+    """The trial's stage as it runs: the bench column, or the tube the inverse kinematics
+    picked (``geo.tube``, which may be another than the spec names)."""
+    stage = spec.stage(stack)
+    return stage if stage.tube is None else Stage.on(stack.tube(geo.tube), stage.exposed)
 
 
 def misalignment_of(result: TrialResult, geo: TrialGeometry) -> float:
@@ -201,8 +209,8 @@ def estimator_inputs(
     campaign's limits; never the simulator's switches."""
     sample = trial_sample(scene, spec)
     c = scene.campaign
-    robot = spec.kind == "robot"
-    compliance, calibrated = stack.compliance(geo.tube if robot else None)
+    stage = trial_stage(spec, stack, geo)
+    compliance, calibrated = stack.compliance(None if stage.tube is None else stage.tube.name)
     belief = belief_fields(
         sample.assumed,
         thickness=sample.thickness,
@@ -211,9 +219,9 @@ def estimator_inputs(
         surface_radius=sample.curvature_radius,
     )
     return EstimatorInputs(
-        kind=spec.kind,
-        exposed_length=spec.exposed_length,
-        flush_translation=stack.tube(geo.tube).flush_translation if robot else 0.0,
+        kind=stage.kind,
+        exposed_length=stage.exposed,
+        flush_translation=stage.flush,
         tip_radius=stack.sensor.tip_radius,
         encoder_resolution=stack.drive.lead / TICKS_PER_REV,
         misalignment=geo.residual if misalignment is None else misalignment,

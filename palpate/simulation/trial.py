@@ -22,6 +22,7 @@ from typing import Any, Literal, Protocol
 from palpate.config.sample import AssumedConfig
 from palpate.config.scene import CampaignConfig, FidelityConfig, SceneConfig
 from palpate.config.schema import ServoBusConfig, StackConfig
+from palpate.config.stage import Stage
 from palpate.live import LiveView
 from palpate.robot.drive import DriveController
 from palpate.robot.dynamixel.driver import DynamixelBus
@@ -45,7 +46,13 @@ from palpate.sim.dynamixel.direct import direct_transport
 from palpate.sim.dynamixel.timing import BusTiming
 from palpate.sim.inprocess import FramePipe, InProcessPort, MemorySerial
 from palpate.sim.world import World
-from palpate.simulation.result import TrialOutcome, estimate_sim_trial, estimator_inputs, outcome_of
+from palpate.simulation.result import (
+    TrialOutcome,
+    estimate_sim_trial,
+    estimator_inputs,
+    outcome_of,
+    trial_stage,
+)
 from palpate.simulation.world import (
     ServoJoints,
     TrialGeometry,
@@ -172,7 +179,8 @@ def run_sim_trial(
     servos = ServoJoints(stack)
     world = trial_world(spec, scene, stack, geo, servos)
     series: dict[str, list[float]] = {}
-    on_tick = _on_tick(world, series if keep_series else None, live, stack, spec)
+    stage = trial_stage(spec, stack, geo)
+    on_tick = _on_tick(world, series if keep_series else None, live, stage)
     timing = bus_timing(scene.fidelity, stack.servos)
     with _emulators(transport, stack, clock, world, hook, timing) as emulators:
         bus, board, servo_port, handler, board_port = emulators
@@ -197,7 +205,7 @@ def run_sim_trial(
                 log_path=None if log_dir is None else log_dir / f"{spec.trial_id}.jsonl",
                 header=_header(spec, scene, stack, plan, geo),
                 mcap=scene.mcap,
-                prober=_prober(spec, scene, stack, geo.tube),
+                prober=_prober(spec, scene, stack, stage),
                 on_tick=on_tick,
                 on_log=None if hook is None else hook.log_opened,
                 # the world's truth the controller never sees, for the report (and --resume)
@@ -262,13 +270,11 @@ def _on_tick(
     world: World,
     series: dict[str, list[float]] | None,
     live: LiveView | None,
-    stack: StackConfig,
-    spec: TrialSpec,
+    stage: Stage,
 ) -> Callable[[Observation, State], None] | None:
     """The trial's ``on_tick``: the series recorder (with ``series``), the live view's feed."""
     recorder = None if series is None else _series_recorder(world, series)
-    tube = stack.tube(spec.tube) if spec.kind == "robot" else None
-    feed = None if live is None else live.trial(tube, spec.kind, spec.exposed_length)
+    feed = None if live is None else live.trial(stage)
     return _ticks(recorder, feed)
 
 
@@ -312,7 +318,7 @@ def _header(
     plan: TrialPlan,
     geo: TrialGeometry,
 ) -> dict[str, Any]:
-    tube = stack.tube(geo.tube) if spec.kind == "robot" else None
+    tube = trial_stage(spec, stack, geo).tube
     inputs = estimator_inputs(spec, scene, stack, geo)
     return {
         "trial": spec.trial_id,
@@ -324,12 +330,12 @@ def _header(
 
 
 def _prober(
-    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, tube: str
+    spec: TrialSpec, scene: SceneConfig, stack: StackConfig, stage: Stage
 ) -> Callable[[TrialPlan], Prober] | None:
     """A robot trial's probing step, told the convex surface's radius the operator believes
     for its sample (its ``assumed:``, else its own); None on the bench or without probing."""
-    if spec.kind != "robot":
+    if stage.tube is None:
         return None
     sample = trial_sample(scene, spec)
     radius = (sample.assumed or AssumedConfig()).surface_radius(sample.curvature_radius)
-    return prober_for(trial_campaign(spec, scene), stack, stack.tube(tube), radius)
+    return prober_for(trial_campaign(spec, scene), stack, stage.tube, radius)

@@ -21,10 +21,10 @@ from palpate.config.loader import InputError
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import FidelityConfig, SceneConfig
 from palpate.config.schema import StackConfig, TubeConfig
+from palpate.config.stage import Stage
 from palpate.robot import kinematics
 from palpate.robot.drive import TRANSLATION, RollerGearDrive
 from palpate.robot.dynamixel.units import rad_from_ticks
-from palpate.robot.trial.estimate import exposed_length_at
 from palpate.robot.trial.setup import sensor_section
 from palpate.sim.dynamixel.bus import EmulatedBus
 from palpate.sim.equilibrium import TissueLaw
@@ -54,6 +54,10 @@ class TrialSpec:
     seed: int
     reference: float | None = None  # Pa, the reported reference modulus; None: the truth
     indent_speed: float | None = None  # m/s; None: the campaign's indent_speed_mm_per_s
+
+    def stage(self, stack: StackConfig) -> Stage:
+        """The stage this trial advances on (the bench column or its tube in ``stack``)."""
+        return Stage.in_stack(self.kind, stack, self.tube, self.exposed_length)
 
     @property
     def reported(self) -> float:
@@ -134,20 +138,22 @@ def trial_geometry(
 ) -> TrialGeometry:
     """Where the sample is and how the robot reaches it; ValueError if it cannot. ``sample``:
     the scene's, for its pose (None: the plan's surface, facing the tube at the target)."""
-    if spec.kind == "bench":
+    if spec.stage(stack).tube is None:
         return _bench_geometry(stack, spec, sample)
     return _robot_geometry(stack, spec, sample)
 
 
 def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
-    if spec.kind == "bench":
-        length = spec.exposed_length
+    stage = spec.stage(stack)
+    if stage.tube is None:
+        length = stage.exposed
 
         def bench_pose(roll: float, translation: float) -> tuple[Any, Any, float]:
             return translation * VERTICAL, VERTICAL, length
 
         return bench_pose
-    tube = stack.tube(tube_name)
+    tube = stack.tube(tube_name)  # the tube the inverse kinematics picked
+    on_tube = Stage.on(tube, stage.exposed)
     frame_roll = math.nan
     frame = kinematics.forward(tube, 0.0, 0.0)
 
@@ -157,8 +163,7 @@ def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
         nonlocal frame, frame_roll
         if roll != frame_roll:
             frame, frame_roll = kinematics.forward(tube, roll, 0.0), roll
-        length = exposed_length_at("robot", translation, 0.0, tube.flush_translation)
-        return frame.tube_tip, frame.tangent, length
+        return frame.tube_tip, frame.tangent, on_tube.exposed_length(translation)
 
     return robot_pose
 
@@ -225,7 +230,7 @@ def trial_world(
         joints=servos.read,
         rng=np.random.default_rng(spec.seed),
         has_force=stack.board.has_force,
-        length_grows=spec.kind == "robot",
+        length_grows=spec.stage(stack).grows,
         encoder_step=stack.drive.lead / TICKS_PER_REV,
         relaxation=relaxation(sample, scene.fidelity),
         friction=sample.friction,

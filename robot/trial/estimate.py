@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from palpate.config.schema import SensorConfig, StackConfig
+from palpate.config.stage import Stage
 from palpate.estimation.beam import Beam
 from palpate.estimation.beamstate import BeamStates
 from palpate.estimation.compliance import ComplianceFit, fit_compliance, less
@@ -235,8 +236,8 @@ def verdict_for(
     ``buckling_tip_load``: the tip grating's load at the buckling mark (N), None without one;
     ``bow``: w0/L fitted against the tip grating's load (``RecordEstimate.tip_bow``)."""
     length = inputs.exposed_length
-    if inputs.kind == "robot" and joint is not None and joint.contact is not None:
-        length = joint.contact - inputs.flush_translation
+    if joint is not None and joint.contact is not None:
+        length = inputs.stage.exposed_length(joint.contact)
     facts = TrialFacts(
         state=state,
         reason=reason,
@@ -261,9 +262,7 @@ def verdict_for(
 def exposed_length_at(kind: str, x: float, fixed_length: float, flush_translation: float) -> float:
     """Exposed length (m) at stage position ``x``: fixed on the bench, on the robot the stage
     translation past the tube's flush translation. Shared by the trial and ``palpate replay``."""
-    if kind == "bench":
-        return fixed_length
-    return x - flush_translation
+    return Stage.of(kind, fixed_length, flush_translation).exposed_length(x)
 
 
 def estimate_from_marks(

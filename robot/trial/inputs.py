@@ -17,6 +17,7 @@ from typing import Any
 from palpate.config.loader import from_mapping
 from palpate.config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
 from palpate.config.schema import MM, SensorConfig
+from palpate.config.stage import Stage
 from palpate.estimation.belief import Belief
 from palpate.estimation.corrections import ContactLaw
 from palpate.estimation.section import Section
@@ -82,6 +83,12 @@ class EstimatorInputs:
     probe_reason: str | None = None
     surface_radius: float | None = None
     version: int = VERSION
+
+    @property
+    def stage(self) -> Stage:
+        """The stage these inputs describe (``palpate.config.stage``): the bench's fixed
+        exposed length, or a tube's flush translation."""
+        return Stage.of(self.kind, self.exposed_length, self.flush_translation)
 
     @property
     def contact_radius(self) -> float:

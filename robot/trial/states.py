@@ -70,6 +70,4 @@ def on_beam(lengths: FloatArray, sensor: SensorConfig) -> NDArray[np.bool_]:
 def record_lengths(advance: FloatArray, inputs: EstimatorInputs) -> FloatArray:
     """The exposed length (m) at each row: the bench's fixed one, or the robot's advance past
     the tube's flush translation (<= 0 while the sensor is still inside the tube)."""
-    if inputs.kind == "robot":
-        return np.asarray(advance - inputs.flush_translation)
-    return np.full(advance.size, inputs.exposed_length)
+    return inputs.stage.exposed_lengths(advance)
