@@ -37,7 +37,7 @@ from palpate.robot.indentation import PLANNED_ENDS
 from palpate.robot.rig import ServoFbgRig
 from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from palpate.robot.trial.inputs import belief_fields, probe_inputs
-from palpate.robot.trial.record import header_common, relaxed_row
+from palpate.robot.trial.record import estimate_row, header_common
 from palpate.robot.trial.run import TrialResult
 from palpate.robot.trial.session import TrialSetup, run_session_trial
 from palpate.robot.trial.setup import (
@@ -81,36 +81,22 @@ class BenchOutcome:
         return self.joint.modulus
 
     def as_dict(self) -> dict[str, Any]:
-        est, t, jf = self.estimate, self.trial, self.joint
-        paper = None if est is None else est.modulus
+        t = self.trial
         modulus = self.modulus()
         rel = None
         if modulus is not None and t.modulus is not None:
             rel = (modulus - t.modulus) / t.modulus
-        shown = jf if modulus is not None else None
         return {
             **t.describe(),
             "state": self.state,
             "reason": self.reason,
-            "joint_kpa": None if modulus is None else modulus / 1e3,
-            "joint_ci_kpa": None if shown is None else [_kpa(shown.ci_low), _kpa(shown.ci_high)],
-            "verdict": self.status if self.calibration is None else None,
-            "verdict_reasons": [] if self.verdict is None else list(self.verdict.reasons),
-            "paper_kpa": None if paper is None else paper / 1e3,
+            **estimate_row(self),
             "actual_kpa": None if t.modulus is None else t.modulus / 1e3,
             "relative_error": rel,
-            "paper_delta_mm": None if est is None else est.delta / MM,
-            "paper_force_n": None if est is None else est.force,
-            "calibration": None if self.calibration is None else self.calibration.as_dict(),
-            **relaxed_row(self.relaxation, self.relaxed_verdict),
             "duration_s": self.duration,
             "bus": self.bus,
             "log": self.log_path,
         }
-
-
-def _kpa(v: float | None) -> float | None:
-    return None if v is None else v / 1e3
 
 
 def bus_stats(hw: Hardware) -> BusStats | None:

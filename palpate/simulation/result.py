@@ -26,7 +26,7 @@ from palpate.robot.indentation import TrialMarks
 from palpate.robot.probe_result import ProbeResult
 from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from palpate.robot.trial.inputs import belief_fields
-from palpate.robot.trial.record import relaxed_row
+from palpate.robot.trial.record import estimate_row
 from palpate.robot.trial.run import TrialResult
 from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.world import TrialGeometry, TrialSpec, trial_sample
@@ -77,13 +77,7 @@ class TrialOutcome:
         raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
 
     def as_dict(self) -> dict[str, Any]:
-        est = self.estimate
         jf = self.joint
-
-        def kpa(v: float | None) -> float | None:
-            return None if v is None else v / 1e3
-
-        shown = jf if self.status != "none" else None
         bow = self.southwell
         return {
             "trial": self.spec.trial_id,
@@ -93,20 +87,13 @@ class TrialOutcome:
             "roll_deg": math.degrees(self.spec.roll),
             "exposed_length_mm": self.spec.exposed_length * 1e3,
             "actual_kpa": self.spec.modulus / 1e3,
-            "reference_kpa": kpa(self.spec.reference),
-            "paper_kpa": None if est is None or est.modulus is None else est.modulus / 1e3,
-            "paper_delta_mm": None if est is None else est.delta * 1e3,
-            "paper_force_n": None if est is None else est.force,
-            "joint_kpa": kpa(None if shown is None else shown.modulus),
-            "joint_ci_kpa": None if shown is None else [kpa(shown.ci_low), kpa(shown.ci_high)],
+            "reference_kpa": None if self.spec.reference is None else self.spec.reference / 1e3,
+            **estimate_row(self),
             "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,
             "joint_message": "no loading record" if jf is None else jf.message,
-            "verdict": self.status,
-            "verdict_reasons": [] if self.verdict is None else list(self.verdict.reasons),
             "model_form": None if jf is None else jf.model_form,
             "best_fit": None if jf is None else jf.best,
             "w0_over_l": None if bow is None else bow.w0_over_l,
-            "calibration": None if self.calibration is None else self.calibration.as_dict(),
             "warnings": [] if jf is None else list(jf.warnings),
             "state": self.state,
             "reason": self.reason,
@@ -115,7 +102,6 @@ class TrialOutcome:
             "true_misalignment_deg": _deg(self.true_misalignment),
             "probe": None if self.probe is None else self.probe.summary(),
             "strain_lean": None if self.lean is None else self.lean.as_dict(),
-            **relaxed_row(self.relaxation, self.relaxed_verdict),
             "probing_s": self.probing_time,
             "sim_time_s": self.sim_time,
             "log": self.log_path,

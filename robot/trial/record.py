@@ -17,7 +17,7 @@ written here, and read back here (:func:`recorded_verdict`), tolerant of logs th
 from __future__ import annotations
 
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from palpate.config.schema import SensorConfig, TubeConfig
 from palpate.estimation.compliance import ComplianceFit
@@ -26,6 +26,7 @@ from palpate.estimation.misalignment import Lean
 from palpate.estimation.relaxation import RelaxationFit
 from palpate.estimation.section import Section
 from palpate.estimation.southwell import SouthwellFit
+from palpate.estimation.stiffness import StiffnessEstimate
 from palpate.estimation.verdict import Verdict
 from palpate.robot.indentation import TrialPlan
 
@@ -128,19 +129,53 @@ def estimator_keys(
     return out
 
 
+class Estimated(Protocol):
+    """A finished trial's estimates, as both outcome types hold them (the simulator's
+    ``TrialOutcome``, the bench's ``BenchOutcome``)."""
+
+    estimate: StiffnessEstimate | None  # the paper's single point (Eqs. 13-14)
+    joint: JointFit | None
+    verdict: Verdict | None
+    calibration: ComplianceFit | None
+    relaxation: RelaxationFit | None
+    relaxed_verdict: Verdict | None
+
+
+def estimate_row(o: Estimated) -> dict[str, Any]:
+    """A trial row's estimate keys (``--json`` of ``palpate sim`` and ``palpate trial``, the
+    run folder's ``trials.csv``): the joint fit's number and interval (none where its verdict
+    is ``none``), the verdict (none on a rigid reference: a calibration), the paper's single
+    point beside it, the calibration and a hold's relaxed modulus; moduli in kPa."""
+    status = "none" if o.verdict is None else o.verdict.status
+    shown = o.joint if status != "none" else None
+    est = o.estimate
+    return {
+        "joint_kpa": None if shown is None else _kpa(shown.modulus),
+        "joint_ci_kpa": None if shown is None else [_kpa(shown.ci_low), _kpa(shown.ci_high)],
+        "verdict": status if o.calibration is None else None,
+        "verdict_reasons": [] if o.verdict is None else list(o.verdict.reasons),
+        "paper_kpa": None if est is None else _kpa(est.modulus),
+        "paper_delta_mm": None if est is None else est.delta * 1e3,
+        "paper_force_n": None if est is None else est.force,
+        "calibration": None if o.calibration is None else o.calibration.as_dict(),
+        **relaxed_row(o.relaxation, o.relaxed_verdict),
+    }
+
+
+def _kpa(v: float | None) -> float | None:
+    return None if v is None else v / 1e3
+
+
 def relaxed_row(fit: RelaxationFit | None, verdict: Verdict | None) -> dict[str, Any]:
     """A trial's row keys (``--json`` of ``palpate sim`` and ``palpate trial``) of its
     relaxation fit, moduli in kPa; empty for a trial that did not hold."""
     if fit is None:
         return {}
 
-    def kpa(v: float | None) -> float | None:
-        return None if v is None else v / 1e3
-
     return {
-        "relaxed_kpa": kpa(fit.relaxed),
-        "relaxed_ci_kpa": [kpa(fit.relaxed_low), kpa(fit.relaxed_high)],
-        "instantaneous_kpa": kpa(fit.instantaneous),
+        "relaxed_kpa": _kpa(fit.relaxed),
+        "relaxed_ci_kpa": [_kpa(fit.relaxed_low), _kpa(fit.relaxed_high)],
+        "instantaneous_kpa": _kpa(fit.instantaneous),
         "relaxation_time_s": fit.relaxation_time,
         "relaxes": fit.relaxes,
         "relaxation_complete": fit.complete,
