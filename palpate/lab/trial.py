@@ -24,11 +24,7 @@ from palpate.config.bench import LoadedBench
 from palpate.config.sample import UNKNOWN, AssumedConfig
 from palpate.config.schema import MM, StackConfig
 from palpate.estimation.compliance import ComplianceFit
-from palpate.estimation.jointfit import JointFit
-from palpate.estimation.relaxation import RelaxationFit
 from palpate.estimation.section import Section
-from palpate.estimation.stiffness import StiffnessEstimate
-from palpate.estimation.verdict import Verdict
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
 from palpate.live import LiveView, Publisher
@@ -37,7 +33,8 @@ from palpate.robot.indentation import PLANNED_ENDS
 from palpate.robot.rig import ServoFbgRig
 from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from palpate.robot.trial.inputs import belief_fields, probe_inputs
-from palpate.robot.trial.record import estimate_row, header_common
+from palpate.robot.trial.outcome import Outcome, outcome_fields
+from palpate.robot.trial.record import header_common
 from palpate.robot.trial.run import TrialResult
 from palpate.robot.trial.session import TrialSetup, run_session_trial
 from palpate.robot.trial.setup import (
@@ -54,31 +51,13 @@ PLANNED = frozenset(s.value for s in PLANNED_ENDS)  # trial ends that keep torqu
 
 
 @dataclass
-class BenchOutcome:
+class BenchOutcome(Outcome):
+    """A bench trial's outcome (``robot.trial.outcome.Outcome``) with the bench file's planned
+    trial (its stated modulus in ``trial.modulus``) and the servo bus's counters."""
+
     trial: BenchTrial
-    state: str
-    reason: str
-    estimate: StiffnessEstimate | None = None  # the paper's (Eqs. 13-14)
-    exposed_length_at_buckling: float | None = None
     duration: float = 0.0
-    log_path: str | None = None
-    joint: JointFit | None = None  # the joint fit: the headline estimate
-    verdict: Verdict | None = None
-    calibration: ComplianceFit | None = None  # on a rigid reference
-    relaxation: RelaxationFit | None = None  # a trial that held: relaxed and instantaneous moduli
-    relaxed_verdict: Verdict | None = None
     bus: dict[str, object] | None = None  # the servo bus during the trial (BusStats, measured)
-
-    @property
-    def status(self) -> str:
-        """The verdict's status ("none" without one)."""
-        return "none" if self.verdict is None else self.verdict.status
-
-    def modulus(self) -> float | None:
-        """The joint fit's modulus (Pa), None when its verdict is ``none``."""
-        if self.joint is None or self.status == "none":
-            return None
-        return self.joint.modulus
 
     def as_dict(self) -> dict[str, Any]:
         t = self.trial
@@ -90,7 +69,7 @@ class BenchOutcome:
             **t.describe(),
             "state": self.state,
             "reason": self.reason,
-            **estimate_row(self),
+            **self.estimate_row(),
             "actual_kpa": None if t.modulus is None else t.modulus / 1e3,
             "relative_error": rel,
             "duration_s": self.duration,
@@ -140,7 +119,8 @@ def run_bench_trials(
     stopped = False
     for trial in trials:
         if stopped:
-            outcomes.append(BenchOutcome(trial, SKIPPED, "an earlier trial did not complete"))
+            why = "an earlier trial did not complete"
+            outcomes.append(BenchOutcome(trial, state=SKIPPED, reason=why))
             continue
         if not torque_on:
             hw.drive.bus.set_torque(True)
@@ -258,33 +238,8 @@ def _run_one(
         on_tick=publisher,
     )
     done = run_session_trial(rig, hw.clock, setup)
-    r = done.result
-    path = Path(str(done.log_path))
-    return _outcome(trial, r.state.value, r.reason, done.estimate, r.duration, path), rig
-
-
-def _outcome(
-    trial: BenchTrial,
-    state: str,
-    reason: str,
-    estimate: TrialEstimate,
-    duration: float,
-    path: Path,
-) -> BenchOutcome:
-    return BenchOutcome(
-        trial,
-        state,
-        reason,
-        estimate.paper,
-        estimate.exposed_length_at_buckling,
-        duration,
-        str(path),
-        estimate.joint,
-        estimate.verdict,
-        estimate.calibration,
-        estimate.relaxation,
-        estimate.relaxed_verdict,
-    )
+    fields = outcome_fields(done.result, done.estimate, done.log_path)
+    return BenchOutcome(trial, duration=done.result.duration, **fields), rig
 
 
 def _header(

@@ -15,18 +15,10 @@ from typing import Any
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.config.stage import Stage
-from palpate.estimation.compliance import ComplianceFit
-from palpate.estimation.jointfit import JointFit
-from palpate.estimation.misalignment import Lean
-from palpate.estimation.relaxation import RelaxationFit
-from palpate.estimation.southwell import SouthwellFit
-from palpate.estimation.stiffness import StiffnessEstimate
-from palpate.estimation.verdict import Verdict
-from palpate.robot.indentation import TrialMarks
 from palpate.robot.probe_result import ProbeResult
 from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
 from palpate.robot.trial.inputs import belief_fields
-from palpate.robot.trial.record import estimate_row
+from palpate.robot.trial.outcome import Outcome, outcome_fields
 from palpate.robot.trial.run import TrialResult
 from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.world import TrialGeometry, TrialSpec, trial_sample
@@ -34,47 +26,19 @@ from palpate.wire.dynamixel import TICKS_PER_REV
 
 
 @dataclass
-class TrialOutcome:
+class TrialOutcome(Outcome):
+    """A simulated trial's outcome (``robot.trial.outcome.Outcome``) with its campaign context:
+    the spec (the world's truth in ``spec.modulus``), the IK residual, the simulated time."""
+
     spec: TrialSpec
-    state: str
-    reason: str
-    estimate: StiffnessEstimate | None
-    exposed_length_at_buckling: float | None
     ik_residual: float
     ticks: int
     sim_time: float
-    log_path: str | None
     series: dict[str, list[float]] = field(default_factory=dict)
-    marks: TrialMarks | None = None  # encoder at contact and at buckling, strains at buckling
-    joint: JointFit | None = None  # the contact-point-free estimate (robot.trial.estimate)
-    joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
-    verdict: Verdict | None = None  # ok, suspect (reasons) or none (why)
-    southwell: SouthwellFit | None = None  # the beam's bow, fitted from the record
-    calibration: ComplianceFit | None = None  # on a rigid reference: the rig's compliance
-    lean: Lean | None = None  # the load's lean from the strains (estimation.misalignment)
-    relaxation: RelaxationFit | None = None  # relaxed and instantaneous moduli (a trial that held)
-    relaxed_verdict: Verdict | None = None  # the verdict on the relaxed modulus
-
     misalignment: float = 0.0  # rad, what the estimator was told (probing's, or the IK's)
     true_misalignment: float | None = None  # rad, the world's at the indentation (sim truth)
     probe: ProbeResult | None = None
     probing_time: float = 0.0  # simulated s in the probing step
-
-    @property
-    def status(self) -> str:
-        """The verdict's status ("none" without one)."""
-        return "none" if self.verdict is None else self.verdict.status
-
-    def modulus(self, method: str = "joint") -> float | None:
-        """E (Pa) by ``"joint"`` (the whole-record fit; None when its verdict is ``none``) or
-        ``"paper"`` (Eqs. 13-14)."""
-        if method == "joint":
-            if self.joint is None or self.status == "none":
-                return None
-            return self.joint.modulus
-        if method == "paper":
-            return None if self.estimate is None else self.estimate.modulus
-        raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
 
     def as_dict(self) -> dict[str, Any]:
         jf = self.joint
@@ -88,7 +52,7 @@ class TrialOutcome:
             "exposed_length_mm": self.spec.exposed_length * 1e3,
             "actual_kpa": self.spec.modulus / 1e3,
             "reference_kpa": None if self.spec.reference is None else self.spec.reference / 1e3,
-            **estimate_row(self),
+            **self.estimate_row(),
             "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,
             "joint_message": "no loading record" if jf is None else jf.message,
             "model_form": None if jf is None else jf.model_form,
@@ -158,24 +122,11 @@ def outcome_of(
 ) -> TrialOutcome:
     return TrialOutcome(
         spec=spec,
-        state=result.state.value,
-        reason=result.reason,
-        estimate=estimate.paper,
-        exposed_length_at_buckling=estimate.exposed_length_at_buckling,
         ik_residual=geo.residual,
         ticks=result.ticks,
         sim_time=result.duration,
-        log_path=log_path,
         series=series,
-        marks=result.marks,
-        joint=estimate.joint,
-        joint_seconds=estimate.joint_seconds,
-        verdict=estimate.verdict,
-        southwell=estimate.southwell,
-        calibration=estimate.calibration,
-        lean=estimate.lean,
-        relaxation=estimate.relaxation,
-        relaxed_verdict=estimate.relaxed_verdict,
+        **outcome_fields(result, estimate, log_path),
         misalignment=misalignment_of(result, geo),
         probe=result.probe,
         probing_time=result.probing_time,

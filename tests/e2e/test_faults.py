@@ -77,7 +77,15 @@ def test_servo_timeout_retracts_blind_once_the_bus_returns(tmp_path: Path) -> No
 
 
 def _outcome(job: FaultJob, log: str | None, state: str = "fault") -> TrialOutcome:
-    return TrialOutcome(job.spec, state, "servo fault", None, None, 0.0, 5, 1.0, log)
+    return TrialOutcome(
+        spec=job.spec,
+        ik_residual=0.0,
+        ticks=5,
+        sim_time=1.0,
+        state=state,
+        reason="servo fault",
+        log_path=log,
+    )
 
 
 def test_judge_catches_a_servo_left_pushing_and_a_missing_log(tmp_path: Path) -> None:

@@ -1,0 +1,100 @@
+"""One outcome type for a finished trial, on the bench and in simulation: how it ended and what it
+estimated, with one serialisation of the estimates (``robot.trial.record.estimate_row``).
+
+The simulator's ``TrialOutcome`` and the bench's ``BenchOutcome`` are this type with their own
+context beside it (the campaign's trial spec and IK residual; the bench file's planned trial
+and the bus counters)::
+
+    done = run_session_trial(rig, clock, setup)
+    fields = outcome_fields(done.result, done.estimate, done.log_path)
+    outcome = BenchOutcome(trial, **fields)
+    outcome.modulus("joint"), outcome.status, outcome.estimate_row()
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from palpate.estimation.compliance import ComplianceFit
+from palpate.estimation.jointfit import JointFit
+from palpate.estimation.misalignment import Lean
+from palpate.estimation.relaxation import RelaxationFit
+from palpate.estimation.southwell import SouthwellFit
+from palpate.estimation.stiffness import StiffnessEstimate
+from palpate.estimation.verdict import Verdict
+from palpate.robot.plan import TrialMarks
+from palpate.robot.trial.estimate import TrialEstimate
+from palpate.robot.trial.record import estimate_row
+from palpate.robot.trial.run import TrialResult
+
+
+@dataclass(kw_only=True)
+class Outcome:
+    """A finished trial (keyword fields: its context's come first in the subclasses).
+
+    Attributes:
+        state, reason: how it ended (``robot.plan.State``'s value) and why.
+        log_path: its log (None: none written); marks: encoder at contact and at buckling.
+        estimate: the paper's single point (Eqs. 13-14); exposed_length_at_buckling: L (m).
+        joint: the joint fit (the headline estimate); verdict: ok, suspect or none, with
+            reasons; southwell: the beam's bow; calibration: on a rigid reference, the rig's
+            compliance instead; lean: the load's lean; relaxation and relaxed_verdict: a hold's.
+    """
+
+    state: str
+    reason: str
+    log_path: str | None = None
+    marks: TrialMarks | None = None
+    estimate: StiffnessEstimate | None = None
+    exposed_length_at_buckling: float | None = None
+    joint: JointFit | None = None
+    joint_seconds: float | None = None  # wall time of the joint fit (for reports, not tests)
+    verdict: Verdict | None = None
+    southwell: SouthwellFit | None = None
+    calibration: ComplianceFit | None = None
+    lean: Lean | None = None
+    relaxation: RelaxationFit | None = None
+    relaxed_verdict: Verdict | None = None
+
+    @property
+    def status(self) -> str:
+        """The verdict's status ("none" without one)."""
+        return "none" if self.verdict is None else self.verdict.status
+
+    def modulus(self, method: str = "joint") -> float | None:
+        """E (Pa) by ``"joint"`` (the whole-record fit; None when its verdict is ``none``) or
+        ``"paper"`` (Eqs. 13-14)."""
+        if method == "joint":
+            if self.joint is None or self.status == "none":
+                return None
+            return self.joint.modulus
+        if method == "paper":
+            return None if self.estimate is None else self.estimate.modulus
+        raise ValueError(f"method must be 'joint' or 'paper', got {method!r}")
+
+    def estimate_row(self) -> dict[str, Any]:
+        """The row's estimate keys (``robot.trial.record.estimate_row``)."""
+        return estimate_row(self)
+
+
+def outcome_fields(
+    result: TrialResult, estimate: TrialEstimate, log_path: str | None
+) -> dict[str, Any]:
+    """The :class:`Outcome` fields of a trial the session ran (keywords for its subclasses)."""
+    return {
+        "state": result.state.value,
+        "reason": result.reason,
+        "log_path": log_path,
+        "marks": result.marks,
+        "estimate": estimate.paper,
+        "exposed_length_at_buckling": estimate.exposed_length_at_buckling,
+        "joint": estimate.joint,
+        "joint_seconds": estimate.joint_seconds,
+        "verdict": estimate.verdict,
+        "southwell": estimate.southwell,
+        "calibration": estimate.calibration,
+        "lean": estimate.lean,
+        "relaxation": estimate.relaxation,
+        "relaxed_verdict": estimate.relaxed_verdict,
+    }
