@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from palpate.config.loader import (
+from .loader import (
     CONFIG_DIR,
     ConfigError,
     InputError,
@@ -16,7 +16,7 @@ from palpate.config.loader import (
     read_yaml,
     resolve,
 )
-from palpate.config.schema import StackConfig
+from .schema import StackConfig
 
 __all__ = [
     "CONFIG_DIR",

@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from palpate.config.loader import ConfigError, limits, load, resolve
-from palpate.config.sample import AssumedConfig
-from palpate.config.scene import CampaignConfig
-from palpate.config.schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
+from .loader import ConfigError, limits, load, resolve
+from .sample import AssumedConfig
+from .scene import CampaignConfig
+from .schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
 
 SIMULATION_ONLY = ("samples", "exposed_lengths_mm", "exposed_length_mm", "tubes", "orientations")
 

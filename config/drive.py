@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from palpate.config.loader import limits
-from palpate.config.optics import MM
+from .loader import limits
+from .optics import MM
 
 
 @dataclass(frozen=True)

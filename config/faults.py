@@ -16,9 +16,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from palpate.config.loader import limits
-from palpate.config.optics import MM
-from palpate.config.units import SI
+from .loader import limits
+from .optics import MM
+from .units import SI
 
 ServoName = Literal["outer_roll", "inner_roll", "translation"]
 # Hardware Error Status bits by name (wire.dynamixel.HW_*).

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from palpate.config.loader import limits
+from .loader import limits
 
 MM = 1e-3
 UE = 1e-6

@@ -19,8 +19,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
-from palpate.config.loader import limits
-from palpate.config.schema import MM
+from .loader import limits
+from .schema import MM
 
 KPA = 1e3
 UNKNOWN = "unknown"

@@ -12,12 +12,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
-from palpate.config.faults import FaultsConfig
-from palpate.config.loader import limits
-from palpate.config.optics import MM, PM, UE
-from palpate.config.sample import PAPER_SAMPLES, SampleConfig
-from palpate.config.schema import DEFAULT_CONTROL_RATE_HZ
-from palpate.config.units import SI, SIOptional, SITuple
+from .faults import FaultsConfig
+from .loader import limits
+from .optics import MM, PM, UE
+from .sample import PAPER_SAMPLES, SampleConfig
+from .schema import DEFAULT_CONTROL_RATE_HZ
+from .units import SI, SIOptional, SITuple
 
 Orientation = Literal["downward", "sideways", "upward"]
 ORIENTATION_ROLL_DEG: dict[str, float] = {"downward": 0.0, "sideways": 90.0, "upward": 180.0}

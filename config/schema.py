@@ -11,9 +11,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
-from palpate.config.drive import DriveConfig
-from palpate.config.loader import limits
-from palpate.config.optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
+from .drive import DriveConfig
+from .loader import limits
+from .optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
 
 __all__ = [
     "DEFAULT_CONTROL_RATE_HZ",

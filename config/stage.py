@@ -16,7 +16,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import StackConfig, TubeConfig
+from .schema import StackConfig, TubeConfig
 
 STAGE = "bench-stage"  # the bench column's rig key (palpate.calibration): its compliance
 Kind = Literal["bench", "robot"]

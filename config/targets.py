@@ -25,8 +25,8 @@ from pathlib import Path
 
 import yaml
 
-from palpate.config.loader import ConfigError, from_mapping, limits, load
-from palpate.config.schema import MM
+from .loader import ConfigError, from_mapping, limits, load
+from .schema import MM
 
 
 @dataclass(frozen=True)

@@ -29,10 +29,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica import fast
-from palpate.estimation.elastica.constants import E_OVER_L_MAX, E_OVER_L_PEAK, P_CRIT, P_PEAK
-from palpate.estimation.elastica.errors import ElasticaConvergenceError
-from palpate.estimation.section import Section
+from .elastica import fast
+from .elastica.constants import E_OVER_L_MAX, E_OVER_L_PEAK, P_CRIT, P_PEAK
+from .elastica.errors import ElasticaConvergenceError
+from .section import Section
 
 FloatArray = NDArray[np.float64]
 Branch = Literal["rising", "falling"]

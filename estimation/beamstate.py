@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica import fast
-from palpate.estimation.elastica.constants import E_OVER_L_MAX
+from .elastica import fast
+from .elastica.constants import E_OVER_L_MAX
 
 FloatArray = NDArray[np.float64]
 

@@ -39,7 +39,7 @@ from typing import Literal
 
 import numpy as np
 
-from palpate.estimation.corrections import CHI_MAX, ContactLaw, LayerLaw
+from .corrections import CHI_MAX, ContactLaw, LayerLaw
 
 E_STEP = 0.02
 CHI_STEP = 0.02

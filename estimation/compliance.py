@@ -34,7 +34,7 @@ from statistics import NormalDist
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.jointfit.noise import lag1
+from .jointfit.noise import lag1
 
 FloatArray = NDArray[np.float64]
 

@@ -35,11 +35,11 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.hertz import MAX_DEPTH_RATIO as MAX_DEPTH_RATIO_HERTZ
-from palpate.estimation.hertz import hertz_validity
-from palpate.estimation.layer import dimitriadis_bracket, layer_coefficients
-from palpate.estimation.layer_table import DEPTH_RATIO_MAX, LayerFactor, layer_factor
-from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
+from .hertz import MAX_DEPTH_RATIO as MAX_DEPTH_RATIO_HERTZ
+from .hertz import hertz_validity
+from .layer import dimitriadis_bracket, layer_coefficients
+from .layer_table import DEPTH_RATIO_MAX, LayerFactor, layer_factor
+from .sneddon import sneddon_bracket, sneddon_y
 
 FloatArray = NDArray[np.float64]
 

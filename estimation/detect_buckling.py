@@ -29,7 +29,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica.constants import MODE_SLOPE_INTEGRAL, X1
+from .elastica.constants import MODE_SLOPE_INTEGRAL, X1
 
 FloatArray = NDArray[np.float64]
 

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.layer import layer_kernel
+from .layer import layer_kernel
 
 FloatArray = NDArray[np.float64]
 

@@ -31,9 +31,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.config.cache import cached_arrays
-from palpate.estimation.layer_exact import kernel_transform, solve_contact
-from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
+from ..config.cache import cached_arrays
+from .layer_exact import kernel_transform, solve_contact
+from .sneddon import sneddon_bracket, sneddon_y
 
 FloatArray = NDArray[np.float64]
 

@@ -51,8 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.beamcolumn import capacity, lateral_shape, lateral_shape_by_grating
-from palpate.estimation.beamstate import onset_mode
+from .beamcolumn import capacity, lateral_shape, lateral_shape_by_grating
+from .beamstate import onset_mode
 
 FloatArray = NDArray[np.float64]
 

@@ -18,8 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from palpate.config.schema import SensorConfig
-from palpate.estimation.elastica.constants import P_CRIT
+from ..config.schema import SensorConfig
+from .elastica.constants import P_CRIT
 
 
 @dataclass(frozen=True)

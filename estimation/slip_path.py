@@ -39,8 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.beamcolumn import capacity, lateral_shape
-from palpate.estimation.misalignment import LOAD_SHARE
+from .beamcolumn import capacity, lateral_shape
+from .misalignment import LOAD_SHARE
 
 FloatArray = NDArray[np.float64]
 

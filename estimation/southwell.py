@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from palpate.estimation.elastica.constants import MODE_SHORTENING
+from .elastica.constants import MODE_SHORTENING
 
 LOAD_WINDOW = (0.3, 0.9)
 MIN_POINTS = 10

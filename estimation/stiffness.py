@@ -23,8 +23,8 @@ from typing import Protocol
 
 import numpy as np
 
-from palpate.estimation.hertz import hertz_modulus
-from palpate.estimation.section import P_CRIT, euler_load
+from .hertz import hertz_modulus
+from .section import P_CRIT, euler_load
 
 EULER_FIXED_PINNED = P_CRIT  # kept as a name the tests and callers use
 """p_cr = P_cr L^2 / EI = mu^2 with tan(mu) = mu: 20.1907 (fixed-pinned column)."""

@@ -15,10 +15,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.beam import Beam
-from palpate.estimation.elastica import fast
-from palpate.estimation.elastica._scipy import least_squares
-from palpate.estimation.elastica.constants import E_OVER_L_MAX
+from .beam import Beam
+from .elastica import fast
+from .elastica._scipy import least_squares
+from .elastica.constants import E_OVER_L_MAX
 
 FloatArray = NDArray[np.float64]
 

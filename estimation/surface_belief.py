@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.surface import Fitter, SurfaceFit, SurfaceGeometry, Vector, fit_with, unit
+from .surface import Fitter, SurfaceFit, SurfaceGeometry, Vector, fit_with, unit
 
 _GN_ITERATIONS = 30
 _GN_TOL = 1e-13  # m, on the centre's step

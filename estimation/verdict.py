@@ -31,11 +31,11 @@ from typing import Literal
 
 import numpy as np
 
-from palpate.estimation.belief import Hypothesis
-from palpate.estimation.jointfit import JointFit
-from palpate.estimation.jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
-from palpate.estimation.misalignment import Lean
-from palpate.estimation.relaxation import RelaxationFit
+from .belief import Hypothesis
+from .jointfit import JointFit
+from .jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
+from .misalignment import Lean
+from .relaxation import RelaxationFit
 
 Status = Literal["ok", "suspect", "none"]
 STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")

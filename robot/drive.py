@@ -23,8 +23,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from palpate.config.schema import DriveConfig
-from palpate.robot.motors import MotorBus, MotorState
+from ..config.schema import DriveConfig
+from .motors import MotorBus, MotorState
 
 OUTER_ROLL = "outer_roll"
 INNER_ROLL = "inner_roll"

@@ -32,9 +32,9 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from palpate.estimation.detect_buckling import BucklingDetector
-from palpate.robot.guards import STATE_TIMEOUT, Guards, Observation, limit_violation
-from palpate.robot.plan import (
+from ..estimation.detect_buckling import BucklingDetector
+from .guards import STATE_TIMEOUT, Guards, Observation, limit_violation
+from .plan import (
     PLANNED_ENDS,
     TERMINAL,
     Command,
@@ -44,8 +44,8 @@ from palpate.robot.plan import (
     TrialMarks,
     TrialPlan,
 )
-from palpate.robot.probe_result import ProbeResult
-from palpate.robot.rest_check import RestCheck
+from .probe_result import ProbeResult
+from .rest_check import RestCheck
 
 # the guards' and the plan's names, re-exported: the machine's interface is read from here
 __all__ = [

@@ -34,8 +34,8 @@ import numpy as np
 import transforms3d
 from numpy.typing import NDArray
 
-from palpate.config.schema import TubeConfig
-from palpate.estimation.surface import SurfaceGeometry
+from ..config.schema import TubeConfig
+from ..estimation.surface import SurfaceGeometry
 
 Vector = NDArray[np.float64]
 

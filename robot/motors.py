@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Protocol, Self
 
-from palpate.config.loader import InputError
+from ..config.loader import InputError
 
 
 class ServoTransportError(OSError):

@@ -8,8 +8,8 @@ import enum
 from dataclasses import dataclass
 from typing import Protocol
 
-from palpate.robot.guards import Observation
-from palpate.robot.probe_result import ProbeResult
+from .guards import Observation
+from .probe_result import ProbeResult
 
 
 class State(enum.Enum):

@@ -13,9 +13,9 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.corrections import MAX_MISALIGNMENT
-from palpate.estimation.surface import SurfaceFit, fit_surface
-from palpate.estimation.surface_belief import fit_sphere_of_radius
+from ..estimation.corrections import MAX_MISALIGNMENT
+from ..estimation.surface import SurfaceFit, fit_surface
+from ..estimation.surface_belief import fit_sphere_of_radius
 
 FloatArray = NDArray[np.float64]
 

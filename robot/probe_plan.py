@@ -30,14 +30,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import TubeConfig
-from palpate.estimation.beamstate import axial_strain
-from palpate.estimation.corrections import MAX_MISALIGNMENT
-from palpate.estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane
-from palpate.robot import kinematics
-from palpate.robot.indentation import TrialPlan
-from palpate.robot.probe_fit import NORMAL_SIGMAS, allowed_residual, scaled_sigma, touch_surface
-from palpate.robot.probe_result import ProbeResult, Touch
+from ..config.schema import TubeConfig
+from ..estimation.beamstate import axial_strain
+from ..estimation.corrections import MAX_MISALIGNMENT
+from ..estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane
+from . import kinematics
+from .indentation import TrialPlan
+from .probe_fit import NORMAL_SIGMAS, allowed_residual, scaled_sigma, touch_surface
+from .probe_result import ProbeResult, Touch
 
 Vector = NDArray[np.float64]
 FloatArray = NDArray[np.float64]

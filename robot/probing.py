@@ -28,10 +28,10 @@ import math
 
 import numpy as np
 
-from palpate.estimation.surface import load_crossing
-from palpate.robot.indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPlan
-from palpate.robot.probe_plan import ProbeGeometry, ProbeSettings
-from palpate.robot.probe_result import ProbeResult, Touch
+from ..estimation.surface import load_crossing
+from .indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPlan
+from .probe_plan import ProbeGeometry, ProbeSettings
+from .probe_result import ProbeResult, Touch
 
 MOVE_LOOKAHEAD = math.radians(12.0)  # roll ahead of the present the stage keeps clear of
 NEAR = 0.03  # rad of roll ahead the stage must be clear of before the roll moves on

@@ -22,16 +22,16 @@ from typing import Literal
 
 import numpy as np
 
-from palpate.config.schema import DEFAULT_CONTROL_RATE_HZ, StackConfig
-from palpate.estimation.beamstate import axial_strain
-from palpate.robot.drive import DriveController, JointState
-from palpate.robot.indentation import Command, Observation
-from palpate.robot.motors import ServoFaultError, ServoTransportError
-from palpate.sensor.clock import Clock
-from palpate.sensor.reader import FrameReader, SensorPortError
-from palpate.sensor.strain import StrainChain
-from palpate.sensor.tipforce import TipForceChain, tip_chain
-from palpate.wire.frame import Frame, Status
+from ..config.schema import DEFAULT_CONTROL_RATE_HZ, StackConfig
+from ..estimation.beamstate import axial_strain
+from ..sensor.clock import Clock
+from ..sensor.reader import FrameReader, SensorPortError
+from ..sensor.strain import StrainChain
+from ..sensor.tipforce import TipForceChain, tip_chain
+from ..wire.frame import Frame, Status
+from .drive import DriveController, JointState
+from .indentation import Command, Observation
+from .motors import ServoFaultError, ServoTransportError
 
 ContactMode = Literal["event", "fbg", "tip"]
 REZERO_FRAMES = 8  # frames a zero taken again during a trial averages

@@ -27,14 +27,14 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import StackConfig
-from palpate.estimation.beam import Beam
-from palpate.estimation.section import sensor_section
-from palpate.sensor.calibration import CalibrationFit, fit_strain_coefficient
-from palpate.sensor.parser import layout_from_config
-from palpate.sensor.strain import grating_intervals
-from palpate.wire.dynamixel import TICKS_PER_REV
-from palpate.wire.frameblock import FrameBlock, decode_block
+from ..config.schema import StackConfig
+from ..estimation.beam import Beam
+from ..estimation.section import sensor_section
+from ..wire.dynamixel import TICKS_PER_REV
+from ..wire.frameblock import FrameBlock, decode_block
+from .calibration import CalibrationFit, fit_strain_coefficient
+from .parser import layout_from_config
+from .strain import grating_intervals
 
 FloatArray = NDArray[np.float64]
 

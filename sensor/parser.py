@@ -20,8 +20,8 @@ from __future__ import annotations
 import zlib
 from dataclasses import asdict, dataclass
 
-from palpate.config.schema import BoardConfig, SensorConfig
-from palpate.wire.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
+from ..config.schema import BoardConfig, SensorConfig
+from ..wire.frame import CRC_SIZE, HEADER_SIZE, MARKER, Frame, FrameLayout, layout_of, unpack
 
 SEQ_MOD = 2**32
 

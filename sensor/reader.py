@@ -23,11 +23,11 @@ from typing import Protocol
 
 import serial
 
-from palpate.config.schema import BoardConfig, SensorConfig
-from palpate.sensor.clock import Clock, SystemClock
-from palpate.sensor.parser import FrameParser, ReaderCounters, layout_from_config
-from palpate.sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff, open_failure
-from palpate.wire.frame import Frame, FrameLayout
+from ..config.schema import BoardConfig, SensorConfig
+from ..wire.frame import Frame, FrameLayout
+from .clock import Clock, SystemClock
+from .parser import FrameParser, ReaderCounters, layout_from_config
+from .ports import OPEN_ERRORS, PORT_ERRORS, Backoff, open_failure
 
 REOPEN_BACKOFF_S = (0.01, 1.0)  # first and longest wait between attempts to reopen a lost port
 

@@ -24,7 +24,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.config.schema import FbgConfig, SensorConfig
+from ..config.schema import FbgConfig, SensorConfig
 
 FloatArray = NDArray[np.float64]
 TemperatureMode = Literal["none", "measured", "reference"]

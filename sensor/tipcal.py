@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from palpate.config.schema import StackConfig
-from palpate.sensor.calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
-from palpate.sensor.tipforce import TipForceChain
-from palpate.wire.frame import Status
-from palpate.wire.frameblock import FrameBlock
+from ..config.schema import StackConfig
+from ..wire.frame import Status
+from ..wire.frameblock import FrameBlock
+from .calibration import CalibrationFit, fit_strain_coefficient, load_pairs_csv
+from .tipforce import TipForceChain
 
 PM_PER_MN = 1e-12 / 1e-3  # m/N in one pm/mN
 COLUMNS = ("force_mn", "shift_pm")

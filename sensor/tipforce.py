@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.config.schema import FbgConfig, TipGratingConfig
-from palpate.estimation.detect_contact import MAD_TO_SIGMA
+from ..config.schema import FbgConfig, TipGratingConfig
+from ..estimation.detect_contact import MAD_TO_SIGMA
 
 FloatArray = NDArray[np.float64]
 

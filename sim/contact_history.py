@@ -26,11 +26,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from palpate.estimation.beam import Beam
-from palpate.sim.contact_table import GridPhysics, grating_strains
-from palpate.sim.equilibrium import TissueLaw, solve_contact
-from palpate.sim.equilibrium.law import FloatArray
-from palpate.sim.viscoelastic import Relaxation, ViscoelasticState, step
+from ..estimation.beam import Beam
+from .contact_table import GridPhysics, grating_strains
+from .equilibrium import TissueLaw, solve_contact
+from .equilibrium.law import FloatArray
+from .viscoelastic import Relaxation, ViscoelasticState, step
 
 Row = tuple[float, float, float, float, tuple[float, ...]]  # delta, e, P, |R|, strains
 

@@ -21,10 +21,10 @@ from typing import NamedTuple, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.beam import Beam
-from palpate.estimation.elastica import post_buckling
-from palpate.sim.equilibrium import ContactEffects, TissueLaw, solve_contact
-from palpate.sim.oblique import ObliqueContact, slip_law, slip_strains
+from ..estimation.beam import Beam
+from ..estimation.elastica import post_buckling
+from .equilibrium import ContactEffects, TissueLaw, solve_contact
+from .oblique import ObliqueContact, slip_law, slip_strains
 
 Vector = NDArray[np.float64]
 

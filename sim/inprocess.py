@@ -21,8 +21,8 @@ from typing import Any
 
 import dynamixel_sdk as sdk
 
-from palpate.sim.dynamixel.bus import EmulatedBus
-from palpate.wire.frame import Frame
+from ..wire.frame import Frame
+from .dynamixel.bus import EmulatedBus
 
 
 class InProcessPort(sdk.PortHandler):  # type: ignore[misc]  # the SDK is untyped

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.sim.equilibrium.law import AxialLaw, TissueLaw
+from .equilibrium.law import AxialLaw, TissueLaw
 
 FloatArray = NDArray[np.float64]
 

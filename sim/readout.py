@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.scene import FidelityConfig
-from palpate.config.schema import FbgConfig, SensorConfig, TipGratingConfig
+from ..config.scene import FidelityConfig
+from ..config.schema import FbgConfig, SensorConfig, TipGratingConfig
 
 
 class GratingReadout:

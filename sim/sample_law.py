@@ -33,12 +33,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from palpate.config.sample import SampleConfig
-from palpate.config.scene import FidelityConfig
-from palpate.sim.equilibrium import TissueLaw
-from palpate.sim.equilibrium.law import FloatArray
-from palpate.sim.fem import FeTissueLaw, LayerProblem, table_key
-from palpate.sim.viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
+from ..config.sample import SampleConfig
+from ..config.scene import FidelityConfig
+from .equilibrium import TissueLaw
+from .equilibrium.law import FloatArray
+from .fem import FeTissueLaw, LayerProblem, table_key
+from .viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
 
 HALF_SPACE_RATIO = 200.0
 """Depth and lateral radius / R of the block that stands in for a half-space on the FE level."""
@@ -105,7 +105,7 @@ def world_tissue(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: flo
     modulus = sample.modulus / (1.0 if sls is None else sls.ratio)
     if fidelity.tissue_model == "fe":
         return FeTissueLaw(fe_problem(sample, fidelity, tip_radius), modulus, tip_radius)
-    from palpate.sim.tissue import TissueModel  # the estimator's family: only on this level
+    from .tissue import TissueModel  # the estimator's family: only on this level
 
     return TissueModel(
         modulus=modulus,

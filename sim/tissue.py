@@ -49,8 +49,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.layer import dimitriadis_bracket, layer_coefficients
-from palpate.estimation.sneddon import sneddon_bracket, sneddon_bracket_at, sneddon_y, sneddon_y_at
+from ..estimation.layer import dimitriadis_bracket, layer_coefficients
+from ..estimation.sneddon import sneddon_bracket, sneddon_bracket_at, sneddon_y, sneddon_y_at
 
 FloatArray = NDArray[np.float64]
 

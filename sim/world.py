@@ -30,19 +30,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from palpate.config.scene import FidelityConfig
-from palpate.config.schema import FbgConfig, SensorConfig
-from palpate.estimation.section import Section
-from palpate.estimation.surface import SurfaceGeometry
-from palpate.sim.board import BoardSample
-from palpate.sim.contact_history import ViscoelasticContact
-from palpate.sim.contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
-from palpate.sim.equilibrium import ContactEffects, TissueLaw
-from palpate.sim.gravity import BeamWeight, offset_to_mode, sensing_axis
-from palpate.sim.oblique import ObliqueContact
-from palpate.sim.readout import GratingReadout, TipReadout, grating_ends
-from palpate.sim.viscoelastic import Relaxation
-from palpate.wire.frame import Status
+from ..config.scene import FidelityConfig
+from ..config.schema import FbgConfig, SensorConfig
+from ..estimation.section import Section
+from ..estimation.surface import SurfaceGeometry
+from ..wire.frame import Status
+from .board import BoardSample
+from .contact_history import ViscoelasticContact
+from .contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
+from .equilibrium import ContactEffects, TissueLaw
+from .gravity import BeamWeight, offset_to_mode, sensing_axis
+from .oblique import ObliqueContact
+from .readout import GratingReadout, TipReadout, grating_ends
+from .viscoelastic import Relaxation
 
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)
 PoseFn = Callable[[float, float], tuple[Vector, Vector, float]]

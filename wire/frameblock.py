@@ -16,7 +16,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.wire.frame import CRC_SIZE, FM, UN, US, Frame, FrameLayout, layout_of
+from .frame import CRC_SIZE, FM, UN, US, Frame, FrameLayout, layout_of
 
 
 @dataclass(frozen=True)

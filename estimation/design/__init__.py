@@ -46,10 +46,10 @@ sensor), ``search`` (the grid and the leximin choice: :func:`design_sensor`), ``
 
 from __future__ import annotations
 
-from palpate.estimation.design.model import evaluate_design, hertz_depth, imperfection_state
-from palpate.estimation.design.results import CHECKS, Check, DesignEvaluation, DesignResult
-from palpate.estimation.design.search import design_sensor
-from palpate.estimation.design.space import DesignConstraints, DesignSpace, SensorDesign
+from .model import evaluate_design, hertz_depth, imperfection_state
+from .results import CHECKS, Check, DesignEvaluation, DesignResult
+from .search import design_sensor
+from .space import DesignConstraints, DesignSpace, SensorDesign
 
 __all__ = [
     "CHECKS",

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.design.results import Check, DesignEvaluation
-from palpate.estimation.design.space import DesignConstraints, SensorDesign
-from palpate.estimation.elastica import fast
-from palpate.estimation.elastica.constants import E_OVER_L_MAX, MODE_SHORTENING, P_CRIT
+from ..elastica import fast
+from ..elastica.constants import E_OVER_L_MAX, MODE_SHORTENING, P_CRIT
+from .results import Check, DesignEvaluation
+from .space import DesignConstraints, SensorDesign
 
 FloatArray = NDArray[np.float64]
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from palpate.estimation.design.space import SensorDesign
+from .space import SensorDesign
 
 CHECKS: dict[str, str] = {
     "depth": "the estimator's trusted sphere depth at E_min: delta/R <= max_depth_ratio",

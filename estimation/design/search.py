@@ -8,10 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.design.model import Assessment, assess, checked_range, evaluation
-from palpate.estimation.design.results import Check, DesignEvaluation, DesignResult
-from palpate.estimation.design.space import DesignConstraints, DesignSpace, SensorDesign
-from palpate.estimation.section import across_rigidity, composite_section
+from ..section import across_rigidity, composite_section
+from .model import Assessment, assess, checked_range, evaluation
+from .results import Check, DesignEvaluation, DesignResult
+from .space import DesignConstraints, DesignSpace, SensorDesign
 
 FloatArray = NDArray[np.float64]
 

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.corrections import LAYER_STRAIN_MAX
-from palpate.estimation.section import Section, across_rigidity, composite_section, euler_load
+from ..corrections import LAYER_STRAIN_MAX
+from ..section import Section, across_rigidity, composite_section, euler_load
 
 FloatArray = NDArray[np.float64]
 

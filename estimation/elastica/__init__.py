@@ -23,17 +23,17 @@ from typing import Literal, overload
 
 from numpy.typing import ArrayLike
 
-from palpate.estimation.elastica import accurate, fast, shooting
-from palpate.estimation.elastica.constants import (
+from . import accurate, fast, shooting
+from .constants import (
     E_OVER_L_MAX,
     E_OVER_L_PEAK,
     E_OVER_L_TIP_NORMAL,
     P_CRIT,
     P_PEAK,
 )
-from palpate.estimation.elastica.errors import ElasticaConvergenceError
-from palpate.estimation.elastica.shooting import ShootingSolution
-from palpate.estimation.elastica.solution import ElasticaSolution, PostBuckling
+from .errors import ElasticaConvergenceError
+from .shooting import ShootingSolution
+from .solution import ElasticaSolution, PostBuckling
 
 Method = Literal["accurate", "fast", "shooting"]
 

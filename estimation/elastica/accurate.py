@@ -15,11 +15,11 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from palpate.estimation.elastica._scipy import brentq, ellipk
-from palpate.estimation.elastica.closed_form import shortening_ratio, state, wavenumber
-from palpate.estimation.elastica.constants import E_OVER_L_MAX, K_MAX, SHORTENING_RATIO_RANGE, X1
-from palpate.estimation.elastica.errors import ElasticaConvergenceError, checked_e_over_L
-from palpate.estimation.elastica.solution import ElasticaSolution
+from ._scipy import brentq, ellipk
+from .closed_form import shortening_ratio, state, wavenumber
+from .constants import E_OVER_L_MAX, K_MAX, SHORTENING_RATIO_RANGE, X1
+from .errors import ElasticaConvergenceError, checked_e_over_L
+from .solution import ElasticaSolution
 
 RTOL = 1e-15
 MAXITER = 200

@@ -35,8 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica._scipy import brentq, ellipj, ellipk, elliprd
-from palpate.estimation.elastica.errors import ElasticaConvergenceError
+from ._scipy import brentq, ellipj, ellipk, elliprd
+from .errors import ElasticaConvergenceError
 
 FloatArray = NDArray[np.float64]
 

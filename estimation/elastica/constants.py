@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from palpate.estimation.elastica._scipy import brentq
-from palpate.estimation.elastica.closed_form import (
+from ._scipy import brentq
+from .closed_form import (
     State,
     shortening_ratio,
     state,

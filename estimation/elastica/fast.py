@@ -26,10 +26,10 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica import accurate
-from palpate.estimation.elastica.constants import E_OVER_L_MAX
-from palpate.estimation.elastica.errors import checked_e_over_L
-from palpate.estimation.elastica.solution import ElasticaSolution
+from . import accurate
+from .constants import E_OVER_L_MAX
+from .errors import checked_e_over_L
+from .solution import ElasticaSolution
 
 FloatArray = NDArray[np.float64]
 

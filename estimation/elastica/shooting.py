@@ -25,9 +25,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica._scipy import brentq, solve_ivp
-from palpate.estimation.elastica.constants import E_OVER_L_MAX, P_CRIT, X1
-from palpate.estimation.elastica.errors import (
+from ._scipy import brentq, solve_ivp
+from .constants import E_OVER_L_MAX, P_CRIT, X1
+from .errors import (
     ElasticaConvergenceError,
     checked_e_over_L,
     checked_unit_interval,

@@ -14,8 +14,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.elastica._scipy import ellipeinc, ellipj
-from palpate.estimation.elastica.errors import checked_unit_interval
+from ._scipy import ellipeinc, ellipj
+from .errors import checked_unit_interval
 
 FloatArray = NDArray[np.float64]
 

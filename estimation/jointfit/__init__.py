@@ -64,7 +64,7 @@ profile over x0), ``envelope`` (4), ``result`` (:class:`JointFit`).
 
 from __future__ import annotations
 
-from palpate.estimation.jointfit.fit import MIN_CONTACT_POINTS, MIN_POINTS, joint_fit
-from palpate.estimation.jointfit.result import JointFit
+from .fit import MIN_CONTACT_POINTS, MIN_POINTS, joint_fit
+from .result import JointFit
 
 __all__ = ["MIN_CONTACT_POINTS", "MIN_POINTS", "JointFit", "joint_fit"]

@@ -24,9 +24,9 @@ import dataclasses
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.belief import Belief
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.jointfit.grid import grid_fits
+from ..belief import Belief
+from ..corrections import ContactLaw
+from .grid import grid_fits
 
 FloatArray = NDArray[np.float64]
 

@@ -20,15 +20,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.belief import Hypothesis
-from palpate.estimation.corrections import ContactLaw, validity_warnings
-from palpate.estimation.jointfit.modelform import model_form, widened
-from palpate.estimation.jointfit.noise import Noise
-from palpate.estimation.jointfit.profile import Candidate, Profile, family_profiles
-from palpate.estimation.jointfit.record import Record
-from palpate.estimation.jointfit.refine import Refined
-from palpate.estimation.jointfit.result import FitFailed, JointFit
-from palpate.estimation.jointfit.scan import Start
+from ..belief import Hypothesis
+from ..corrections import ContactLaw, validity_warnings
+from .modelform import model_form, widened
+from .noise import Noise
+from .profile import Candidate, Profile, family_profiles
+from .record import Record
+from .refine import Refined
+from .result import FitFailed, JointFit
+from .scan import Start
 
 FloatArray = NDArray[np.float64]
 

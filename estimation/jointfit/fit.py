@@ -9,20 +9,20 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.estimation.belief import Belief, Hypothesis
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.jointfit.beliefcheck import contradictions
-from palpate.estimation.jointfit.envelope import Found, envelope, profile_hypotheses
-from palpate.estimation.jointfit.noise import (
+from ..belief import Belief, Hypothesis
+from ..corrections import ContactLaw
+from .beliefcheck import contradictions
+from .envelope import Found, envelope, profile_hypotheses
+from .noise import (
     Noise,
     frozen_noise,
     profile_span,
     require_significance,
 )
-from palpate.estimation.jointfit.record import Record, check_options, checked_record
-from palpate.estimation.jointfit.refine import Refined, refine, require_contact
-from palpate.estimation.jointfit.result import FitFailed, JointFit
-from palpate.estimation.jointfit.scan import Start, scan
+from .record import Record, check_options, checked_record
+from .refine import Refined, refine, require_contact
+from .result import FitFailed, JointFit
+from .scan import Start, scan
 
 FloatArray = NDArray[np.float64]
 

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.corrections import ContactLaw, shape_values
+from ..corrections import ContactLaw, shape_values
 
 FloatArray = NDArray[np.float64]
 GridFit = tuple[FloatArray, FloatArray, FloatArray, FloatArray]

@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from palpate.estimation.corrections import ContactLaw
+from ..corrections import ContactLaw
 
 LAYER_SERIES = 0.25
 FINITE_STRAIN = 0.1

@@ -24,8 +24,8 @@ from statistics import NormalDist
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.jointfit.refine import Refined
-from palpate.estimation.jointfit.result import FitFailed
+from .refine import Refined
+from .result import FitFailed
 
 FloatArray = NDArray[np.float64]
 

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.jointfit.grid import GridFit, grid_fits
+from ..corrections import ContactLaw
+from .grid import GridFit, grid_fits
 
 FloatArray = NDArray[np.float64]
 

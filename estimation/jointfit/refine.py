@@ -25,12 +25,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.belief import Hypothesis
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.elastica._scipy import least_squares
-from palpate.estimation.jointfit.record import Record
-from palpate.estimation.jointfit.result import FitFailed
-from palpate.estimation.jointfit.scan import SCAN_POINTS, SCAN_STEP, Start
+from ..belief import Hypothesis
+from ..corrections import ContactLaw
+from ..elastica._scipy import least_squares
+from .record import Record
+from .result import FitFailed
+from .scan import SCAN_POINTS, SCAN_STEP, Start
 
 FloatArray = NDArray[np.float64]
 

@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.estimation.belief import Hypothesis
-from palpate.estimation.jointfit.grid import grid_fits
-from palpate.estimation.jointfit.record import Record
-from palpate.estimation.jointfit.result import FitFailed
+from ..belief import Hypothesis
+from .grid import grid_fits
+from .record import Record
+from .result import FitFailed
 
 FloatArray = NDArray[np.float64]
 

@@ -51,8 +51,8 @@ the memory basis, one x0's non-negative least squares, the intervals), ``result`
 
 from __future__ import annotations
 
-from palpate.estimation.relaxation.fit import fit_relaxation
-from palpate.estimation.relaxation.result import RelaxationFit, RelaxationRecord
-from palpate.estimation.relaxation.spectrum import memory_basis
+from .fit import fit_relaxation
+from .result import RelaxationFit, RelaxationRecord
+from .spectrum import memory_basis
 
 __all__ = ["RelaxationFit", "RelaxationRecord", "fit_relaxation", "memory_basis"]

@@ -11,9 +11,9 @@ import numpy as np
 # without stats' 0.4 s import on every process that estimates
 from scipy.special import gammaincinv  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.relaxation.result import FloatArray, RelaxationFit, RelaxationRecord
-from palpate.estimation.relaxation.spectrum import (
+from ..corrections import ContactLaw
+from .result import FloatArray, RelaxationFit, RelaxationRecord
+from .spectrum import (
     Solved,
     interval,
     scale2,

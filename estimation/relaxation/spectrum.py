@@ -10,9 +10,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import nnls  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.jointfit.noise import lag1
-from palpate.estimation.relaxation.result import RelaxationRecord
+from ..corrections import ContactLaw
+from ..jointfit.noise import lag1
+from .result import RelaxationRecord
 
 FloatArray = NDArray[np.float64]
 

@@ -34,11 +34,19 @@ from typing import Any, Self, TypeVar
 
 import dynamixel_sdk as sdk
 
-from palpate.config.schema import ServoBusConfig
-from palpate.robot.dynamixel import units
-from palpate.robot.dynamixel.latency import USB_SERIAL_SYSFS, latency_warning
-from palpate.robot.dynamixel.port import PortRecovery, TimedPortHandler
-from palpate.robot.dynamixel.replies import (
+from ...config.schema import ServoBusConfig
+from ...sensor.ports import PORT_ERRORS, open_failure
+from ...wire import dynamixel as tables
+from ..motors import (
+    MotorState,
+    ServoFaultError,
+    ServoIdentityError,
+    ServoTransportError,
+)
+from . import units
+from .latency import USB_SERIAL_SYSFS, latency_warning
+from .port import PortRecovery, TimedPortHandler
+from .replies import (
     GOAL_ADDR,
     GOAL_LEN,
     STATE_LEN,
@@ -48,15 +56,7 @@ from palpate.robot.dynamixel.replies import (
     hardware_fault,
     status_fault,
 )
-from palpate.robot.dynamixel.stats import BusStats
-from palpate.robot.motors import (
-    MotorState,
-    ServoFaultError,
-    ServoIdentityError,
-    ServoTransportError,
-)
-from palpate.sensor.ports import PORT_ERRORS, open_failure
-from palpate.wire import dynamixel as tables
+from .stats import BusStats
 
 R = TypeVar("R")
 CONNECT_PATIENCE_S = 0.5

@@ -16,7 +16,7 @@ from typing import Any
 
 import dynamixel_sdk as sdk
 
-from palpate.sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff
+from ...sensor.ports import OPEN_ERRORS, PORT_ERRORS, Backoff
 
 REOPEN_BACKOFF_S = (0.02, 1.0)  # first and longest wall-time wait between reopening attempts
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import struct
 
-from palpate.robot.dynamixel import units
-from palpate.robot.motors import MotorState, ServoFaultError, ServoTransportError
-from palpate.wire import dynamixel as tables
+from ...wire import dynamixel as tables
+from ..motors import MotorState, ServoFaultError, ServoTransportError
+from . import units
 
 STATE_START = tables.X_SERIES_CONTROL_TABLE["Moving"][0]
 """First address of one tick's sync read: Moving .. Present_Position."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from palpate.wire import dynamixel as tables
+from ...wire import dynamixel as tables
 
 _TICKS_PER_RAD = tables.TICKS_PER_REV / (2.0 * math.pi)
 _RAD_S_PER_VELOCITY_UNIT = tables.VELOCITY_UNIT_RPM * 2.0 * math.pi / 60.0

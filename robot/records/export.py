@@ -7,8 +7,8 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 
-from palpate.robot.records.log import read_log
-from palpate.robot.records.recording import McapRecorder
+from .log import read_log
+from .recording import McapRecorder
 
 
 def export(

@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
-from palpate.config.loader import InputError
-from palpate.robot.records.logschema import LogRecordError, check_record
-from palpate.robot.records.recording import McapRecorder
+from ...config.loader import InputError
+from .logschema import LogRecordError, check_record
+from .recording import McapRecorder
 
 FORMAT = "palpate-trial-log"
 VERSION = 1

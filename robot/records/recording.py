@@ -33,10 +33,10 @@ from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,u
 from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
 from mcap_ros2.decoder import DecoderFactory  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.config.loader import from_mapping
-from palpate.config.schema import TubeConfig
-from palpate.robot.records import cdr
-from palpate.robot.records.ros2 import (
+from ...config.loader import from_mapping
+from ...config.schema import TubeConfig
+from . import cdr
+from .ros2 import (
     SCHEMAS,
     TOPICS,
     messages,

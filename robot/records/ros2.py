@@ -30,9 +30,9 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from palpate.config.schema import TubeConfig
-from palpate.robot.kinematics import tube_tip_in_bend_plane
-from palpate.robot.records import cdr
+from ...config.schema import TubeConfig
+from ..kinematics import tube_tip_in_bend_plane
+from . import cdr
 
 SEP = "\n" + "=" * 80 + "\n"
 TIME = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"

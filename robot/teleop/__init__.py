@@ -13,7 +13,7 @@ draws :meth:`Teleop.view` (the screen's text belongs to the application).
 
 from __future__ import annotations
 
-from palpate.robot.teleop.interface import (
+from .interface import (
     ESTOP_KEY,
     KEYMAP,
     Action,
@@ -21,7 +21,7 @@ from palpate.robot.teleop.interface import (
     JogSettings,
     TeleopView,
 )
-from palpate.robot.teleop.model import LATCHED, Teleop
+from .model import LATCHED, Teleop
 
 __all__ = [
     "ESTOP_KEY",

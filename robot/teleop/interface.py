@@ -10,9 +10,9 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
-from palpate.config.schema import TubeConfig
-from palpate.robot.drive import JointState
-from palpate.robot.indentation import State
+from ...config.schema import TubeConfig
+from ..drive import JointState
+from ..indentation import State
 
 Action = Literal[
     "advance",

@@ -25,19 +25,19 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from palpate.config.schema import DriveConfig, TubeConfig
-from palpate.config.targets import TargetConfig
-from palpate.estimation.detect_buckling import BucklingDetector
-from palpate.robot import kinematics
-from palpate.robot.drive import JointState, RollerGearDrive
-from palpate.robot.indentation import (
+from ...config.schema import DriveConfig, TubeConfig
+from ...config.targets import TargetConfig
+from ...estimation.detect_buckling import BucklingDetector
+from .. import kinematics
+from ..drive import JointState, RollerGearDrive
+from ..indentation import (
     Command,
     Guards,
     Observation,
     State,
     limit_violation,
 )
-from palpate.robot.teleop.interface import (
+from .interface import (
     ESTOP_KEY,
     KEYMAP,
     MAX_NAME,

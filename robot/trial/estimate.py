@@ -33,28 +33,28 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import SensorConfig, StackConfig
-from palpate.config.stage import Stage
-from palpate.estimation.beam import Beam
-from palpate.estimation.beamstate import BeamStates
-from palpate.estimation.compliance import ComplianceFit, fit_compliance, less
-from palpate.estimation.detect_contact import baseline_deviation
-from palpate.estimation.elastica.constants import P_CRIT
-from palpate.estimation.jointfit import MIN_POINTS, JointFit, joint_fit
-from palpate.estimation.misalignment import Lean
-from palpate.estimation.relaxation import RelaxationFit
-from palpate.estimation.section import Section
-from palpate.estimation.southwell import SouthwellFit, southwell
-from palpate.estimation.stiffness import StiffnessEstimate, paper_estimate
-from palpate.estimation.strain_fit import fit_strains
-from palpate.estimation.verdict import TrialFacts, Verdict, judge, relaxed_verdict
-from palpate.robot.trial.inputs import EstimatorInputs
-from palpate.robot.trial.lean import lean_of_rows, row_in, rows_in
-from palpate.robot.trial.relaxed import relaxation_of
-from palpate.robot.trial.run import TrialResult
-from palpate.robot.trial.states import LOADING_STATES, record_lengths, states_at
-from palpate.sensor.strain import grating_intervals
-from palpate.sensor.tipforce import force_sigma
+from ...config.schema import SensorConfig, StackConfig
+from ...config.stage import Stage
+from ...estimation.beam import Beam
+from ...estimation.beamstate import BeamStates
+from ...estimation.compliance import ComplianceFit, fit_compliance, less
+from ...estimation.detect_contact import baseline_deviation
+from ...estimation.elastica.constants import P_CRIT
+from ...estimation.jointfit import MIN_POINTS, JointFit, joint_fit
+from ...estimation.misalignment import Lean
+from ...estimation.relaxation import RelaxationFit
+from ...estimation.section import Section
+from ...estimation.southwell import SouthwellFit, southwell
+from ...estimation.stiffness import StiffnessEstimate, paper_estimate
+from ...estimation.strain_fit import fit_strains
+from ...estimation.verdict import TrialFacts, Verdict, judge, relaxed_verdict
+from ...sensor.strain import grating_intervals
+from ...sensor.tipforce import force_sigma
+from .inputs import EstimatorInputs
+from .lean import lean_of_rows, row_in, rows_in
+from .relaxed import relaxation_of
+from .run import TrialResult
+from .states import LOADING_STATES, record_lengths, states_at
 
 __all__ = [
     "EstimatorInputs",

@@ -14,13 +14,13 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
-from palpate.config.loader import from_mapping
-from palpate.config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
-from palpate.config.schema import MM, SensorConfig
-from palpate.config.stage import Stage
-from palpate.estimation.belief import Belief
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.section import Section
+from ...config.loader import from_mapping
+from ...config.sample import HALF_SPACE, UNKNOWN, AssumedConfig
+from ...config.schema import MM, SensorConfig
+from ...config.stage import Stage
+from ...estimation.belief import Belief
+from ...estimation.corrections import ContactLaw
+from ...estimation.section import Section
 
 VERSION = 2
 DEFAULT_POISSON = 0.45  # the nominal value of an unknown Poisson ratio (the paper's)

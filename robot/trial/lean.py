@@ -16,13 +16,13 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import SensorConfig
-from palpate.estimation.misalignment import Lean, measure_lean
-from palpate.estimation.section import Section
-from palpate.estimation.slip_path import measure_slip_path
-from palpate.robot.trial.inputs import EstimatorInputs
-from palpate.robot.trial.states import LOADING_STATES, record_lengths
-from palpate.sensor.strain import grating_intervals
+from ...config.schema import SensorConfig
+from ...estimation.misalignment import Lean, measure_lean
+from ...estimation.section import Section
+from ...estimation.slip_path import measure_slip_path
+from ...sensor.strain import grating_intervals
+from .inputs import EstimatorInputs
+from .states import LOADING_STATES, record_lengths
 
 PRE_BUCKLING = frozenset({"approach", "contact", "indenting"})
 

@@ -16,17 +16,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from palpate.estimation.compliance import ComplianceFit
-from palpate.estimation.jointfit import JointFit
-from palpate.estimation.misalignment import Lean
-from palpate.estimation.relaxation import RelaxationFit
-from palpate.estimation.southwell import SouthwellFit
-from palpate.estimation.stiffness import StiffnessEstimate
-from palpate.estimation.verdict import Verdict
-from palpate.robot.plan import TrialMarks
-from palpate.robot.trial.estimate import TrialEstimate
-from palpate.robot.trial.record import estimate_row
-from palpate.robot.trial.run import TrialResult
+from ...estimation.compliance import ComplianceFit
+from ...estimation.jointfit import JointFit
+from ...estimation.misalignment import Lean
+from ...estimation.relaxation import RelaxationFit
+from ...estimation.southwell import SouthwellFit
+from ...estimation.stiffness import StiffnessEstimate
+from ...estimation.verdict import Verdict
+from ..plan import TrialMarks
+from .estimate import TrialEstimate
+from .record import estimate_row
+from .run import TrialResult
 
 
 @dataclass(kw_only=True)

@@ -19,20 +19,20 @@ from __future__ import annotations
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any, Protocol
 
-from palpate.config.schema import SensorConfig, TubeConfig
-from palpate.estimation.compliance import ComplianceFit
-from palpate.estimation.jointfit import JointFit
-from palpate.estimation.misalignment import Lean
-from palpate.estimation.relaxation import RelaxationFit
-from palpate.estimation.section import Section
-from palpate.estimation.southwell import SouthwellFit
-from palpate.estimation.stiffness import StiffnessEstimate
-from palpate.estimation.verdict import Verdict
-from palpate.robot.indentation import TrialPlan
+from ...config.schema import SensorConfig, TubeConfig
+from ...estimation.compliance import ComplianceFit
+from ...estimation.jointfit import JointFit
+from ...estimation.misalignment import Lean
+from ...estimation.relaxation import RelaxationFit
+from ...estimation.section import Section
+from ...estimation.southwell import SouthwellFit
+from ...estimation.stiffness import StiffnessEstimate
+from ...estimation.verdict import Verdict
+from ..indentation import TrialPlan
 
 if TYPE_CHECKING:  # types only: estimate.py is above this module
-    from palpate.robot.trial.estimate import TrialEstimate
-    from palpate.robot.trial.inputs import EstimatorInputs
+    from .estimate import TrialEstimate
+    from .inputs import EstimatorInputs
 
 UNITS = "SI (m, N, Pa, rad, s); strains dimensionless"
 

@@ -16,14 +16,14 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import SensorConfig
-from palpate.estimation.belief import Hypothesis
-from palpate.estimation.jointfit import JointFit
-from palpate.estimation.relaxation import RelaxationFit, RelaxationRecord, fit_relaxation
-from palpate.estimation.section import Section
-from palpate.robot.trial.inputs import EstimatorInputs
-from palpate.robot.trial.lean import row_in, rows_in
-from palpate.robot.trial.states import LOADING_STATES, record_states
+from ...config.schema import SensorConfig
+from ...estimation.belief import Hypothesis
+from ...estimation.jointfit import JointFit
+from ...estimation.relaxation import RelaxationFit, RelaxationRecord, fit_relaxation
+from ...estimation.section import Section
+from .inputs import EstimatorInputs
+from .lean import row_in, rows_in
+from .states import LOADING_STATES, record_states
 
 HOLD_STATE = "holding"
 RECORD_STATES = LOADING_STATES | {HOLD_STATE}

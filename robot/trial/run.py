@@ -14,8 +14,9 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
-from palpate.estimation.detect_buckling import BucklingDetector
-from palpate.robot.indentation import (
+from ...estimation.detect_buckling import BucklingDetector
+from ...sensor.clock import Clock
+from ..indentation import (
     PLANNED_ENDS,
     Command,
     Guards,
@@ -27,9 +28,8 @@ from palpate.robot.indentation import (
     TrialMarks,
     TrialPlan,
 )
-from palpate.robot.probe_result import ProbeResult
-from palpate.robot.records.log import TrialLogWriter
-from palpate.sensor.clock import Clock
+from ..probe_result import ProbeResult
+from ..records.log import TrialLogWriter
 
 
 class Rig(Protocol):

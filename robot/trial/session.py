@@ -21,18 +21,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from palpate.config.scene import CampaignConfig
-from palpate.config.schema import StackConfig
-from palpate.robot.guards import Observation
-from palpate.robot.indentation import Prober, State, TrialPlan
-from palpate.robot.records.log import TrialLogWriter
-from palpate.robot.trial.estimate import TrialEstimate
-from palpate.robot.trial.record import estimate_record
-from palpate.robot.trial.run import Rig, TrialResult, end_record, run_trial
-from palpate.robot.trial.setup import detector_for, guards_for
-from palpate.robot.trial.tipforce import axial_loads
-from palpate.sensor.clock import Clock
-from palpate.sensor.strain import StrainChain
+from ...config.scene import CampaignConfig
+from ...config.schema import StackConfig
+from ...sensor.clock import Clock
+from ...sensor.strain import StrainChain
+from ..guards import Observation
+from ..indentation import Prober, State, TrialPlan
+from ..records.log import TrialLogWriter
+from .estimate import TrialEstimate
+from .record import estimate_record
+from .run import Rig, TrialResult, end_record, run_trial
+from .setup import detector_for, guards_for
+from .tipforce import axial_loads
 
 
 class ZeroingRig(Rig, Protocol):

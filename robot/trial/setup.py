@@ -15,18 +15,18 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.scene import CampaignConfig
-from palpate.config.schema import MM, StackConfig, TubeConfig
-from palpate.estimation.beamstate import infer_states, onset_mode
-from palpate.estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
-from palpate.estimation.elastica.constants import P_CRIT
-from palpate.estimation.section import Section
-from palpate.estimation.section import sensor_section as section_of
-from palpate.robot.indentation import STATE_TIMEOUT, Guards, Prober, TrialPlan
-from palpate.robot.probing import ProbeGeometry, ProbeRoutine, ProbeSettings, probe_budget
-from palpate.robot.rig import RigSettings
-from palpate.sensor.strain import StrainChain, grating_intervals
-from palpate.wire.dynamixel import TICKS_PER_REV
+from ...config.scene import CampaignConfig
+from ...config.schema import MM, StackConfig, TubeConfig
+from ...estimation.beamstate import infer_states, onset_mode
+from ...estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
+from ...estimation.elastica.constants import P_CRIT
+from ...estimation.section import Section
+from ...estimation.section import sensor_section as section_of
+from ...sensor.strain import StrainChain, grating_intervals
+from ...wire.dynamixel import TICKS_PER_REV
+from ..indentation import STATE_TIMEOUT, Guards, Prober, TrialPlan
+from ..probing import ProbeGeometry, ProbeRoutine, ProbeSettings, probe_budget
+from ..rig import RigSettings
 
 FloatArray = NDArray[np.float64]
 

@@ -14,11 +14,11 @@ from statistics import NormalDist
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.schema import SensorConfig
-from palpate.estimation.beamstate import BeamStates, infer_states
-from palpate.estimation.section import Section
-from palpate.robot.trial.inputs import EstimatorInputs
-from palpate.sensor.strain import grating_intervals
+from ...config.schema import SensorConfig
+from ...estimation.beamstate import BeamStates, infer_states
+from ...estimation.section import Section
+from ...sensor.strain import grating_intervals
+from .inputs import EstimatorInputs
 
 FloatArray = NDArray[np.float64]
 LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})  # the joint fit's rows

@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from palpate.robot.records.recording import McapRecorder
-from palpate.robot.trial.inputs import header_sensor
-from palpate.robot.trial.states import on_beam, record_lengths, states_at
+from ..records.recording import McapRecorder
+from .inputs import header_sensor
+from .states import on_beam, record_lengths, states_at
 
 
 def axial_loads(recorder: McapRecorder) -> list[float] | None:

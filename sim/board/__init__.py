@@ -10,9 +10,9 @@ Modules: :mod:`.source` (:class:`BoardSample`, the sample source), :mod:`.faults
 (:class:`BoardEmulator`: the clock, the frames, the pty and its writer thread).
 """
 
-from palpate.sim.board.emulator import BoardEmulator, ByteSink
-from palpate.sim.board.faults import SYNC_BYTE, BoardFaults, BoardStats
-from palpate.sim.board.source import BoardSample, SampleSource, constant_source
+from .emulator import BoardEmulator, ByteSink
+from .faults import SYNC_BYTE, BoardFaults, BoardStats
+from .source import BoardSample, SampleSource, constant_source
 
 __all__ = [
     "SYNC_BYTE",

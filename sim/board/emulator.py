@@ -38,10 +38,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from palpate.sim.board.faults import BoardFaults, BoardStats, FaultInjector
-from palpate.sim.board.source import SampleSource
-from palpate.sim.clock import VirtualClock
-from palpate.wire.frame import Frame, FrameLayout, Status, check_ranges, encode, frame_from_si
+from ...wire.frame import Frame, FrameLayout, Status, check_ranges, encode, frame_from_si
+from ..clock import VirtualClock
+from .faults import BoardFaults, BoardStats, FaultInjector
+from .source import SampleSource
 
 EMIT_SLACK_S = 1e-7  # s: a sample this close to the clock's time is due (see emit_until)
 

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from palpate.config.loader import limits
-from palpate.wire.frame import SYNC
+from ...config.loader import limits
+from ...wire.frame import SYNC
 
 SYNC_BYTE = SYNC[0]
 

@@ -10,7 +10,7 @@ Layering: the control table is :mod:`wire.dynamixel` (a hardware fact kept in on
 the driver in ``robot/`` reads too); nothing here imports ``robot/``.
 """
 
-from palpate.sim.dynamixel.bus import EmulatedBus
-from palpate.sim.dynamixel.servo import EmulatedServo
+from .bus import EmulatedBus
+from .servo import EmulatedServo
 
 __all__ = ["EmulatedBus", "EmulatedServo"]

@@ -29,14 +29,14 @@ import time
 from collections.abc import Callable, Iterable
 from typing import Self
 
-from palpate.config.schema import ServoBusConfig
-from palpate.sim.clock import VirtualClock
-from palpate.sim.dynamixel import protocol
-from palpate.sim.dynamixel.instructions import InstructionSet, Reply
-from palpate.sim.dynamixel.pty import PtyLink
-from palpate.sim.dynamixel.servo import EmulatedServo
-from palpate.sim.dynamixel.timing import RETURN_DELAY_UNIT_S, BusTiming
-from palpate.wire import dynamixel as tables
+from ...config.schema import ServoBusConfig
+from ...wire import dynamixel as tables
+from ..clock import VirtualClock
+from . import protocol
+from .instructions import InstructionSet, Reply
+from .pty import PtyLink
+from .servo import EmulatedServo
+from .timing import RETURN_DELAY_UNIT_S, BusTiming
 
 _REALTIME_POLL_S = 0.01
 _RETURN_DELAY_ADDRESS = tables.X_SERIES_CONTROL_TABLE["Return_Delay_Time"][0]

@@ -27,9 +27,9 @@ from collections.abc import Sequence
 
 import dynamixel_sdk as sdk
 
-from palpate.sim.dynamixel import protocol
-from palpate.sim.dynamixel.bus import EmulatedBus
-from palpate.sim.dynamixel.instructions import Reply
+from . import protocol
+from .bus import EmulatedBus
+from .instructions import Reply
 
 _SDK = sdk.PacketHandler(2.0)  # only for getTxRxResult / getRxPacketError: the same messages
 

@@ -23,12 +23,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from palpate.config.loader import limits
-from palpate.sim.clock import VirtualClock
-from palpate.sim.dynamixel import protocol
-from palpate.sim.dynamixel.bus import EmulatedBus
-from palpate.sim.dynamixel.servo import EmulatedServo
-from palpate.sim.dynamixel.timing import BusTiming
+from ...config.loader import limits
+from ..clock import VirtualClock
+from . import protocol
+from .bus import EmulatedBus
+from .servo import EmulatedServo
+from .timing import BusTiming
 
 _HEAD = len(protocol.HEADER) + 3  # header, id, two length bytes
 

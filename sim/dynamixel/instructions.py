@@ -16,9 +16,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import NamedTuple
 
-from palpate.sim.dynamixel import protocol
-from palpate.sim.dynamixel.servo import EmulatedServo
-from palpate.wire import dynamixel as tables
+from ...wire import dynamixel as tables
+from . import protocol
+from .servo import EmulatedServo
 
 _PING, _READ, _OTHER = 0, 1, 2  # reply kinds, compared with Status_Return_Level
 _CLEAR_KEY = bytes([0x01, 0x44, 0x58, 0x4C, 0x22])

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Final
 
-from palpate.wire import dynamixel as tables
+from ...wire import dynamixel as tables
 
 TICKS_PER_S_PER_VEL_UNIT: Final = tables.VELOCITY_UNIT_RPM * tables.TICKS_PER_REV / 60.0
 TICKS_PER_S2_PER_ACC_UNIT: Final = tables.ACCELERATION_UNIT_RPM2 * tables.TICKS_PER_REV / 3600.0

@@ -19,7 +19,7 @@ import struct
 from collections.abc import Callable
 from typing import Final
 
-from palpate.wire import dynamixel as tables
+from ...wire import dynamixel as tables
 
 _Unpack = Callable[[bytes | bytearray, int], tuple[int]]
 _Pack = Callable[[bytearray, int, int], None]

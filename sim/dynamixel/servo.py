@@ -37,7 +37,8 @@ import threading
 from collections.abc import Callable
 from typing import Final
 
-from palpate.sim.dynamixel.motion import (
+from ...wire import dynamixel as tables
+from .motion import (
     DRIVEN_MODES,
     POSITION_MODES,
     TICKS_PER_S_PER_VEL_UNIT,
@@ -45,8 +46,7 @@ from palpate.sim.dynamixel.motion import (
     profile_motion,
     velocity_motion,
 )
-from palpate.sim.dynamixel.registers import OPERATING_MODE, TORQUE_ENABLE, ControlTable, model_name
-from palpate.wire import dynamixel as tables
+from .registers import OPERATING_MODE, TORQUE_ENABLE, ControlTable, model_name
 
 _ID: Final = tables.X_SERIES_CONTROL_TABLE["ID"][0]
 _HARDWARE_ERROR: Final = tables.X_SERIES_CONTROL_TABLE["Hardware_Error_Status"][0]

@@ -32,7 +32,7 @@ model is described there), :mod:`.arrays` (the vectorised two-stages), :mod:`.sc
 plain-float twin), :mod:`.solve` (:func:`solve_contact`: checks and dispatch).
 """
 
-from palpate.sim.equilibrium.law import (
+from .law import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,
     BeamLike,
@@ -41,8 +41,8 @@ from palpate.sim.equilibrium.law import (
     TissueLaw,
     axial_law,
 )
-from palpate.sim.equilibrium.solve import solve_contact
-from palpate.sim.equilibrium.state import STATUS_MESSAGES, ContactState
+from .solve import solve_contact
+from .state import STATUS_MESSAGES, ContactState
 
 __all__ = [
     "DEFAULT_MAX_E_OVER_L",

@@ -14,9 +14,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from palpate.sim.equilibrium.law import AxialLaw, BoolArray, ContactEffects, FloatArray, TissueLaw
-from palpate.sim.equilibrium.sides import BeamSide, TissueSide
-from palpate.sim.equilibrium.state import ContactState, status_message
+from .law import AxialLaw, BoolArray, ContactEffects, FloatArray, TissueLaw
+from .sides import BeamSide, TissueSide
+from .state import ContactState, status_message
 
 
 class _Onset(NamedTuple):

@@ -20,15 +20,15 @@ from collections.abc import Callable
 
 import numpy as np
 
-from palpate.estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
-from palpate.sim.equilibrium.law import (
+from ...estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
+from .law import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,
     ContactEffects,
     FloatArray,
     TissueLaw,
 )
-from palpate.sim.equilibrium.state import ContactState, status_message
+from .state import ContactState, status_message
 
 
 def _as_float(x: object) -> float:

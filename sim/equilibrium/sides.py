@@ -35,8 +35,8 @@ from typing import Generic, TypeVar
 
 import numpy as np
 
-from palpate.estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
-from palpate.sim.equilibrium.law import (
+from ...estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
+from .law import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,
     ContactEffects,

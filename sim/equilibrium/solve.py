@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from palpate.sim.equilibrium.arrays import solve_array
-from palpate.sim.equilibrium.law import AxialLaw, BeamLike, ContactEffects, TissueLaw, axial_law
-from palpate.sim.equilibrium.scalar import solve_scalar
-from palpate.sim.equilibrium.state import ContactState
+from .arrays import solve_array
+from .law import AxialLaw, BeamLike, ContactEffects, TissueLaw, axial_law
+from .scalar import solve_scalar
+from .state import ContactState
 
 
 def solve_contact(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from palpate.sim.equilibrium.law import BoolArray, FloatArray
+from .law import BoolArray, FloatArray
 
 STATUS_MESSAGES: dict[int, str] = {
     0: "converged",

@@ -7,8 +7,8 @@ See docs/tissue-fe.md.
 
 from __future__ import annotations
 
-from palpate.sim.fem.law import FeTissueLaw
-from palpate.sim.fem.problem import LayerProblem
-from palpate.sim.fem.table import ForceTable, load_table, table_key
+from .law import FeTissueLaw
+from .problem import LayerProblem
+from .table import ForceTable, load_table, table_key
 
 __all__ = ["FeTissueLaw", "ForceTable", "LayerProblem", "load_table", "table_key"]

@@ -21,8 +21,8 @@ from numpy.typing import NDArray
 from scipy import sparse  # type: ignore[import-untyped,unused-ignore]
 from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector
 
-from palpate.sim.fem.material import MaterialLaw, Response
-from palpate.sim.fem.mesh import LayerMesh
+from .material import MaterialLaw, Response
+from .mesh import LayerMesh
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.sim.fem.assembly import Discretization
+from .assembly import Discretization
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -15,8 +15,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from palpate.sim.fem.problem import LayerProblem
-from palpate.sim.fem.table import SHIPPED_DIR, save_table, solve_table, table_key
+from .problem import LayerProblem
+from .table import SHIPPED_DIR, save_table, solve_table, table_key
 
 _PAPER = {"tip_radius": 3.5e-3, "thickness": 10e-3, "radius": 40e-3, "poisson": 0.45}
 _SOFT = {"tip_radius": 6e-3, "thickness": 20e-3, "radius": 40e-3, "poisson": 0.45}

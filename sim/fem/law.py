@@ -29,8 +29,8 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from palpate.sim.fem.problem import LayerProblem
-from palpate.sim.fem.table import ForceTable, load_table, table_key
+from .problem import LayerProblem
+from .table import ForceTable, load_table, table_key
 
 FloatArray = NDArray[np.float64]
 T = TypeVar("T", float, FloatArray)

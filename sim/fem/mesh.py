@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 from skfem import MeshTri
 
-from palpate.sim.fem.problem import LayerProblem
+from .problem import LayerProblem
 
 FloatArray = NDArray[np.float64]
 

@@ -26,11 +26,11 @@ from numpy.typing import NDArray
 from scipy import sparse  # type: ignore[import-untyped,unused-ignore]
 from scipy.sparse import linalg as splinalg  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.sim.fem import contact
-from palpate.sim.fem.assembly import Assembled, Discretization, assemble, discretize
-from palpate.sim.fem.material import CONSTANT_TANGENT, MATERIAL_LAWS
-from palpate.sim.fem.mesh import build_mesh
-from palpate.sim.fem.problem import LayerProblem
+from . import contact
+from .assembly import Assembled, Discretization, assemble, discretize
+from .material import CONSTANT_TANGENT, MATERIAL_LAWS
+from .mesh import build_mesh
+from .problem import LayerProblem
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

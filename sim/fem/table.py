@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.config.cache import cache_dir, write_npz
-from palpate.sim.fem.problem import LayerProblem
+from ...config.cache import cache_dir, write_npz
+from .problem import LayerProblem
 
 FloatArray = NDArray[np.float64]
 
@@ -110,7 +110,7 @@ def solve_table(problem: LayerProblem) -> ForceTable:
     Raises:
         RuntimeError: not even the first depth converged (the solver's message).
     """
-    from palpate.sim.fem.solver import solve_indentation
+    from .solver import solve_indentation
 
     start = time.perf_counter()
     result = solve_indentation(problem)
