@@ -45,6 +45,7 @@ mode stops describing the pinned beam), thinned to ``MAX_ROWS``. Shapes: N rows,
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -283,18 +284,28 @@ class _Model:
         """(C, N): each row's residual at its load P (C, N) and the lean c of its line (the
         lateral shape as :func:`lateral_shape_by_grating` computes it, element for element,
         with the rows' grating spans taken once)."""
-        k = np.sqrt(np.maximum(np.minimum(P, LOAD_SHARE * self.cap), 0.0) / self.EI)
+        k = np.sqrt(np.maximum(np.minimum(P, self._saturation), 0.0) / self.EI)
         half_k = 0.5 * k
-        d0 = np.minimum(self.from_tip[:, 0, None], self.L)  # (G, N)
-        d1 = np.minimum(self.from_tip[:, 1, None], self.L)
-        span = (self.from_tip[:, 1] - self.from_tip[:, 0])[:, None, None]
-        integral = (
-            2.0 * np.sin(half_k * (d0 + d1)[:, None, :]) * np.sin(half_k * (d1 - d0)[:, None, :])
-        )
+        d_sum, d_diff, span = self._spans
+        integral = 2.0 * np.sin(half_k * d_sum) * np.sin(half_k * d_diff)
         shape = -self.dy * integral / (span * np.cos(k * self.L))
         axial = P / self.EA
         c2 = cs[:, None]
         return self._ss([y + axial - c2 * g for y, g in zip(self.y, shape, strict=True)])
+
+    @functools.cached_property
+    def _saturation(self) -> FloatArray:
+        """(N,): the largest load a free tip's shape is taken at, LOAD_SHARE of the capacity."""
+        return np.asarray(LOAD_SHARE * self.cap)
+
+    @functools.cached_property
+    def _spans(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The rows' grating spans on the exposed beam, (G, 1, N) each: d0 + d1 and d1 - d0,
+        and the gratings' lengths (G, 1, 1)."""
+        d0 = np.minimum(self.from_tip[:, 0, None], self.L)  # (G, N)
+        d1 = np.minimum(self.from_tip[:, 1, None], self.L)
+        span = (self.from_tip[:, 1] - self.from_tip[:, 0])[:, None, None]
+        return (d0 + d1)[:, None, :], (d1 - d0)[:, None, :], span
 
     def _ss(self, v: list[FloatArray]) -> FloatArray:
         """Squared norm over the gratings of v (one (C, N) array per grating) with the onset
