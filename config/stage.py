@@ -46,17 +46,17 @@ class Stage:
     def of(cls, kind: str, exposed: float, flush_translation: float) -> Stage:
         """From a serialised trial's fields (a log's estimator inputs: ``kind`` and the flush
         translation it recorded)."""
-        return cls(exposed, flush_translation) if kind == "robot" else cls(exposed)
+        return cls(exposed, flush_translation) if kind == "robot" else cls.column(exposed)
 
     @classmethod
     def of_tube(cls, kind: str, tube: TubeConfig, exposed: float) -> Stage:
         """A trial's stage from its ``kind`` and the tube it names (unused on the bench)."""
-        return cls.on(tube, exposed) if kind == "robot" else cls(exposed)
+        return cls.on(tube, exposed) if kind == "robot" else cls.column(exposed)
 
     @classmethod
     def in_stack(cls, kind: str, stack: StackConfig, tube: str, exposed: float) -> Stage:
         """A campaign trial's stage: ``kind`` ("bench" or "robot") and its tube's name."""
-        return cls.on(stack.tube(tube), exposed) if kind == "robot" else cls(exposed)
+        return cls.on(stack.tube(tube), exposed) if kind == "robot" else cls.column(exposed)
 
     @property
     def kind(self) -> Kind:

@@ -22,6 +22,7 @@ from palpate.config.loader import from_mapping
 from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
 from palpate.estimation.section import Section
 from palpate.robot.records.log import TrialLog, TrialLogError, read_log
+from palpate.robot.records.logschema import logged_number
 from palpate.robot.trial.estimate import (
     EstimatorInputs,
     estimate_from_marks,
@@ -141,7 +142,7 @@ def _replay_joint(
         raw = {**raw, **probe_inputs(probe)}
     inputs = EstimatorInputs.from_dict(raw)
     samples = list(log.of_kind("sample"))
-    rows = [(r["state"], _number(r["advance"]), r["strains"]) for r in samples]  # null: missed
+    rows = [(r["state"], logged_number(r["advance"]), r["strains"]) for r in samples]
     tips = [r.get("tip_force") for r in samples] if any("tip_force" in r for r in samples) else None
     fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples], tips)
     end = log.end or {}
@@ -198,11 +199,6 @@ def known_moduli(header: dict[str, Any]) -> dict[str, float | None]:
 
 def _tuples(d: dict[str, Any]) -> dict[str, Any]:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
-
-
-def _number(value: object) -> float:
-    """A log's number, NaN for its null (a value the tick did not measure)."""
-    return math.nan if value is None else float(value)  # type: ignore[arg-type]
 
 
 def _kpa(value: object) -> float | None:

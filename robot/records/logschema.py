@@ -38,6 +38,12 @@ class Field:
     required: bool = True
 
 
+def logged_number(value: Any) -> float:
+    """A number as a log holds it, NaN for its null (a value the tick did not measure, such as
+    the advance of a tick whose servo read was missed)."""
+    return math.nan if value is None else float(value)
+
+
 def _fail(key: str, want: str, value: Any) -> LogRecordError:
     shown = repr(value)
     return LogRecordError(key, f"expected {want}, got {shown[:60]}")

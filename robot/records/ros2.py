@@ -33,6 +33,7 @@ from typing import Any
 from ...config.schema import TubeConfig
 from ..kinematics import tube_tip_in_bend_plane
 from . import cdr
+from .logschema import logged_number
 
 SEP = "\n" + "=" * 80 + "\n"
 TIME = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
@@ -116,12 +117,8 @@ def header(stamp_ns: int, frame: str) -> dict[str, Any]:
     return {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": frame}
 
 
-def _number(value: Any) -> float:
-    return math.nan if value is None else float(value)
-
-
 def _numbers(values: Sequence[Any]) -> list[float]:
-    return [_number(v) for v in values]
+    return [logged_number(v) for v in values]
 
 
 def sample_messages(record: dict[str, Any], stamp_ns: int) -> list[tuple[str, bytes]]:
@@ -136,7 +133,7 @@ def sample_messages(record: dict[str, Any], stamp_ns: int) -> list[tuple[str, by
         record["state"],
         _numbers(record["strains"]),
         bool(record["contact"]),
-        _number(record.get("goal")),
+        logged_number(record.get("goal")),
     )
     return [("/joint_states", joints), ("/fbg/strains", strains)]
 
@@ -154,7 +151,7 @@ def messages(record: dict[str, Any], stamp_ns: int, line: str) -> list[Message]:
                     "from_state": record["from"],
                     "to_state": record["to"],
                     "reason": record["reason"],
-                    "advance": _number(record["advance"]),
+                    "advance": logged_number(record["advance"]),
                     "strain": _numbers(record["strains"]),
                 },
             )
