@@ -79,6 +79,44 @@ class AssumedConfig:
 
 
 @dataclass(frozen=True)
+class InclusionConfig:
+    """A stiff (or soft) sphere inside a sample's layer: a tumour in parenchyma, a fibrotic
+    focus. ``center_mm``: (x, y, depth) of its centre, x and y along the surface from the point
+    where a single trial indents (the sample's origin), the depth below the surface;
+    ``radius_mm``; its own ``modulus_kpa`` and ``poisson``. The world feels it
+    (``sim.fem3d``); the estimator is never told it exists::
+
+        inclusions:
+          - {center_mm: [0, 0, 5], radius_mm: 2.5, modulus_kpa: 1500}
+    """
+
+    center_mm: tuple[float, float, float] = field(metadata=limits(ge=-1000, le=1000))
+    radius_mm: float = field(metadata=limits(gt=0, le=1000))
+    modulus_kpa: float = field(metadata=limits(gt=0, le=1e6))
+    poisson: float = field(default=0.45, metadata=limits(ge=0, le=0.5))
+
+    def validate(self) -> None:
+        if self.center_mm[2] <= self.radius_mm:
+            raise ValueError(
+                f"center_mm: the depth {self.center_mm[2]:g} mm must exceed radius_mm "
+                f"{self.radius_mm:g} (the inclusion lies below the surface)"
+            )
+
+    @property
+    def center(self) -> tuple[float, float, float]:
+        x, y, depth = self.center_mm
+        return (x * MM, y * MM, depth * MM)
+
+    @property
+    def radius(self) -> float:
+        return self.radius_mm * MM
+
+    @property
+    def modulus(self) -> float:
+        return self.modulus_kpa * KPA
+
+
+@dataclass(frozen=True)
 class SampleConfig:
     """A tissue phantom as the world has it, and where it sits.
 
@@ -105,6 +143,10 @@ class SampleConfig:
     (x, y, z in the robot's base frame).
 
     ``assumed``: what the operator believes (:class:`AssumedConfig`); null = the truth above.
+
+    ``inclusions``: spheres inside the layer (:class:`InclusionConfig`), which the world's
+    finite-element tissue feels and the estimator is not told of; ``modulus_kpa`` is then the
+    matrix's (docs/inclusions.md).
     """
 
     name: str
@@ -127,6 +169,24 @@ class SampleConfig:
         default=(0.0, 0.0, 0.0), metadata=limits(ge=-1000, le=1000)
     )
     assumed: AssumedConfig | None = None
+    inclusions: tuple[InclusionConfig, ...] = ()
+
+    def validate(self) -> None:
+        for k, inc in enumerate(self.inclusions):
+            x, y, depth = inc.center_mm
+            where = f"inclusions[{k}]"
+            if self.rigid:
+                raise ValueError(f"{where}: a rigid sample holds no inclusion")
+            if self.thickness_mm is not None and depth + inc.radius_mm >= self.thickness_mm:
+                raise ValueError(
+                    f"{where}: reaches the base (depth {depth:g} + radius {inc.radius_mm:g} mm "
+                    f">= thickness_mm {self.thickness_mm:g})"
+                )
+            if math.hypot(x, y) + inc.radius_mm >= self.lateral_radius_mm:
+                raise ValueError(
+                    f"{where}: reaches the sample's edge (lateral_radius_mm "
+                    f"{self.lateral_radius_mm:g})"
+                )
 
     @property
     def modulus(self) -> float:

@@ -187,6 +187,12 @@ class SceneConfig:
         names = [s.name for s in self.samples]
         if len(set(names)) != len(names):
             raise ValueError(f"samples: names must be unique, got {names}")
+        for k, sample in enumerate(self.samples):
+            if sample.inclusions and self.fidelity.tissue_model != "fe":
+                raise ValueError(
+                    f"samples[{k}].inclusions: the world feels inclusions only on "
+                    f"fidelity.tissue_model: fe (got {self.fidelity.tissue_model!r})"
+                )
         for wanted in self.campaign.samples:
             if wanted not in names:
                 raise ValueError(f"campaign.samples: no sample named {wanted!r}; known: {names}")

@@ -11,6 +11,8 @@ keys map onto them (the one place that does).
   A half-space (``thickness_mm: null``, or ``finite_thickness: false``) is a block 200 R deep
   and 200 R wide (within 0.4 % of Sneddon's half-space to delta = R, docs/tissue-fe.md). The
   FE is always a sphere at finite depth, so ``large_indentation`` does not apply to it.
+  A sample with ``inclusions`` takes that table times the inclusions' factor on the force from
+  a three-dimensional solve (:func:`fe_world`, :mod:`sim.fem3d`, docs/inclusions.md).
 - ``"closed-form"``: :class:`sim.tissue.TissueModel`, Sneddon's sphere times the Dimitriadis
   series: the estimator's own family of laws, cheap; a scene that picks it judges the estimator
   on its own model. Linear, frictionless only (``material`` and ``friction`` are ignored).
@@ -38,10 +40,13 @@ from ..config.scene import FidelityConfig
 from .equilibrium import TissueLaw
 from .equilibrium.law import FloatArray
 from .fem import FeTissueLaw, LayerProblem, table_key
+from .fem3d import Inclusion, InclusionProblem, InclusionWorld
 from .viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
 
 HALF_SPACE_RATIO = 200.0
 """Depth and lateral radius / R of the block that stands in for a half-space on the FE level."""
+SOLID_LIMIT_RATIO = 40.0
+"""Largest depth and half-width / R of the 3-D model of a layer with inclusions."""
 
 STEEL_MODULUS = 200e9  # Pa
 STEEL_POISSON = 0.3
@@ -85,6 +90,42 @@ def fe_problem(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float
     return LayerProblem.from_dimensions(tip_radius, thickness, sample.lateral_radius, **options)
 
 
+def fe_world(
+    sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float
+) -> LayerProblem | InclusionWorld:
+    """The FE tissue of ``sample``: its layer's problem, or with inclusions the layer and its
+    3-D problem (:class:`sim.fem3d.InclusionWorld`; the 3-D model is cut at
+    ``SOLID_LIMIT_RATIO`` R deep and wide, which the inclusions' factor does not feel)."""
+    layer = fe_problem(sample, fidelity, tip_radius)
+    if not sample.inclusions:
+        return layer
+    inclusions = tuple(
+        Inclusion(
+            x=_ratio(inc.center[0], tip_radius),
+            y=_ratio(inc.center[1], tip_radius),
+            depth=_ratio(inc.center[2], tip_radius),
+            radius=_ratio(inc.radius, tip_radius),
+            contrast=_ratio(inc.modulus, sample.modulus),
+            poisson=inc.poisson,
+        )
+        for inc in sample.inclusions
+    )
+    solid = InclusionProblem(
+        thickness_ratio=min(layer.thickness_ratio, SOLID_LIMIT_RATIO),
+        radius_ratio=min(layer.radius_ratio, SOLID_LIMIT_RATIO),
+        poisson=layer.poisson,
+        base=layer.base,
+        inclusions=inclusions,
+        depth_max=layer.depth_max,
+        n_depths=layer.n_depths,
+    )
+    return InclusionWorld(layer, solid)
+
+
+def _ratio(a: float, b: float) -> float:
+    return float(f"{a / b:.9g}")
+
+
 def relaxation(sample: SampleConfig, fidelity: FidelityConfig) -> Relaxation | None:
     """The sample's relaxation (``relaxation``: a standard linear solid or a power law) when the
     scene switches viscoelasticity on and the sample has a relaxation time; None: elastic."""
@@ -104,7 +145,7 @@ def world_tissue(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: flo
     sls = relaxation(sample, fidelity)
     modulus = sample.modulus / (1.0 if sls is None else sls.ratio)
     if fidelity.tissue_model == "fe":
-        return FeTissueLaw(fe_problem(sample, fidelity, tip_radius), modulus, tip_radius)
+        return FeTissueLaw(fe_world(sample, fidelity, tip_radius), modulus, tip_radius)
     from .tissue import TissueModel  # the estimator's family: only on this level
 
     return TissueModel(
@@ -138,6 +179,18 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
             poisson=problem.poisson,
             table=table_key(problem),
         )
+        world = fe_world(sample, fidelity, tip_radius)
+        if isinstance(world, InclusionWorld):
+            out["inclusions"] = [
+                {
+                    "center_mm": list(i.center_mm),
+                    "radius_mm": i.radius_mm,
+                    "modulus_kpa": i.modulus_kpa,
+                }
+                for i in sample.inclusions
+            ]
+            out["law"] = "finite elements (sim.fem) x 3-D inclusion factor (sim.fem3d)"
+            out["table"] = world.key
     else:
         out["law"] = "Sneddon x Dimitriadis (sim.tissue: the estimator's own family)"
     out["viscoelastic"] = None if sls is None else {**sls.describe(), "modulus": "relaxed"}

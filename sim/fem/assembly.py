@@ -100,19 +100,21 @@ def pressures(disc: Discretization, p: FloatArray) -> FloatArray:
 def assemble(
     disc: Discretization,
     law: MaterialLaw,
-    shear: float,
-    bulk_compliance: float,
+    shear: float | FloatArray,
+    bulk_compliance: float | FloatArray,
     u: FloatArray,
     p: FloatArray,
 ) -> Assembled:
     """Residuals dPi/du (n_u,), dPi/dp (n_p,) and the tangent blocks at (u, p).
 
-    ``bulk_compliance`` is 1/K in units of 1/E (0 when incompressible). Raises
-    FloatingPointError when the material rejects the state (an inverted element).
+    ``shear`` is mu in units of E, ``bulk_compliance`` 1/K in units of 1/E (0 when
+    incompressible): constants, or (nel, nqp) values at the quadrature points (an inclusion;
+    the energies are linear in mu). Raises FloatingPointError when the material rejects the
+    state (an inverted element).
     """
     H = gradients(disc, u)
     pq = pressures(disc, p)
-    resp: Response = law(H, shear)
+    resp: Response = _response(law, H, shear)
     weights = disc.weights
     B, P = disc.B, disc.P
     stress = resp.stress + pq * resp.volume_grad
@@ -121,7 +123,10 @@ def assemble(
     D = resp.tangent + pq * resp.volume_hess
     k_uu = np.einsum("iaeq,abeq,jbeq,eq->eij", B, D, B, weights, optimize=True)
     k_up = np.einsum("iaeq,aeq,jeq,eq->eij", B, resp.volume_grad, P, weights, optimize=True)
-    k_pp = -bulk_compliance * np.einsum("ieq,jeq,eq->eij", P, P, weights, optimize=True)
+    if isinstance(bulk_compliance, np.ndarray):
+        k_pp = -np.einsum("ieq,jeq,eq->eij", P, P, bulk_compliance * weights, optimize=True)
+    else:
+        k_pp = -bulk_compliance * np.einsum("ieq,jeq,eq->eij", P, P, weights, optimize=True)
     ud, pd = disc.ubasis.element_dofs, disc.pbasis.element_dofs
     return Assembled(
         r_u=_vector(r_u, ud, disc.n_u),
@@ -130,6 +135,14 @@ def assemble(
         K_up=_matrix(k_up, ud, pd, (disc.n_u, disc.n_p)),
         K_pp=_matrix(k_pp, pd, pd, (disc.n_p, disc.n_p)),
     )
+
+
+def _response(law: MaterialLaw, H: FloatArray, shear: float | FloatArray) -> Response:
+    """The law's response for a constant shear modulus, or scaled point by point."""
+    if not isinstance(shear, np.ndarray):
+        return law(H, shear)
+    unit = law(H, 1.0)
+    return unit._replace(stress=unit.stress * shear, tangent=unit.tangent * shear)
 
 
 def _vector(local: FloatArray, dofs: IntArray, n: int) -> FloatArray:

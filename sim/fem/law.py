@@ -24,7 +24,7 @@ import bisect
 import functools
 import math
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Protocol, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -52,10 +52,28 @@ class _Curve:
     m_list: list[float]
 
 
+class TableSource(Protocol):
+    """A force table that is not one axisymmetric layer's (``sim.fem3d.InclusionWorld``)."""
+
+    @property
+    def key(self) -> str: ...
+
+    def table(self) -> ForceTable: ...
+
+    def __hash__(self) -> int: ...
+
+
+Problem = LayerProblem | TableSource
+"""What a :class:`FeTissueLaw` reads its table from."""
+
+
+def _load(problem: Problem) -> ForceTable:
+    return load_table(problem) if isinstance(problem, LayerProblem) else problem.table()
+
+
 @functools.lru_cache(maxsize=64)
-def _curve(problem: LayerProblem) -> _Curve:
-    table = load_table(problem)
-    return curve_from_table(table)
+def _curve(problem: Problem) -> _Curve:
+    return curve_from_table(_load(problem))
 
 
 def curve_from_table(table: ForceTable) -> _Curve:
@@ -148,12 +166,13 @@ class FeTissueLaw:
 
     Attributes:
         problem: the dimensionless problem (geometry / R, Poisson's ratio, material, base,
-            friction, mesh); its table is loaded by key on first use.
+            friction, mesh), or another source of a table (a layer with inclusions:
+            ``sim.fem3d.InclusionWorld``); its table is loaded by key on first use.
         modulus: Young's modulus E in Pa (small-strain modulus for neo-Hookean).
         tip_radius: radius R of the spherical tip in m.
     """
 
-    problem: LayerProblem
+    problem: Problem
     modulus: float
     tip_radius: float
 
@@ -168,12 +187,14 @@ class FeTissueLaw:
     @property
     def key(self) -> str:
         """The key of the table this law reads."""
-        return table_key(self.problem)
+        return (
+            table_key(self.problem) if isinstance(self.problem, LayerProblem) else self.problem.key
+        )
 
     @property
     def depth_limit(self) -> float:
         """Deepest tabulated depth (m); beyond it the law is extrapolated."""
-        return float(self.tip_radius * load_table(self.problem).depths[-1])
+        return float(self.tip_radius * _load(self.problem).depths[-1])
 
     @property
     def _scale(self) -> float:

@@ -27,6 +27,8 @@ GROWTH = 1.3
 """Ratio of neighbouring spacings of the tensor grid away from the origin."""
 CONTACT_ZONE = 1.4
 """Radius (units of R) about the origin inside which the mesh is graded."""
+INCLUSION_SIZE = 0.1
+"""Largest triangle at an on-axis inclusion's boundary, over its radius."""
 _MAX_REFINEMENTS = 30
 
 
@@ -64,7 +66,7 @@ def build_mesh(problem: LayerProblem) -> LayerMesh:
     target = 1.0 / problem.resolution
     floor = target * math.sqrt(problem.depths()[0])
     for _ in range(_MAX_REFINEMENTS):
-        marked = _too_large(mesh, target, floor)
+        marked = _too_large(mesh, target, floor, problem.inclusion)
         if marked.size == 0:
             break
         mesh = mesh.refined(marked)
@@ -73,12 +75,20 @@ def build_mesh(problem: LayerProblem) -> LayerMesh:
     return LayerMesh(mesh=mesh, thickness=h, radius=width)
 
 
-def _too_large(mesh: MeshTri, target: float, floor: float) -> NDArray[np.int64]:
-    """Indices of triangles in the contact zone larger than ``max(floor, target * distance)``."""
+def _too_large(
+    mesh: MeshTri, target: float, floor: float, inclusion: tuple[float, float, float, float] | None
+) -> NDArray[np.int64]:
+    """Indices of triangles in the contact zone larger than ``max(floor, target * distance)``,
+    and of triangles near an inclusion's boundary larger than ``radius * INCLUSION_SIZE``."""
     p = mesh.p[:, mesh.t]  # (2, 3, nel)
     centroid = p.mean(axis=1)
     distance = np.hypot(centroid[0], centroid[1])
     edges = p - np.roll(p, 1, axis=1)
     size = np.sqrt((edges**2).sum(axis=0)).max(axis=0)
     near = distance < CONTACT_ZONE
-    return np.flatnonzero(near & (size > np.maximum(floor, target * distance)))
+    marked = near & (size > np.maximum(floor, target * distance))
+    if inclusion is not None:
+        depth, radius = inclusion[0], inclusion[1]
+        rho = np.hypot(centroid[0], centroid[1] + depth)
+        marked |= (np.abs(rho - radius) < size) & (size > INCLUSION_SIZE * radius)
+    return np.flatnonzero(marked)

@@ -18,6 +18,11 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
 MATERIALS = ("linear", "neo-hookean")
 BASES = ("bonded", "sliding")
 CONTACTS = ("frictionless", "stick")
@@ -39,6 +44,10 @@ class LayerProblem:
         depth_max: deepest tabulated depth delta / R.
         n_depths: number of tabulated depths (uniform in sqrt(delta / R)).
         resolution: mesh density (elements per contact radius at the contact edge, about).
+        inclusion: a sphere on the axis, ``(depth, radius, contrast, poisson)`` of its centre
+            below the surface, its radius (units of R), its Young's modulus over the layer's
+            and its Poisson's ratio; None (the default, and left out of the table's key): a
+            homogeneous layer. The three-dimensional world's reference (``sim.fem3d``).
     """
 
     thickness_ratio: float
@@ -50,6 +59,7 @@ class LayerProblem:
     depth_max: float = 1.0
     n_depths: int = 20
     resolution: int = 6
+    inclusion: tuple[float, float, float, float] | None = None
 
     def __post_init__(self) -> None:
         _check_choice("material", self.material, MATERIALS)
@@ -67,6 +77,12 @@ class LayerProblem:
             raise ValueError(f"n_depths must be >= 3, got {self.n_depths}")
         if not 2 <= self.resolution <= 64:
             raise ValueError(f"resolution must be in [2, 64], got {self.resolution}")
+        if self.inclusion is not None:
+            depth, radius, contrast, nu = self.inclusion
+            if not (0 < radius < depth and depth + radius < self.thickness_ratio):
+                raise ValueError(f"inclusion {self.inclusion} must lie inside the layer")
+            if not (contrast > 0 and 0.0 <= nu <= 0.5):
+                raise ValueError(f"inclusion {self.inclusion}: contrast > 0, poisson in [0, 0.5]")
 
     @property
     def shear_modulus(self) -> float:
@@ -77,6 +93,19 @@ class LayerProblem:
     def bulk_compliance(self) -> float:
         """E / K = 3 (1 - 2 nu): 0 for an incompressible solid."""
         return 3.0 * (1.0 - 2.0 * self.poisson)
+
+    def material_fields(
+        self, r: FloatArray, z: FloatArray
+    ) -> tuple[float | FloatArray, float | FloatArray]:
+        """(mu / E, E / K) at the points (r, z): the layer's constants, or arrays of the points'
+        shape with the inclusion's values inside it."""
+        if self.inclusion is None:
+            return self.shear_modulus, self.bulk_compliance
+        depth, radius, contrast, nu = self.inclusion
+        inside = r**2 + (z + depth) ** 2 <= radius**2
+        shear = np.where(inside, contrast * 0.5 / (1.0 + nu), self.shear_modulus)
+        bulk = np.where(inside, 3.0 * (1.0 - 2.0 * nu) / contrast, self.bulk_compliance)
+        return shear, bulk
 
     def depths(self) -> list[float]:
         """The tabulated depths delta / R: uniform in s = sqrt(delta / R) from s_max / n."""
@@ -99,8 +128,12 @@ class LayerProblem:
         )
 
     def as_dict(self) -> dict[str, Any]:
-        """Plain-data form (what the table key hashes)."""
-        return asdict(self)
+        """Plain-data form (what the table key hashes; no ``inclusion`` key when there is none,
+        so the homogeneous layers keep their keys)."""
+        out = asdict(self)
+        if self.inclusion is None:
+            del out["inclusion"]
+        return out
 
 
 def _check_choice(name: str, value: str, allowed: tuple[str, ...]) -> None:

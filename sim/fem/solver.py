@@ -94,6 +94,8 @@ class IndentationSystem:
     surface: contact.Surface
     free: IntArray
     finite: bool
+    shear: float | FloatArray
+    bulk: float | FloatArray
     cached: dict[str, Assembled] = field(default_factory=dict)
 
 
@@ -112,7 +114,9 @@ def build_system(problem: LayerProblem) -> IndentationSystem:
         fixed += [base.nodal["u^1"], base.facet["u^1"]]
     free = np.setdiff1d(np.arange(disc.n_u), np.concatenate(fixed))
     finite = problem.material not in CONSTANT_TANGENT
-    return IndentationSystem(problem, disc, contact.top_surface(disc), free, finite)
+    r, z = (np.asarray(c) for c in ub.global_coordinates())
+    shear, bulk = problem.material_fields(r, z)
+    return IndentationSystem(problem, disc, contact.top_surface(disc), free, finite, shear, bulk)
 
 
 def _assemble(system: IndentationSystem, state: _State) -> Assembled:
@@ -123,7 +127,7 @@ def _assemble(system: IndentationSystem, state: _State) -> Assembled:
         r_p = a.K_up.T @ state.u + a.K_pp @ state.p
         return Assembled(r_u, r_p, a.K_uu, a.K_up, a.K_pp)
     law = MATERIAL_LAWS[prob.material]
-    a = assemble(system.disc, law, prob.shear_modulus, prob.bulk_compliance, state.u, state.p)
+    a = assemble(system.disc, law, system.shear, system.bulk, state.u, state.p)
     if not system.finite:
         system.cached["linear"] = a
     return a

@@ -76,3 +76,54 @@ def test_scene_defaults_are_the_papers_phantoms() -> None:
     assert [s.name for s in scene.samples][:2] == ["S1", "S2"]
     assert scene.fidelity.tissue_model in ("fe", "closed-form")
     assert scene.campaign.probe is None
+
+
+def _inclusion_sample(*inclusions: dict, **sample: object) -> SampleConfig:
+    data = {"name": "T", "modulus_kpa": 5.0, "thickness_mm": 35, "inclusions": list(inclusions)}
+    return from_mapping(SampleConfig, {**data, **sample}, "scene.yaml", "samples[0]")
+
+
+def test_a_sample_holds_inclusions_in_its_units() -> None:
+    s = _inclusion_sample({"center_mm": [1, -2, 10], "radius_mm": 4, "modulus_kpa": 40})
+    (inc,) = s.inclusions
+    assert inc.center == pytest.approx((1e-3, -2e-3, 10e-3))
+    assert (inc.radius, inc.modulus, inc.poisson) == pytest.approx((4e-3, 40e3, 0.45))
+    assert _inclusion_sample().inclusions == ()
+
+
+@pytest.mark.parametrize(
+    ("inclusion", "sample", "key", "says"),
+    [
+        ({"center_mm": [0, 0, 3], "radius_mm": 4, "modulus_kpa": 40}, {},
+         "samples[0].inclusions[0]", "must exceed radius_mm"),
+        ({"center_mm": [0, 0, 30], "radius_mm": 6, "modulus_kpa": 40}, {},
+         "samples[0]", "inclusions[0]: reaches the base"),
+        ({"center_mm": [38, 0, 10], "radius_mm": 3, "modulus_kpa": 40}, {},
+         "samples[0]", "inclusions[0]: reaches the sample's edge"),
+        ({"center_mm": [0, 0, 10], "radius_mm": 3, "modulus_kpa": 40}, {"rigid": True},
+         "samples[0]", "rigid sample"),
+        ({"center_mm": [0, 0, 10], "radius_mm": 3, "modulus_kpa": -1}, {},
+         "samples[0].inclusions[0].modulus_kpa", ""),
+        ({"center_mm": [0, 10], "radius_mm": 3, "modulus_kpa": 40}, {},
+         "samples[0].inclusions[0].center_mm", ""),
+        ({"center_mm": [0, 0, 10], "radius_mm": 3, "modulus_kpa": 40, "shape": "egg"}, {},
+         "samples[0].inclusions[0].shape", "unknown key"),
+    ],
+)  # fmt: skip
+def test_a_bad_inclusion_names_the_file_and_the_key(inclusion, sample, key, says) -> None:
+    with pytest.raises(ConfigError) as err:
+        _inclusion_sample(inclusion, **sample)
+    assert err.value.source == "scene.yaml"
+    assert err.value.key == key
+    assert says in str(err.value)
+
+
+def test_inclusions_need_the_finite_element_world() -> None:
+    scene = {
+        "name": "x",
+        "samples": [{"name": "T", "modulus_kpa": 5, "inclusions": [
+            {"center_mm": [0, 0, 5], "radius_mm": 2, "modulus_kpa": 40}]}],
+        "fidelity": {"tissue_model": "closed-form"},
+    }  # fmt: skip
+    with pytest.raises(ConfigError, match=r"samples\[0\].inclusions: the world feels"):
+        from_mapping(SceneConfig, scene, "scene.yaml")

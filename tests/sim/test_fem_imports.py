@@ -11,7 +11,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-SOURCES = [*sorted((ROOT / "sim" / "fem").glob("*.py")), ROOT / "sim" / "viscoelastic.py"]
+SOURCES = [
+    *sorted((ROOT / "sim" / "fem").glob("*.py")),
+    *sorted((ROOT / "sim" / "fem3d").glob("*.py")),
+    ROOT / "sim" / "viscoelastic.py",
+]
 # the world's FE path outside sim/fem: it may use estimation's beam mechanics, never its laws
 WORLD = [
     ROOT / "sim" / n

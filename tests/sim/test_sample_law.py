@@ -14,12 +14,16 @@ from palpate.config.scene import FidelityConfig, SceneConfig
 from palpate.sim.fem import FeTissueLaw, table_key
 from palpate.sim.fem.generate import SHIPPED
 from palpate.sim.fem.table import SHIPPED_DIR, read_table
+from palpate.sim.fem3d import InclusionWorld
+from palpate.sim.fem3d.table import SHIPPED_DIR as RATIOS_DIR
+from palpate.sim.fem3d.table import read_ratios
 from palpate.sim.sample_law import (
     HALF_SPACE_RATIO,
     RigidBlock,
     contact_condition,
     describe,
     fe_problem,
+    fe_world,
     relaxation,
     world_tissue,
 )
@@ -142,6 +146,7 @@ SCENES = [
     p
     for pattern in (
         "*.yaml",
+        "inclusions/*.yaml",
         "layers/*.yaml",
         "lung/*.yaml",
         "oblique/*.yaml",
@@ -161,6 +166,10 @@ def test_shipped_scenes_need_no_finite_element_solve(path: Path) -> None:
             continue
         problem = fe_problem(sample, scene.fidelity, stack.sensor.tip_radius)
         assert read_table(problem, SHIPPED_DIR) is not None, f"{path.name}: {sample.name}"
+        world = fe_world(sample, scene.fidelity, stack.sensor.tip_radius)
+        if isinstance(world, InclusionWorld):
+            found = read_ratios(world.solid, RATIOS_DIR)
+            assert found is not None, f"{path.name}: {sample.name}'s 3-D table"
 
 
 def test_the_paper_scenes_use_the_independent_world() -> None:
