@@ -338,6 +338,13 @@ def _print_report(
     levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
     print(f"world tissue: {', '.join(levels)}{note}")
+    held = [s.name for s in samples if s.inclusions]
+    if held:
+        print(
+            f"inclusions in {', '.join(held)}: each estimate is the apparent modulus at the "
+            "indented point (the estimator is not told); 'true' is the matrix's "
+            "(docs/inclusions.md)"
+        )
     print()
     threshold = scene.campaign.classify_at
     for line in verdicts.summary_lines(outcomes) + verdicts.classified_line(outcomes, threshold):
