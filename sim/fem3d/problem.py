@@ -20,6 +20,11 @@ from ..fem.problem import BASES, LayerProblem
 FloatArray = NDArray[np.float64]
 
 
+def _round(x: float) -> float:
+    """9 significant digits: a position computed two ways names the same table."""
+    return float(f"{x:.9g}")
+
+
 @dataclass(frozen=True)
 class Inclusion:
     """A spherical inclusion (units of R and of the matrix's E).
@@ -128,6 +133,26 @@ class InclusionProblem:
 
     def depths(self) -> list[float]:
         return self.layer().depths()
+
+    def seen_from(self, x: float, y: float) -> InclusionProblem:
+        """The problem of a probe at (x, y) on the surface (units of R): the same layer, its
+        inclusions placed relative to that point (the square layer is re-centred on it: its
+        edge is far from what the probe feels, docs/inclusions.md). A map's probes::
+
+            for x, y in points:
+                ratios = load_ratios(problem.seen_from(x, y))
+        """
+        moved = tuple(replace(i, x=_round(i.x - x), y=_round(i.y - y)) for i in self.inclusions)
+        return replace(self, inclusions=moved)
+
+    def canonical_problem(self) -> InclusionProblem:
+        """The same problem in the frame its solve uses (:meth:`canonical`), so that probes at
+        the same distance from an inclusion share one table."""
+        symmetry, inclusions = self.canonical()
+        if symmetry != "half":
+            return self
+        turned = tuple(replace(i, x=_round(i.x), y=0.0) for i in inclusions)
+        return replace(self, inclusions=turned)
 
     def canonical(self) -> tuple[str, tuple[Inclusion, ...]]:
         """The symmetry the solve can use and the inclusions turned into its frame.

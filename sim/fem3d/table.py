@@ -117,9 +117,15 @@ def solve_ratios(problem: InclusionProblem) -> RatioTable:
     )
 
 
-@functools.lru_cache(maxsize=64)
 def load_ratios(problem: InclusionProblem) -> RatioTable:
-    """The table of ``problem``: shipped, else cached, else solved and cached."""
+    """The table of ``problem``: shipped, else cached, else solved and cached (kept in memory;
+    looked up in the frame of its solve, so problems that differ by a turn about the vertical
+    share one)."""
+    return _load(problem.canonical_problem())
+
+
+@functools.lru_cache(maxsize=256)
+def _load(problem: InclusionProblem) -> RatioTable:
     for directory in (SHIPPED_DIR, cache_dir()):
         table = read_ratios(problem, directory)
         if table is not None:

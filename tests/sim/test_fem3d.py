@@ -141,3 +141,14 @@ def test_the_world_law_is_the_layer_times_the_factor(monkeypatch, tmp_path) -> N
     assert law.force(depths) == pytest.approx(plain.force(depths) * ratios, rel=1e-9)
     assert law.key != plain.key
     assert list(tmp_path.glob("inclusion-*.npz"))
+
+
+def test_probes_at_the_same_distance_from_an_inclusion_share_a_table() -> None:
+    from palpate.sim.fem3d.table import ratio_key
+
+    layer = _with(Inclusion(2.0, 1.0, 1.0, 0.5, 5.0))
+    east, north = layer.seen_from(2.0, 0.0), layer.seen_from(1.0, 1.0)
+    assert east.inclusions[0].offset == pytest.approx(1.0)
+    assert north.inclusions[0].offset == pytest.approx(1.0)
+    assert ratio_key(east.canonical_problem()) == ratio_key(north.canonical_problem())
+    assert layer.seen_from(2.0, 1.0).canonical()[0] == "quarter"  # right above it
