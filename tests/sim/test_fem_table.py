@@ -25,6 +25,7 @@ CHANGES = {
     "depth_max": 0.1,
     "n_depths": 4,
     "resolution": 3,
+    "inclusion": (0.5, 0.2, 5.0, 0.45),
 }
 
 
