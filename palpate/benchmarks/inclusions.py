@@ -71,7 +71,7 @@ PAPER = Sensor("paper (R 3.5 mm, S8 314.5 kPa, 10 mm layer)", 3.5, 10.0, 40.0, 3
                2.5, (3.5, 5.0, 7.0), (0.0, 3.5, 7.0, 14.0))  # fmt: skip
 LUNG = Sensor("lung (R 10 mm, 2 kPa, 20 mm layer)", 10.0, 20.0, 60.0, 2.0, 0.0197,
               5.0, (7.5, 10.0, 14.0), (0.0, 5.0, 10.0, 20.0))  # fmt: skip
-CONTRASTS = (5.0, 30.0)
+CONTRASTS = (5.0,)
 
 
 def _row(cells: Sequence[object]) -> str:
