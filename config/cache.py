@@ -16,15 +16,28 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 Arrays = dict[str, NDArray[np.float64]]
+
+
+def parameter_record(version: int, parameters: Mapping[str, Any]) -> str:
+    """The canonical text of a table's parameters under its solver's ``version``: what a table
+    file stores and its key hashes."""
+    return json.dumps({"solver_version": version, **parameters}, sort_keys=True)
+
+
+def record_key(record: str) -> str:
+    """16 hex digits naming the table of ``record`` (the first of its SHA-256)."""
+    return hashlib.sha256(record.encode()).hexdigest()[:16]
 
 
 def cache_dir() -> Path:

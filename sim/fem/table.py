@@ -15,8 +15,6 @@ The solver (and scikit-fem, ~1 s to import) is imported only when a table must b
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,7 +22,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ...config.cache import cache_dir, write_npz
+from ...config.cache import cache_dir, parameter_record, record_key, write_npz
 from .problem import LayerProblem
 
 FloatArray = NDArray[np.float64]
@@ -62,12 +60,12 @@ class ForceTable:
 
 
 def _record(problem: LayerProblem) -> str:
-    return json.dumps({"solver_version": SOLVER_VERSION, **problem.as_dict()}, sort_keys=True)
+    return parameter_record(SOLVER_VERSION, problem.as_dict())
 
 
 def table_key(problem: LayerProblem) -> str:
     """16 hex digits naming the table of ``problem`` under the current ``SOLVER_VERSION``."""
-    return hashlib.sha256(_record(problem).encode()).hexdigest()[:16]
+    return record_key(_record(problem))
 
 
 def save_table(table: ForceTable, directory: Path) -> Path:

@@ -16,8 +16,6 @@ full parameter record in it equals the request.
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
 import sys
 import time
 from dataclasses import dataclass
@@ -26,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ...config.cache import cache_dir, write_npz
+from ...config.cache import cache_dir, parameter_record, record_key, write_npz
 from .problem import InclusionProblem
 
 FloatArray = NDArray[np.float64]
@@ -65,12 +63,12 @@ class RatioTable:
 
 
 def _record(problem: InclusionProblem) -> str:
-    return json.dumps({"solver_version": SOLVER_VERSION, **problem.as_dict()}, sort_keys=True)
+    return parameter_record(SOLVER_VERSION, problem.as_dict())
 
 
 def ratio_key(problem: InclusionProblem) -> str:
     """16 hex digits naming the table of ``problem`` under the current ``SOLVER_VERSION``."""
-    return hashlib.sha256(_record(problem).encode()).hexdigest()[:16]
+    return record_key(_record(problem))
 
 
 def save_ratios(table: RatioTable, directory: Path) -> Path:
