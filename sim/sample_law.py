@@ -91,11 +91,17 @@ def fe_problem(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float
 
 
 def fe_world(
-    sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float
+    sample: SampleConfig,
+    fidelity: FidelityConfig,
+    tip_radius: float,
+    at: tuple[float, float] = (0.0, 0.0),
 ) -> LayerProblem | InclusionWorld:
-    """The FE tissue of ``sample``: its layer's problem, or with inclusions the layer and its
-    3-D problem (:class:`sim.fem3d.InclusionWorld`; the 3-D model is cut at
-    ``SOLID_LIMIT_RATIO`` R deep and wide, which the inclusions' factor does not feel)."""
+    """The FE tissue of ``sample`` under a tip pressing at ``at`` (x, y in m on its surface,
+    from the sample's origin, where a single trial indents): its layer's problem, or with
+    inclusions the layer and its 3-D problem as seen from that point
+    (:class:`sim.fem3d.InclusionWorld`; the 3-D model is cut at ``SOLID_LIMIT_RATIO`` R deep
+    and wide, which the inclusions' factor does not feel). Points at the same distance from a
+    single inclusion share one 3-D table."""
     layer = fe_problem(sample, fidelity, tip_radius)
     if not sample.inclusions:
         return layer
@@ -119,6 +125,9 @@ def fe_world(
         depth_max=layer.depth_max,
         n_depths=layer.n_depths,
     )
+    x, y = at
+    if x or y:
+        solid = solid.seen_from(_ratio(x, tip_radius), _ratio(y, tip_radius))
     return InclusionWorld(layer, solid)
 
 

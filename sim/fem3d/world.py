@@ -48,7 +48,7 @@ class InclusionWorld:
     @property
     def key(self) -> str:
         """The key of the combined table."""
-        both = f"{table_key(self.layer)}|{ratio_key(self.solid)}"
+        both = f"{table_key(self.layer)}|{ratio_key(self.solid.canonical_problem())}"
         return hashlib.sha256(both.encode()).hexdigest()[:16]
 
     def table(self) -> ForceTable:

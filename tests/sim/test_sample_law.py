@@ -189,3 +189,16 @@ def test_a_power_law_sample_gets_the_power_law_relaxation() -> None:
     relax = relaxation(sample, on)
     assert isinstance(relax, PowerLawSolid)
     assert (relax.tau, relax.ratio, relax.exponent) == (0.1, 0.6, 0.8)
+
+
+def test_a_tip_anywhere_sees_the_inclusion_from_where_it_presses() -> None:
+    """The world under a tip 3.5 mm from the shipped scene's inclusion is the one the scene's
+    `aside-3.5mm` sample has at its origin: the same shipped 3-D table."""
+    scene = load(SceneConfig, resolve("scenes/inclusions/bench.yaml"))
+    by_name = {s.name: s for s in scene.samples}
+    moved = fe_world(by_name["below"], scene.fidelity, R, at=(0.0, -3.5e-3))
+    aside = fe_world(by_name["aside-3.5mm"], scene.fidelity, R)
+    assert isinstance(moved, InclusionWorld)
+    assert isinstance(aside, InclusionWorld)
+    assert moved.key == aside.key
+    assert read_ratios(moved.solid.canonical_problem(), RATIOS_DIR) is not None
