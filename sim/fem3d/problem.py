@@ -105,19 +105,6 @@ class InclusionProblem:
             if max(abs(inc.x), abs(inc.y)) + inc.radius >= self.radius_ratio:
                 raise ValueError(f"inclusion {inc} reaches the sample's edge")
 
-    def reference(self) -> InclusionProblem:
-        """The same layer without inclusions (the denominator of the world's correction)."""
-        return InclusionProblem(
-            self.thickness_ratio,
-            self.radius_ratio,
-            self.poisson,
-            self.base,
-            (),
-            self.depth_max,
-            self.n_depths,
-            self.fine,
-        )
-
     def layer(self, **options: Any) -> LayerProblem:
         """The axisymmetric problem of the same homogeneous layer (``options``: material,
         contact, resolution)."""
