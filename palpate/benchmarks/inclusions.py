@@ -10,6 +10,8 @@ are cached, so a second run reads them):
 - ``visibility``: the apparent modulus (the force at the depth a trial reaches, over the
   homogeneous layer's) against the inclusion's lateral offset and depth, for the paper's sensor
   and for the lung sensor;
+- ``limits``: the deepest centre depth at which an inclusion straight below the tip is still
+  seen above the noise floor, by size and contrast, for both sensors;
 - ``published``: Egorov and Sarvazyan's phantoms (IEEE TMI 27:1275, 2008, Table II: a 5 kPa
   layer 35 mm thick, inclusions 5-18 mm across at 10 mm depth, 10-156 kPa) under the lung
   sensor.
@@ -108,6 +110,49 @@ def visibility(sensors: Sequence[Sensor] = (PAPER, LUNG)) -> list[str]:
     return out
 
 
+FLOORS = {PAPER.name: 0.043, LUNG.name: 0.053}
+"""The joint fit's 95 % half-width on the homogeneous sample (docs/inclusions.md)."""
+LIMIT_RADII_MM = {PAPER.name: (1.5, 2.5, 4.0), LUNG.name: (2.5, 5.0, 7.5)}
+LIMIT_CONTRASTS = (2.0, 5.0, 10.0)
+_BISECTIONS = 4
+
+
+def limits(sensors: Sequence[Sensor] = (PAPER, LUNG)) -> list[str]:
+    """The deepest centre depth at which an inclusion straight below the tip is still seen
+    above the noise floor, by bisection over its depth (quarter models)."""
+    out = ["### How deep an inclusion straight below the tip is still seen", ""]
+    for sensor in sensors:
+        end, floor = sensor.end_depth(), FLOORS[sensor.name]
+        out += [f"{sensor.name}; floor {floor:.1%}; deepest visible centre depth (mm):", ""]
+        rows = []
+        for radius in LIMIT_RADII_MM[sensor.name]:
+            one = dataclasses.replace(sensor, inclusion_radius_mm=radius)
+            rows.append(
+                [f"{2 * radius:g} mm across"]
+                + [_deepest(one, contrast, end, floor) for contrast in LIMIT_CONTRASTS]
+            )
+        out += [*_table(["inclusion", *(f"{c:g}x" for c in LIMIT_CONTRASTS)], rows), ""]
+    return out
+
+
+def _deepest(sensor: Sensor, contrast: float, end: float, floor: float) -> str:
+    radius = sensor.inclusion_radius_mm
+
+    def seen(depth: float) -> bool:
+        table = load_ratios(sensor.problem((sensor.inclusion(0.0, depth, contrast),)))
+        return _at(table, end) - 1.0 > floor
+
+    lo, hi = radius + 0.25, sensor.thickness_mm - radius - 0.25
+    if not seen(lo):
+        return f"not at {lo:g}"
+    if seen(hi):
+        return f"> {hi:g} (the base)"
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if seen(mid) else (lo, mid)
+    return f"{lo:.1f}-{hi:.1f}"
+
+
 def validation() -> list[str]:
     base = PAPER.problem()
     axi = load_table(base.layer())
@@ -172,7 +217,12 @@ def published() -> list[str]:
     ]
 
 
-SECTIONS = {"validation": validation, "visibility": visibility, "published": published}
+SECTIONS = {
+    "validation": validation,
+    "visibility": visibility,
+    "limits": limits,
+    "published": published,
+}
 
 
 def main(argv: list[str] | None = None) -> int:
