@@ -40,6 +40,7 @@ from ..config.scene import FidelityConfig
 from .equilibrium import TissueLaw
 from .equilibrium.law import FloatArray
 from .fem import FeTissueLaw, LayerProblem, table_key
+from .fem.problem import significant
 from .fem3d import Inclusion, InclusionProblem, InclusionWorld
 from .viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
 
@@ -107,11 +108,11 @@ def fe_world(
         return layer
     inclusions = tuple(
         Inclusion(
-            x=_ratio(inc.center[0], tip_radius),
-            y=_ratio(inc.center[1], tip_radius),
-            depth=_ratio(inc.center[2], tip_radius),
-            radius=_ratio(inc.radius, tip_radius),
-            contrast=_ratio(inc.modulus, sample.modulus),
+            x=significant(inc.center[0] / tip_radius),
+            y=significant(inc.center[1] / tip_radius),
+            depth=significant(inc.center[2] / tip_radius),
+            radius=significant(inc.radius / tip_radius),
+            contrast=significant(inc.modulus / sample.modulus),
             poisson=inc.poisson,
         )
         for inc in sample.inclusions
@@ -127,12 +128,8 @@ def fe_world(
     )
     x, y = at
     if x or y:
-        solid = solid.seen_from(_ratio(x, tip_radius), _ratio(y, tip_radius))
+        solid = solid.seen_from(significant(x / tip_radius), significant(y / tip_radius))
     return InclusionWorld(layer, solid)
-
-
-def _ratio(a: float, b: float) -> float:
-    return float(f"{a / b:.9g}")
 
 
 def relaxation(sample: SampleConfig, fidelity: FidelityConfig) -> Relaxation | None:
@@ -177,7 +174,8 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
     if sample.rigid:
         out["law"] = "steel block (Hertz, E = 200 GPa)"
     elif fidelity.tissue_model == "fe":
-        problem = fe_problem(sample, fidelity, tip_radius)
+        world = fe_world(sample, fidelity, tip_radius)
+        problem = world.layer if isinstance(world, InclusionWorld) else world
         out.update(
             law="finite elements (sim.fem)",
             material=problem.material,
@@ -188,7 +186,6 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
             poisson=problem.poisson,
             table=table_key(problem),
         )
-        world = fe_world(sample, fidelity, tip_radius)
         if isinstance(world, InclusionWorld):
             out["inclusions"] = [
                 {

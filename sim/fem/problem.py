@@ -122,8 +122,8 @@ class LayerProblem:
         if not (math.isfinite(tip_radius) and tip_radius > 0):
             raise ValueError(f"tip_radius must be finite and > 0, got {tip_radius}")
         return cls(
-            thickness_ratio=_round(thickness / tip_radius),
-            radius_ratio=_round(radius / tip_radius),
+            thickness_ratio=significant(thickness / tip_radius),
+            radius_ratio=significant(radius / tip_radius),
             **options,
         )
 
@@ -141,5 +141,7 @@ def _check_choice(name: str, value: str, allowed: tuple[str, ...]) -> None:
         raise ValueError(f"{name} must be one of {allowed}, got {value!r}")
 
 
-def _round(x: float) -> float:
+def significant(x: float) -> float:
+    """``x`` to 9 significant digits: a ratio computed two ways (10 mm / 3.5 mm or 0.01 /
+    0.0035, a position turned or moved) names the same table."""
     return float(f"{x:.9g}")

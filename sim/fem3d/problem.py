@@ -15,14 +15,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..fem.problem import BASES, LayerProblem
+from ..fem.problem import BASES, LayerProblem, significant
 
 FloatArray = NDArray[np.float64]
-
-
-def _round(x: float) -> float:
-    """9 significant digits: a position computed two ways names the same table."""
-    return float(f"{x:.9g}")
 
 
 @dataclass(frozen=True)
@@ -129,7 +124,9 @@ class InclusionProblem:
             for x, y in points:
                 ratios = load_ratios(problem.seen_from(x, y))
         """
-        moved = tuple(replace(i, x=_round(i.x - x), y=_round(i.y - y)) for i in self.inclusions)
+        moved = tuple(
+            replace(i, x=significant(i.x - x), y=significant(i.y - y)) for i in self.inclusions
+        )
         return replace(self, inclusions=moved)
 
     def canonical_problem(self) -> InclusionProblem:
@@ -138,7 +135,7 @@ class InclusionProblem:
         symmetry, inclusions = self.canonical()
         if symmetry != "half":
             return self
-        turned = tuple(replace(i, x=_round(i.x), y=0.0) for i in inclusions)
+        turned = tuple(replace(i, x=significant(i.x), y=0.0) for i in inclusions)
         return replace(self, inclusions=turned)
 
     def canonical(self) -> tuple[str, tuple[Inclusion, ...]]:

@@ -78,8 +78,6 @@ class Compliance:
     """The factorised layer and the surface compliance over the touchable nodes.
 
     Attributes:
-        problem: what it solves (``homogeneous``: its inclusions replaced by the matrix, on the
-            same grid: the reference whose discretisation error the world's correction cancels).
         grid: the mesh of the solved part.
         multiplicity: copies of the part in the layer (:data:`MULTIPLICITY`).
         r: (n,) distance of each touchable surface node from the indented point.
@@ -88,8 +86,6 @@ class Compliance:
         columns: computed columns of C, by node index (each (n,)).
     """
 
-    problem: InclusionProblem
-    homogeneous: bool
     grid: HexGrid
     multiplicity: int
     r: FloatArray
@@ -147,8 +143,6 @@ def factorise(problem: InclusionProblem, homogeneous: bool = False) -> Complianc
     index[free] = np.arange(free.size)
     r = r[inside]
     return Compliance(
-        problem,
-        homogeneous,
         grid,
         MULTIPLICITY[symmetry],
         r,
