@@ -10,6 +10,7 @@ recordings with its decoder, against the definitions in ``robot.records.ros2``.
 
 from __future__ import annotations
 
+import functools
 import struct
 from collections.abc import Sequence
 
@@ -62,10 +63,45 @@ class _Buffer:
         return ENCAPSULATION + bytes(self.data)
 
 
+def _stamp(stamp_ns: int) -> bytes:
+    return _STAMP.pack(*divmod(stamp_ns, 1_000_000_000))
+
+
+_STAMP = struct.Struct("<iI")
+
+
+@functools.lru_cache(maxsize=64)
+def _joint_layout(frame: str, names: tuple[str, ...], n: int) -> tuple[bytes, struct.Struct]:
+    """A JointState of ``n`` > 0 positions as (the bytes between the stamp and the positions,
+    the positions' and the empty arrays' struct): every offset is fixed by the frame, the
+    names and n, so a tick's message is two packs (the messages are written every tick)."""
+    b = _Buffer()
+    b.header(0, frame)
+    b.strings(names)
+    b.u32(n)
+    b.align(8)
+    return bytes(b.data[_STAMP.size :]), struct.Struct(f"<{n}d2I")  # velocity, effort: empty
+
+
+@functools.lru_cache(maxsize=64)
+def _strains_layout(frame: str, state: str, n: int) -> tuple[bytes, struct.Struct]:
+    """A GratingStrains of ``n`` > 0 strains, as :func:`_joint_layout`: the strains end on an
+    8-byte boundary, so the flag is followed by 7 bytes of padding and the goal."""
+    b = _Buffer()
+    b.header(0, frame)
+    b.string(state)
+    b.u32(n)
+    b.align(8)
+    return bytes(b.data[_STAMP.size :]), struct.Struct(f"<{n}d?7xd")
+
+
 def joint_state(
     stamp_ns: int, frame: str, names: Sequence[str], positions: Sequence[float]
 ) -> bytes:
     """``sensor_msgs/msg/JointState`` with positions only (no velocity, no effort)."""
+    if positions:
+        middle, values = _joint_layout(frame, tuple(names), len(positions))
+        return ENCAPSULATION + _stamp(stamp_ns) + middle + values.pack(*positions, 0, 0)
     b = _Buffer()
     b.header(stamp_ns, frame)
     b.strings(names)
@@ -79,6 +115,9 @@ def grating_strains(
     stamp_ns: int, frame: str, state: str, strain: Sequence[float], contact: bool, goal: float
 ) -> bytes:
     """``palpate_msgs/msg/GratingStrains``."""
+    if strain:
+        middle, values = _strains_layout(frame, state, len(strain))
+        return ENCAPSULATION + _stamp(stamp_ns) + middle + values.pack(*strain, contact, goal)
     b = _Buffer()
     b.header(stamp_ns, frame)
     b.string(state)

@@ -35,6 +35,8 @@ from .recording import McapRecorder
 
 FORMAT = "palpate-trial-log"
 VERSION = 1
+# one encoder for every line (json.dumps builds one per call when given options)
+_ENCODER = json.JSONEncoder(separators=(",", ":"), allow_nan=False)
 
 
 def _clean(value: Any) -> Any:
@@ -75,7 +77,9 @@ class TrialLogWriter:
         full = {"format": FORMAT, "version": VERSION, **header}
         # the MCAP recording beside it (robot.records.recording): every record, as it is written
         self.recording = McapRecorder(self.path.with_suffix(".mcap"), full) if mcap else None
-        self._loads = loads  # the tip force the recording derives at its close (robot.trial)
+        # the tip force the recording derives at its close (robot.trial.tipforce); the session
+        # hands it the estimate's beam states once it has them
+        self.loads = loads
         self.write({"kind": "header", **full})
 
     def write(self, record: dict[str, Any]) -> None:
@@ -83,9 +87,9 @@ class TrialLogWriter:
         if self._fh is None:
             raise ValueError(f"trial log {self.path} is closed")
         try:  # the common case: nothing to clean, one pass
-            line = json.dumps(record, separators=(",", ":"), allow_nan=False)
+            line = _ENCODER.encode(record)
         except ValueError:  # a NaN or an infinity somewhere: written as null
-            line = json.dumps(_clean(record), separators=(",", ":"), allow_nan=False)
+            line = _ENCODER.encode(_clean(record))
         self._pending.append(line)
         self.written += 1
         if self.recording is not None:
@@ -119,7 +123,7 @@ class TrialLogWriter:
             self._fh.close()
             self._fh = None
         if self.recording is not None:
-            self.recording.close(self._loads)
+            self.recording.close(self.loads)
 
     def __enter__(self) -> TrialLogWriter:
         return self

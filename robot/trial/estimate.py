@@ -54,7 +54,7 @@ from .inputs import EstimatorInputs
 from .lean import lean_of_rows, row_in, rows_in
 from .relaxed import relaxation_of
 from .run import TrialResult
-from .states import LOADING_STATES, record_lengths, states_at
+from .states import LOADING_STATES, RowLoads, record_lengths, row_loads, states_at
 
 __all__ = [
     "EstimatorInputs",
@@ -92,6 +92,7 @@ class RecordEstimate:
     lean: Lean | None = None
     relaxation: RelaxationFit | None = None
     tip_load: bool = False
+    loads: RowLoads = dataclasses.field(default_factory=dict)  # the beam states' P, by row
 
     @property
     def tip_bow(self) -> float | None:
@@ -126,7 +127,7 @@ def fit_record(
     if inputs.rigid:  # the tube's (stage's) compliance: a tip grating's element is the sensor's
         element = 0.0 if sensor.tip_grating is None else sensor.tip_grating.compliance
         fit = less(fit_compliance(advance, states.P, states.e), element)
-        return RecordEstimate(None, calibration=fit)
+        return RecordEstimate(None, calibration=fit, loads=row_loads(advance, strains, states))
     force, sigma_force = states.P, k * states.sigma_P
     if tip_forces is not None:
         force, sigma_force = tip_forces, np.full(n, force_sigma(tip_forces))
@@ -144,7 +145,8 @@ def fit_record(
     )
     # the bow against the load the fit read: the tip grating's, independent of the strains
     bow = _bow(force, states, lengths, section)
-    return RecordEstimate(joint, bow, tip_load=tip_forces is not None)
+    loads = row_loads(advance, strains, states)
+    return RecordEstimate(joint, bow, tip_load=tip_forces is not None, loads=loads)
 
 
 def critical_load(section: Section, length: float) -> float:
@@ -303,6 +305,8 @@ class TrialEstimate:
         calibration: the rig's compliance, on a rigid reference (instead of the joint fit).
         relaxation: the relaxed and instantaneous moduli, when the trial held (else None).
         relaxed_verdict: the verdict on the relaxed modulus, when the trial held.
+        beam_loads: the axial load the joint fit's beam states gave each loading row, by row
+            (``robot.trial.states.RowLoads``): the recording's tip force reuses them.
     """
 
     paper: StiffnessEstimate | None
@@ -315,6 +319,7 @@ class TrialEstimate:
     lean: Lean | None = None
     relaxation: RelaxationFit | None = None
     relaxed_verdict: Verdict | None = None
+    beam_loads: RowLoads = dataclasses.field(default_factory=dict)
 
 
 def estimate_trial(
@@ -369,4 +374,5 @@ def estimate_trial(
         fitted.lean,
         fitted.relaxation,
         relaxed,
+        fitted.loads,
     )

@@ -15,6 +15,7 @@ bench's hardware) are its two callers.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -99,6 +100,8 @@ def run_session_trial(rig: ZeroingRig, clock: Clock, setup: TrialSetup) -> Sessi
         )
         estimate = setup.estimate(result)
         if log is not None:
+            # the recording's tip force reuses the rows the estimate's beam states inferred
+            log.loads = functools.partial(axial_loads, known=estimate.beam_loads)
             extra = [] if setup.before_estimate is None else setup.before_estimate(result)
             for record in [*extra, estimate_record(estimate), end_record(result)]:
                 log.write(record)

@@ -9,6 +9,7 @@ noise setting leaks in.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from statistics import NormalDist
 
 import numpy as np
@@ -22,6 +23,9 @@ from .inputs import EstimatorInputs
 
 FloatArray = NDArray[np.float64]
 LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})  # the joint fit's rows
+# a row's axial load (N) by the row, (advance, *strains) as recorded: what the estimate's beam
+# states hand the recording's tip force (robot.trial.tipforce), so those rows are inferred once
+RowLoads = Mapping[tuple[float, ...], float]
 _UNIT_SIGMA = 1e-6  # infer_states is linear in sigma: run at 1e-6, rescale by the measured one
 
 
@@ -71,3 +75,11 @@ def record_lengths(advance: FloatArray, inputs: EstimatorInputs) -> FloatArray:
     """The exposed length (m) at each row: the bench's fixed one, or the robot's advance past
     the tube's flush translation (<= 0 while the sensor is still inside the tube)."""
     return inputs.stage.exposed_lengths(advance)
+
+
+def row_loads(
+    advance: FloatArray, strains: FloatArray, states: BeamStates
+) -> dict[tuple[float, ...], float]:
+    """Each row's axial load keyed by the row (:data:`RowLoads`)."""
+    keys = np.column_stack([advance, strains]).tolist()
+    return {tuple(k): p for k, p in zip(keys, states.P.tolist(), strict=True)}

@@ -12,15 +12,18 @@ import numpy as np
 
 from ..records.recording import McapRecorder
 from .inputs import header_sensor
-from .states import on_beam, record_lengths, states_at
+from .states import RowLoads, on_beam, record_lengths, states_at
 
 
-def axial_loads(recorder: McapRecorder) -> list[float] | None:
+def axial_loads(recorder: McapRecorder, known: RowLoads | None = None) -> list[float] | None:
     """The axial load (N) at every sample of ``recorder``: the tip grating's where the sensor
     has one, else from its strains (the estimator's beam states), NaN where a sample has no
     beam state (strains incomplete, or the sensor not yet out of the tube: such rows are never
     handed to the beam model); None when the header lacks the sensor, the section or the
-    estimator's inputs."""
+    estimator's inputs. ``known``: loads the trial's estimate already inferred, by row
+    (``robot.trial.states.row_loads``); only the other rows are inferred here (each row's
+    state is its own least-squares fit: a row inferred in another batch differs in the last
+    bits of its Gauss-Newton stop, below 1e-12 relative)."""
     tips = [x.tip_force for x in recorder.samples]
     if any(math.isfinite(f) for f in tips):
         return tips
@@ -37,13 +40,22 @@ def axial_loads(recorder: McapRecorder) -> list[float] | None:
     advance = np.asarray([samples[i].advance for i in whole], dtype=np.float64)
     lengths = record_lengths(advance, inputs)
     keep = on_beam(lengths, sensor)
+    lengths = lengths[keep]
     rows = [i for i, k in zip(whole, keep.tolist(), strict=True) if k]
-    if not rows:
+    known = known or {}
+    todo = []
+    for j, i in enumerate(rows):
+        found = known.get((samples[i].advance, *samples[i].strains))
+        if found is None:
+            todo.append(j)
+        else:
+            loads[i] = found
+    if not todo:
         return loads
-    strains = np.asarray([samples[i].strains for i in rows], dtype=np.float64)
-    states, _ = states_at(strains, lengths[keep], sensor, section)
-    for i, load in zip(rows, states.P.tolist(), strict=True):
-        loads[i] = load
+    strains = np.asarray([samples[rows[j]].strains for j in todo], dtype=np.float64)
+    states, _ = states_at(strains, lengths[todo], sensor, section)
+    for j, load in zip(todo, states.P.tolist(), strict=True):
+        loads[rows[j]] = load
     return loads
 
 
