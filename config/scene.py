@@ -66,6 +66,10 @@ class FidelityConfig:
     # a coarser grid (rounded to whole encoder counts) solves fewer equilibria per trial and
     # interpolates linearly between them: a cheaper world, for speed-over-accuracy levels.
     contact_grid_um: float | None = field(default=None, metadata=limits(gt=0, le=1000))
+    # A sample with one inclusion seen from a point the 3-D tables were not solved at: solve
+    # there ("exact", 10-100 s a new distance) or interpolate between solves at fixed distances
+    # ("interpolated", sim/fem3d/offsets.py: what a map's many points need; docs/maps.md).
+    inclusion_offsets: Literal["exact", "interpolated"] = "exact"
 
     # the SI views of the unit-suffixed fields (palpate.config.units)
     fbg_noise = SI("fbg_noise_pm", PM)  # m of wavelength
@@ -79,7 +83,7 @@ class FidelityConfig:
 class CampaignConfig:
     """Which trials to run and how each one indents."""
 
-    kind: Literal["bench", "robot"] = "robot"
+    kind: Literal["bench", "robot", "map"] = "robot"
     samples: tuple[str, ...] = ()  # empty: every sample of the scene
     exposed_lengths_mm: tuple[float, ...] = field(  # bench-top; each as exposed_length_mm
         default=(42.0, 44.0, 46.0, 48.0, 50.0), metadata=limits(gt=0, le=500)
@@ -128,6 +132,16 @@ class CampaignConfig:
     # x axis): what fixes the normal's tilt along the tube's bend, so the roll span per tube.
     probe_sagitta_mm: float = field(default=3.0, metadata=limits(gt=0, le=50))
     probe_touch_ue: float = field(default=25.0, metadata=limits(gt=0, le=1000))  # light touch
+    # kind: map (palpate map, docs/maps.md): the patch of the sample's surface it surveys
+    # (x_min, y_min, x_max, y_max, mm, from where a single trial indents), the plan, the probe
+    # budget, the level set's modulus (null: from the data), and the x-y stage's speed between
+    # probes (its travel counts in the map's lab time). Each probe indents on the bench column
+    # at the first of exposed_lengths_mm.
+    patch_mm: tuple[float, ...] = (-10.0, -10.0, 10.0, 10.0)
+    strategy: Literal["active", "raster", "random"] = "active"
+    max_probes: int = field(default=30, metadata=limits(ge=1, le=10000))
+    map_threshold_kpa: float | None = field(default=None, metadata=limits(gt=0))
+    stage_speed_mm_per_s: float = field(default=5.0, metadata=limits(gt=0, le=1000))
 
     def speeds_mm_per_s(self) -> tuple[float, ...]:
         """The indentation speeds the campaign runs each trial at (mm/s)."""
@@ -161,6 +175,12 @@ class CampaignConfig:
     miss_tolerance = SI("miss_tolerance_mm", MM)
     probe_sagitta = SI("probe_sagitta_mm", MM)
     probe_touch = SI("probe_touch_ue", UE)
+    stage_speed = SI("stage_speed_mm_per_s", MM)  # m/s
+
+    @property
+    def map_threshold(self) -> float | None:
+        """The map's level set in Pa, or None (from the data)."""
+        return None if self.map_threshold_kpa is None else self.map_threshold_kpa * 1e3
 
 
 @dataclass(frozen=True)
@@ -196,7 +216,31 @@ class SceneConfig:
         for wanted in self.campaign.samples:
             if wanted not in names:
                 raise ValueError(f"campaign.samples: no sample named {wanted!r}; known: {names}")
+        if self.fidelity.inclusion_offsets == "interpolated":
+            for k, sample in enumerate(self.samples):
+                if len(sample.inclusions) > 1:
+                    raise ValueError(
+                        f"samples[{k}].inclusions: fidelity.inclusion_offsets: interpolated "
+                        "holds one inclusion a sample"
+                    )
+        if self.campaign.kind == "map":
+            _check_map(self)
 
     def campaign_samples(self) -> tuple[SampleConfig, ...]:
         wanted = self.campaign.samples
         return tuple(s for s in self.samples if not wanted or s.name in wanted)
+
+
+def _check_map(scene: SceneConfig) -> None:
+    """A map campaign's keys: a patch of four corners in order, one sample."""
+    c = scene.campaign
+    if len(c.patch_mm) != 4 or not (
+        c.patch_mm[2] > c.patch_mm[0] and c.patch_mm[3] > c.patch_mm[1]
+    ):
+        raise ValueError(
+            f"campaign.patch_mm: [x_min, y_min, x_max, y_max] with x_max > x_min and y_max > "
+            f"y_min, got {list(c.patch_mm)}"
+        )
+    if len(scene.campaign_samples()) != 1:
+        names = [s.name for s in scene.campaign_samples()]
+        raise ValueError(f"campaign.samples: a map surveys one sample, got {names}")

@@ -22,6 +22,7 @@ from palpate.api import (
     scene_from_dict,
     simulate,
     simulate_trial,
+    survey,
     trials,
 )
 
@@ -51,5 +52,6 @@ __all__ = [
     "scene_from_dict",
     "simulate",
     "simulate_trial",
+    "survey",
     "trials",
 ]

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the heavy modules load when a function needs them: `import palpate` is cheap
+    from palpate.campaigns.survey import SurveyResult
     from palpate.commands.design import DesignOutcome
     from palpate.config.scene import SceneConfig
     from palpate.config.schema import StackConfig
@@ -160,6 +161,36 @@ def read_recording(path: str | Path) -> Recording:
     from palpate.robot.records.recording import read_recording as read
 
     return read(path)
+
+
+def survey(
+    scene: SceneConfig,
+    *,
+    seed: int = 0,
+    strategy: str | None = None,
+    max_probes: int | None = None,
+    run_dir: str | Path | None = None,
+    robot: StackConfig | None = None,
+) -> SurveyResult:
+    """``palpate map``: a map scene's survey (``campaign.kind: map``), probe by probe through
+    whole simulated trials; ``.summary`` is the map's answer (``found``, ``centre``,
+    ``centre_ci``, ``radius``), ``.scores()`` compares it with the truth, ``.as_dict()`` is
+    what ``--json`` prints. ``run_dir``: the probes file and trial logs (a second call
+    carries on from its probes)."""
+    from palpate.campaigns.survey import run_survey
+    from palpate.config import InputError
+
+    if scene.campaign.kind != "map":
+        raise InputError(
+            f"{PYTHON}: campaign.kind: a survey needs kind: map, got {scene.campaign.kind!r}"
+        )
+    stack = robot if robot is not None else load_robot(scene.robot)
+    path = None if run_dir is None else Path(run_dir)
+    if path is not None:
+        path.mkdir(parents=True, exist_ok=True)
+    return run_survey(
+        scene, stack, seed=seed, strategy=strategy, max_probes=max_probes, run_dir=path
+    )
 
 
 def design(

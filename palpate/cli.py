@@ -46,6 +46,10 @@ COMMANDS: dict[str, Command] = {
         "Coverage study: N seeded repeats of a scene's campaign; error and interval coverage "
         "with bounds.",
     ),
+    "map": Command(
+        "palpate.commands.map",
+        "Map a patch of a simulated sample probe by probe and find the stiff inclusion in it.",
+    ),
     "bench": Command(
         "palpate.commands.bench",
         "Speed against error of the mechanics, the signal chain and the servo bus.",

@@ -42,6 +42,7 @@ from .equilibrium.law import FloatArray
 from .fem import FeTissueLaw, LayerProblem, table_key
 from .fem.problem import significant
 from .fem3d import Inclusion, InclusionProblem, InclusionWorld
+from .fem3d.offsets import MapWorld, on_axis
 from .viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
 
 HALF_SPACE_RATIO = 200.0
@@ -96,13 +97,14 @@ def fe_world(
     fidelity: FidelityConfig,
     tip_radius: float,
     at: tuple[float, float] = (0.0, 0.0),
-) -> LayerProblem | InclusionWorld:
+) -> LayerProblem | InclusionWorld | MapWorld:
     """The FE tissue of ``sample`` under a tip pressing at ``at`` (x, y in m on its surface,
     from the sample's origin, where a single trial indents): its layer's problem, or with
     inclusions the layer and its 3-D problem as seen from that point
     (:class:`sim.fem3d.InclusionWorld`; the 3-D model is cut at ``SOLID_LIMIT_RATIO`` R deep
     and wide, which the inclusions' factor does not feel). Points at the same distance from a
-    single inclusion share one 3-D table."""
+    single inclusion share one 3-D table. With ``fidelity.inclusion_offsets: interpolated`` the
+    factor is read between solves at fixed distances (:class:`sim.fem3d.offsets.MapWorld`)."""
     layer = fe_problem(sample, fidelity, tip_radius)
     if not sample.inclusions:
         return layer
@@ -129,6 +131,8 @@ def fe_world(
     x, y = at
     if x or y:
         solid = solid.seen_from(significant(x / tip_radius), significant(y / tip_radius))
+    if fidelity.inclusion_offsets == "interpolated":
+        return MapWorld(layer, on_axis(solid), solid.inclusions[0].offset)
     return InclusionWorld(layer, solid)
 
 
@@ -175,7 +179,7 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
         out["law"] = "steel block (Hertz, E = 200 GPa)"
     elif fidelity.tissue_model == "fe":
         world = fe_world(sample, fidelity, tip_radius)
-        problem = world.layer if isinstance(world, InclusionWorld) else world
+        problem = world if isinstance(world, LayerProblem) else world.layer
         out.update(
             law="finite elements (sim.fem)",
             material=problem.material,
@@ -186,7 +190,7 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
             poisson=problem.poisson,
             table=table_key(problem),
         )
-        if isinstance(world, InclusionWorld):
+        if not isinstance(world, LayerProblem):
             out["inclusions"] = [
                 {
                     "center_mm": list(i.center_mm),

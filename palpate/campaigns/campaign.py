@@ -46,7 +46,7 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
         specs.append(
             TrialSpec(
                 trial_id="-".join(parts),
-                kind=c.kind,
+                kind="robot" if c.on_tubes else "bench",
                 sample=s.name,
                 modulus=s.modulus,
                 poisson=s.poisson,

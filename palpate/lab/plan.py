@@ -187,7 +187,7 @@ def _repeats(
         trials.append(
             BenchTrial(
                 trial_id=_safe("-".join(parts)),
-                kind=c.kind,
+                kind="robot" if c.on_tubes else "bench",
                 target=target,
                 tube=tube,
                 sample=entry.label,

@@ -15,6 +15,7 @@ from palpate.sim.fem import FeTissueLaw, table_key
 from palpate.sim.fem.generate import SHIPPED
 from palpate.sim.fem.table import SHIPPED_DIR, read_table
 from palpate.sim.fem3d import InclusionWorld
+from palpate.sim.fem3d.offsets import MapWorld, node_problems
 from palpate.sim.fem3d.table import SHIPPED_DIR as RATIOS_DIR
 from palpate.sim.fem3d.table import read_ratios
 from palpate.sim.sample_law import (
@@ -149,6 +150,7 @@ SCENES = [
         "inclusions/*.yaml",
         "layers/*.yaml",
         "lung/*.yaml",
+        "maps/*.yaml",
         "oblique/*.yaml",
         "viscoelastic/*.yaml",
     )
@@ -170,6 +172,10 @@ def test_shipped_scenes_need_no_finite_element_solve(path: Path) -> None:
         if isinstance(world, InclusionWorld):
             found = read_ratios(world.solid, RATIOS_DIR)
             assert found is not None, f"{path.name}: {sample.name}'s 3-D table"
+        if isinstance(world, MapWorld):  # a map's world: every solved distance is shipped
+            for node in node_problems(world.solid):
+                found = read_ratios(node.canonical_problem(), RATIOS_DIR)
+                assert found is not None, f"{path.name}: {sample.name}'s 3-D table at {node}"
 
 
 def test_the_paper_scenes_use_the_independent_world() -> None:

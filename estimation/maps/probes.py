@@ -1,0 +1,79 @@
+"""A map's probes: where each indentation was and what the estimator said of it.
+
+A probe carries the joint fit's modulus and interval and the verdict; the map (``gp``) turns the
+interval into the probe's own noise on log E (its half-width over the interval's z), inflates a
+``suspect`` probe's variance (:data:`SUSPECT_INFLATION`) and leaves out a probe without a number,
+keeping its reason::
+
+    probe = Probe(x=2e-3, y=-1e-3, modulus=3.4e5, ci=(3.2e5, 3.6e5), status="ok")
+    probe.log_sigma()   # ~0.03: the sd of log E the interval implies
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+Z95 = 1.959963984540054  # the joint fit's intervals are 95 %
+SUSPECT_INFLATION = 4.0  # a suspect probe's variance on log E, times its interval's
+SIGMA_FLOOR = 0.01  # sd of log E below which no probe is believed (1 %: the world's own scatter)
+
+
+@dataclass(frozen=True)
+class Probe:
+    """One indentation of a map.
+
+    Attributes:
+        x, y: where it indented on the patch (m).
+        modulus: the joint fit's E (Pa), None without a number.
+        ci: its 95 % interval (Pa), None without one.
+        status: the verdict's ``ok``, ``suspect`` or ``none``; reasons: its reasons.
+        lab_time: simulated or bench seconds it took, the stage's travel to it included.
+        truth: in simulation, the world's apparent modulus there if known (Pa), else None.
+    """
+
+    x: float
+    y: float
+    modulus: float | None
+    ci: tuple[float, float] | None
+    status: str
+    reasons: tuple[str, ...] = field(default=())
+    lab_time: float = 0.0
+
+    @property
+    def usable(self) -> bool:
+        """A number with a finite, positive interval around it."""
+        if self.modulus is None or self.ci is None or not self.modulus > 0:
+            return False
+        lo, hi = self.ci
+        return self.status != "none" and 0 < lo <= self.modulus <= hi and math.isfinite(hi)
+
+    def log_sigma(self) -> float:
+        """The sd of log E its interval implies (half the log-width over the 95 % z), at least
+        :data:`SIGMA_FLOOR`, widened for a ``suspect`` verdict. ValueError if not usable."""
+        if not self.usable or self.ci is None:
+            raise ValueError(f"probe at ({self.x:.4g}, {self.y:.4g}) m has no usable interval")
+        lo, hi = self.ci
+        sigma = max(math.log(hi / lo) / (2.0 * Z95), SIGMA_FLOOR)
+        if self.status == "suspect":
+            sigma *= math.sqrt(SUSPECT_INFLATION)
+        return sigma
+
+    def why_left_out(self) -> str | None:
+        """Why the map does not use it (None: it does)."""
+        if self.usable:
+            return None
+        if self.status == "none" or self.modulus is None:
+            return "; ".join(self.reasons) or "no number"
+        return "no finite interval"
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "x_mm": self.x * 1e3,
+            "y_mm": self.y * 1e3,
+            "modulus_kpa": None if self.modulus is None else self.modulus / 1e3,
+            "ci_kpa": None if self.ci is None else [self.ci[0] / 1e3, self.ci[1] / 1e3],
+            "status": self.status,
+            "reasons": list(self.reasons),
+            "lab_time_s": self.lab_time,
+        }

@@ -1,0 +1,180 @@
+"""What a map says: the stiff region, whether it is an inclusion, where, and how large.
+
+The threshold on log E is given, or taken from the data: half-way (in log E) between the
+background and the map's peak, but never closer to the background than ``min_rise`` (10 %: more
+than twice the paper sensor's scatter between repeats on one homogeneous sample), so a flat
+patch has nothing above it. The region is where the process is above it with probability over
+one half; an inclusion is **found** when some point of the patch is above it with probability
+at least ``found_probability`` (0.95), else the summary says "no inclusion found" with its
+evidence (the largest probability, the peak's rise). The centre is the region's centroid
+weighted by how far the mean is above the threshold, the radius that of a disc of the
+region's area; their intervals are the 2.5 and 97.5 percentiles over joint posterior draws
+(each draw's own region, centroid and area)::
+
+    summary = summarise(StiffnessMap.fit(probes), patch)
+    summary.found, summary.centre, summary.centre_ci, summary.radius
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
+
+from .gp import MM, Patch, StiffnessMap
+
+FloatArray = NDArray[np.float64]
+MIN_RISE = 0.10  # the smallest rise above the background a threshold from the data takes
+FOUND_PROBABILITY = 0.95
+GRID = 41  # points a side of the summary's grid
+DRAW_GRID = 25  # points a side of the posterior draws' grid
+DRAWS = 200
+
+
+@dataclass(frozen=True)
+class MapSummary:
+    """A map's answer (SI: m, Pa); the grid's arrays are (GRID, GRID), y along the rows."""
+
+    x: FloatArray
+    y: FloatArray
+    mean: FloatArray  # E (Pa), the posterior median exp(mean of log E)
+    sd: FloatArray  # sd of log E
+    p_above: FloatArray
+    threshold: float  # Pa
+    threshold_from_data: bool
+    background: float  # Pa
+    found: bool
+    evidence: str
+    centre: tuple[float, float] | None = None
+    centre_ci: tuple[tuple[float, float], tuple[float, float]] | None = None
+    radius: float | None = None
+    radius_ci: tuple[float, float] | None = None
+
+    def as_dict(self) -> dict[str, object]:
+        def mm(v: tuple[float, ...] | None) -> list[float] | None:
+            return None if v is None else [float(a) / MM for a in v]
+
+        return {
+            "inclusion_found": self.found,
+            "evidence": self.evidence,
+            "inclusion_center_mm": mm(self.centre),
+            "inclusion_center_ci_mm": (
+                None if self.centre_ci is None else [mm(self.centre_ci[0]), mm(self.centre_ci[1])]
+            ),
+            "inclusion_radius_mm": None if self.radius is None else self.radius / MM,
+            "inclusion_radius_ci_mm": mm(self.radius_ci),
+            "threshold_kpa": self.threshold / 1e3,
+            "threshold_from_data": self.threshold_from_data,
+            "background_kpa": self.background / 1e3,
+            "peak_kpa": float(np.max(self.mean)) / 1e3,
+            "max_p_above": float(np.max(self.p_above)),
+        }
+
+
+def summarise(
+    m: StiffnessMap,
+    patch: Patch,
+    *,
+    threshold: float | None = None,
+    min_rise: float = MIN_RISE,
+    found_probability: float = FOUND_PROBABILITY,
+    seed: int = 0,
+) -> MapSummary:
+    """The map's answer over ``patch`` (``threshold`` in Pa, None: from the data)."""
+    x, y = patch.grid(GRID)
+    points = patch.points(GRID)
+    mean, sd = m.predict(points)
+    t = log_threshold(m, mean, threshold, min_rise)
+    p = above(mean, sd, t)
+    shape = (GRID, GRID)
+    base: dict[str, Any] = {
+        "x": x,
+        "y": y,
+        "mean": np.exp(mean).reshape(shape),
+        "sd": sd.reshape(shape),
+        "p_above": p.reshape(shape),
+        "threshold": math.exp(t),
+        "threshold_from_data": threshold is None,
+        "background": math.exp(m.background),
+    }
+    rise = math.exp(float(mean.max()) - m.background) - 1.0
+    best = float(p.max())
+    if best < found_probability:
+        evidence = (
+            f"no inclusion found: nowhere above {math.exp(t) / 1e3:.4g} kPa with probability "
+            f">= {found_probability:g} (at most {best:.3f}); the map's peak is "
+            f"{100 * rise:+.1f} % of the background"
+        )
+        return MapSummary(**base, found=False, evidence=evidence)
+    region = p > 0.5
+    weight = np.where(region, mean - t, 0.0)
+    centre = (
+        float(points[:, 0] @ weight / weight.sum()),
+        float(points[:, 1] @ weight / weight.sum()),
+    )
+    radius = math.sqrt(region.sum() * _cell(patch, GRID) / math.pi)
+    centre_ci, radius_ci = _intervals(m, patch, t, np.random.default_rng(seed))
+    evidence = (
+        f"inclusion found: above {math.exp(t) / 1e3:.4g} kPa with probability {best:.3f}; the "
+        f"map's peak is {100 * rise:+.1f} % of the background"
+    )
+    return MapSummary(
+        **base,
+        found=True,
+        evidence=evidence,
+        centre=centre,
+        centre_ci=centre_ci,
+        radius=radius,
+        radius_ci=radius_ci,
+    )
+
+
+def above(mean: FloatArray, sd: FloatArray, t: float) -> FloatArray:
+    """P(log E > t) of a normal posterior with ``mean`` and ``sd``."""
+    return np.asarray(ndtr((mean - t) / np.maximum(sd, 1e-12)), dtype=np.float64)
+
+
+def log_threshold(
+    m: StiffnessMap, mean: FloatArray, threshold: float | None, min_rise: float = MIN_RISE
+) -> float:
+    """The threshold on log E: the given one, or half-way from the background to the peak
+    and at least ``min_rise`` above the background."""
+    if threshold is not None:
+        if not threshold > 0:
+            raise ValueError(f"threshold must be > 0 Pa, got {threshold!r}")
+        return math.log(threshold)
+    floor = m.background + math.log1p(min_rise)
+    return max(m.background + 0.5 * (float(np.max(mean)) - m.background), floor)
+
+
+def _cell(patch: Patch, n: int) -> float:
+    return patch.area / (n - 1) ** 2
+
+
+def _intervals(
+    m: StiffnessMap, patch: Patch, t: float, rng: np.random.Generator
+) -> tuple[tuple[tuple[float, float], tuple[float, float]], tuple[float, float]]:
+    """95 % intervals of the centre (x and y) and the radius over posterior draws (a draw
+    with no point above the threshold counts as radius 0 and no centre)."""
+    points = patch.points(DRAW_GRID)
+    f = m.draws(points, DRAWS, rng)
+    above = f > t
+    weight = np.where(above, f - t, 0.0)
+    total = weight.sum(axis=1)
+    some = total > 0
+    cx = (weight[some] @ points[:, 0]) / total[some]
+    cy = (weight[some] @ points[:, 1]) / total[some]
+    radius = np.sqrt(above.sum(axis=1) * _cell(patch, DRAW_GRID) / math.pi)
+    if not some.any():
+        nan = (math.nan, math.nan)
+        return (nan, nan), (0.0, float(np.percentile(radius, 97.5)))
+
+    def ci(v: FloatArray) -> tuple[float, float]:
+        lo, hi = np.percentile(v, [2.5, 97.5])
+        return float(lo), float(hi)
+
+    return (ci(cx), ci(cy)), ci(radius)

@@ -1,0 +1,149 @@
+"""A map study: many seeded worlds, each surveyed by every plan, scored against its truth.
+
+Each world is the map scene's sample with its inclusion moved to a random point of the patch
+(uniform, the inclusion's footprint inside the patch), seeded by the world's index; the same
+worlds for every plan, so the plans are compared pair by pair. Beside them as many homogeneous
+worlds (the scene's inclusion taken out) surveyed by the active plan: its false alarms. Each
+survey is a whole run of ``campaigns.survey`` (every probe a simulated trial); surveys run in
+parallel over ``workers`` processes. The summary per plan: detection, the centre's error, the
+boundary's sensitivity, specificity and error (the area where the estimated region and the
+true footprint disagree, mm^2), probes and lab time; for the raster, each budget given::
+
+    rows = run_map_study(scene, stack, worlds=20, plans=[("active", 30), ("raster", 36)])
+    table = summarise_study(rows)
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+
+from .survey import MM, run_survey
+
+Plan = tuple[str, int]  # (strategy, probe budget)
+
+
+def world_scene(scene: SceneConfig, index: int, seed: int, plain: bool = False) -> SceneConfig:
+    """World ``index``: the scene's one sample with its inclusion at a seeded random point of
+    the patch (or taken out, ``plain``)."""
+    sample = scene.campaign_samples()[0]
+    if plain:
+        moved = dataclasses.replace(sample, inclusions=())
+    else:
+        inc = sample.inclusions[0]
+        x0, y0, x1, y1 = scene.campaign.patch_mm
+        r = inc.radius_mm
+        rng = np.random.default_rng([seed, index])
+        x, y = rng.uniform([x0 + r, y0 + r], [x1 - r, y1 - r])
+        centre = (float(x), float(y), inc.center_mm[2])
+        moved = dataclasses.replace(
+            sample, inclusions=(dataclasses.replace(inc, center_mm=centre),)
+        )
+    return dataclasses.replace(
+        scene, samples=(moved,), campaign=dataclasses.replace(scene.campaign, samples=())
+    )
+
+
+def survey_row(
+    scene: SceneConfig, stack: StackConfig, plan: Plan, index: int, seed: int, plain: bool
+) -> dict[str, Any]:
+    """One survey of world ``index`` by ``plan``: its scores and costs (picklable)."""
+    strategy, budget = plan
+    world = world_scene(scene, index, seed, plain)
+    result = run_survey(
+        world, stack, seed=seed * 1000 + index, strategy=strategy, max_probes=budget
+    )
+    s = result.summary
+    row: dict[str, Any] = {
+        "strategy": strategy,
+        "budget": budget,
+        "world": index,
+        "plain": plain,
+        "probes": len(result.probes),
+        "lab_time_s": result.lab_time,
+        "map_s_per_probe": result.map_seconds / max(len(result.probes), 1),
+        "found": bool(s is not None and s.found),
+        **result.scores(),
+    }
+    if s is not None and result.truth is not None:
+        xx, yy = np.meshgrid(s.x, s.y)
+        t = result.truth
+        inside = np.hypot(xx - t.centre[0], yy - t.centre[1]) <= t.radius
+        said = (s.p_above > 0.5) if s.found else np.zeros_like(inside)
+        cell = (s.x[1] - s.x[0]) * (s.y[1] - s.y[0]) / MM**2
+        row["boundary_error_mm2"] = float((said ^ inside).sum() * cell)
+    return row
+
+
+def run_map_study(
+    scene: SceneConfig,
+    stack: StackConfig,
+    *,
+    worlds: int,
+    plans: Sequence[Plan],
+    seed: int = 0,
+    workers: int = 1,
+    progress: Callable[[dict[str, Any]], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Every plan on every world, and the active plan on as many homogeneous worlds."""
+    jobs = [(plan, k, False) for plan in plans for k in range(worlds)]
+    active = next((p for p in plans if p[0] == "active"), None)
+    if active is not None:
+        jobs += [(active, k, True) for k in range(worlds)]
+    rows: list[dict[str, Any]] = []
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+        futures = [
+            pool.submit(survey_row, scene, stack, plan, k, seed, plain) for plan, k, plain in jobs
+        ]
+        for future in concurrent.futures.as_completed(futures):
+            row = future.result()
+            rows.append(row)
+            if progress is not None:
+                progress(row)
+    return sorted(rows, key=lambda r: (r["plain"], r["strategy"], r["budget"], r["world"]))
+
+
+def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per plan (and the homogeneous worlds apart): the medians and rates the study reports."""
+    groups: dict[tuple[str, int, bool], list[dict[str, Any]]] = {}
+    for r in rows:
+        groups.setdefault((r["strategy"], r["budget"], r["plain"]), []).append(r)
+    out = []
+    for (strategy, budget, plain), rs in sorted(
+        groups.items(), key=lambda g: (g[0][2], g[0][0], g[0][1])
+    ):
+        line: dict[str, Any] = {"strategy": strategy, "budget": budget, "worlds": len(rs)}
+        line["probes_median"] = _median([r["probes"] for r in rs])
+        line["lab_time_s_median"] = _median([r["lab_time_s"] for r in rs])
+        line["map_s_per_probe_max"] = max(r["map_s_per_probe"] for r in rs)
+        if plain:
+            line["homogeneous"] = True
+            line["false_alarms"] = sum(r["found"] for r in rs)
+        else:
+            line["detected"] = sum(r["found"] for r in rs)
+            for key in ("center_error_mm", "sensitivity", "specificity", "boundary_error_mm2"):
+                line[f"{key}_median"] = _median([r[key] for r in rs if r.get(key) is not None])
+        out.append(line)
+    return out
+
+
+def _median(values: Sequence[float]) -> float | None:
+    return float(np.median(values)) if values else None
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """The Wilson 95 % interval of a rate k / n."""
+    if n == 0:
+        return (0.0, 1.0)
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (max(0.0, centre - half), min(1.0, centre + half))

@@ -1,0 +1,211 @@
+"""Map a patch of a simulated sample probe by probe and find the stiff inclusion in it.
+
+Runs a scene's map campaign (``campaign.kind: map``; the shipped one:
+``config/scenes/maps/inclusion.yaml``): each probe a whole simulated trial, the next point
+chosen by the plan (``--strategy active``: where the boundary is least certain, travel-aware;
+``raster`` and ``random`` as baselines), then the Gaussian-process map of the modulus, the
+region above the threshold and the inclusion's centre and radius with 95 % intervals, or "no
+inclusion found" with the evidence. The run folder (``--out``/<stamp>) keeps the probes
+(``probes.jsonl``, appended as they finish), the trial logs, ``map.json`` and ``map.png``;
+``--resume`` carries the newest run of the same configuration on from its last probe.
+docs/maps.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+from pathlib import Path
+from typing import Any
+
+from palpate.argtypes import non_negative_int, positive_int
+from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
+from palpate.campaigns.survey import SurveyResult, run_survey
+from palpate.config import InputError, load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.estimation.maps import STRATEGIES, Probe
+from palpate.exitcodes import EXIT_OK
+from palpate.progress import progress_bar
+
+SHIPPED = "scenes/maps/inclusion.yaml"
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scene", type=Path, help=f"a map scene YAML (default: {SHIPPED})")
+    parser.add_argument("--sample", help="survey this sample of the scene instead")
+    parser.add_argument("--strategy", choices=STRATEGIES, help="override campaign.strategy")
+    parser.add_argument("--max-probes", type=positive_int, help="override campaign.max_probes")
+    parser.add_argument("--seed", type=non_negative_int, default=0, help="the run's seed")
+    parser.add_argument("--out", type=Path, default=Path("out/map"), help="run folders here")
+    parser.add_argument(
+        "--resume", action="store_true", help="carry on the newest run of this configuration"
+    )
+    parser.add_argument("--no-plots", action="store_true", help="skip map.png")
+    parser.add_argument(
+        "--worlds",
+        type=positive_int,
+        help="a study instead: this many seeded worlds (the inclusion at a random point of the "
+        "patch), each surveyed by every plan of --plans, and as many homogeneous ones",
+    )
+    parser.add_argument(
+        "--plans",
+        default="active:30,raster:25,raster:49,random:30",
+        help="the study's plans, strategy:budget, comma-separated",
+    )
+    parser.add_argument("--workers", type=positive_int, default=2, help="the study's processes")
+
+
+def map_scene(path: Path, sample: str | None) -> SceneConfig:
+    """The map scene at ``path`` (with ``sample`` surveyed instead of its campaign's);
+    InputError naming the file and key when it is not a map scene."""
+    scene = load(SceneConfig, path)
+    if scene.campaign.kind != "map":
+        raise InputError(
+            f"{path}: campaign.kind: palpate map runs kind: map, got {scene.campaign.kind!r}"
+        )
+    if sample is not None:
+        if sample not in [s.name for s in scene.samples]:
+            raise InputError(f"--sample: {path} has no sample {sample!r}")
+        scene = dataclasses.replace(
+            scene, campaign=dataclasses.replace(scene.campaign, samples=(sample,))
+        )
+    return scene
+
+
+def run(args: argparse.Namespace) -> int:
+    """Exit 0 when the survey ran (found or not), 2 on bad input."""
+    path = Path(args.scene) if args.scene else resolve(SHIPPED)
+    scene = map_scene(path, args.sample)
+    stack = load_stack(resolve(scene.robot))
+    info = {
+        "scene": scene.name,
+        "fingerprint": fingerprint(scene, stack),
+        "seed": args.seed,
+        "strategy": args.strategy or scene.campaign.strategy,
+        "max_probes": args.max_probes or scene.campaign.max_probes,
+    }
+    if args.worlds:
+        return _study(scene, stack, args)
+    run_dir = resumable(args.out, info) if args.resume else new_run_dir(args.out)
+    with locked(run_dir):
+        write_run_info(run_dir, info)
+        result = _survey(scene, stack, args, run_dir)
+        payload = _payload(result, info, run_dir)
+        (run_dir / "map.json").write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
+        if not args.no_plots:
+            from palpate.reports.mapfig import map_figure
+
+            payload["figure"] = str(map_figure(result, run_dir / "map.png", scene.name))
+    if args.json:
+        print(json.dumps(payload, indent=2))
+    else:
+        _print(result, payload, run_dir)
+    return EXIT_OK
+
+
+def _survey(
+    scene: SceneConfig, stack: Any, args: argparse.Namespace, run_dir: Path
+) -> SurveyResult:
+    bar = progress_bar(args.max_probes or scene.campaign.max_probes, f"{scene.name} map")
+
+    def on_probe(p: Probe) -> None:
+        bar.update(1)
+        bar.set_postfix_str(f"({p.x * 1e3:+.1f}, {p.y * 1e3:+.1f}) mm {p.status}")
+
+    try:
+        return run_survey(
+            scene,
+            stack,
+            seed=args.seed,
+            strategy=args.strategy,
+            max_probes=args.max_probes,
+            run_dir=run_dir,
+            on_probe=on_probe,
+        )
+    finally:
+        bar.close()
+
+
+def _payload(result: SurveyResult, info: dict[str, Any], run_dir: Path) -> dict[str, Any]:
+    return {**info, "run_dir": str(run_dir), **result.as_dict()}
+
+
+def _print(result: SurveyResult, payload: dict[str, Any], run_dir: Path) -> None:
+    s = result.summary
+    print(
+        f"{payload['scene']}: {len(result.probes)} probes ({payload['strategy']}), "
+        f"{result.lab_time:.0f} s of lab time; {result.stopped}"
+    )
+    if s is None:
+        print("no map: too few probes gave a number")
+    else:
+        print(s.evidence)
+        if s.found and s.centre is not None and s.centre_ci is not None and s.radius is not None:
+            (x0, x1), (y0, y1) = s.centre_ci
+            print(
+                f"centre ({s.centre[0] * 1e3:+.2f}, {s.centre[1] * 1e3:+.2f}) mm "
+                f"[x {x0 * 1e3:+.2f}..{x1 * 1e3:+.2f}, y {y0 * 1e3:+.2f}..{y1 * 1e3:+.2f}], "
+                f"radius {s.radius * 1e3:.2f} mm"
+            )
+    if result.truth is not None:
+        t = result.truth
+        print(
+            f"truth: centre ({t.centre[0] * 1e3:+.2f}, {t.centre[1] * 1e3:+.2f}) mm, "
+            f"radius {t.radius * 1e3:.2f} mm, {t.depth * 1e3:.1f} mm deep, {t.contrast:.1f}x; "
+            f"scores {result.scores()}"
+        )
+    print(f"run folder: {run_dir}")
+
+
+def parse_plans(text: str) -> list[tuple[str, int]]:
+    """``active:30,raster:49`` -> [("active", 30), ("raster", 49)]; InputError naming --plans."""
+    plans = []
+    for item in text.split(","):
+        name, _, budget = item.strip().partition(":")
+        if name not in STRATEGIES or not budget.isdigit() or int(budget) < 1:
+            raise InputError(f"--plans: {item!r} is not strategy:budget ({', '.join(STRATEGIES)})")
+        plans.append((name, int(budget)))
+    return plans
+
+
+def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
+    from palpate.campaigns.mapstudy import run_map_study, summarise_study
+
+    plans = parse_plans(args.plans)
+    total = args.worlds * (len(plans) + any(p[0] == "active" for p in plans))
+    bar = progress_bar(total, f"{scene.name} map study")
+
+    def done(_: dict[str, Any]) -> None:
+        bar.update(1)
+
+    try:
+        rows = run_map_study(
+            scene,
+            stack,
+            worlds=args.worlds,
+            plans=plans,
+            seed=args.seed,
+            workers=args.workers,
+            progress=done,
+        )
+    finally:
+        bar.close()
+    table = summarise_study(rows)
+    run_dir = new_run_dir(args.out)
+    payload = {
+        "scene": scene.name,
+        "worlds": args.worlds,
+        "seed": args.seed,
+        "summary": table,
+        "rows": rows,
+        "run_dir": str(run_dir),
+    }
+    (run_dir / "study.json").write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
+    if args.json:
+        print(json.dumps(payload, indent=2))
+    else:
+        for line in table:
+            print(json.dumps(line))
+        print(f"study: {run_dir / 'study.json'}")
+    return EXIT_OK

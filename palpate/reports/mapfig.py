@@ -1,0 +1,105 @@
+"""The map figure: what a survey found, beside what it did not know.
+
+Three panels over the patch (mm): the map's modulus (posterior median, kPa) with every probe
+numbered in the order it was taken and the stage's path between them (a probe without a
+number as a grey cross, a ``suspect`` one in orange); the map's uncertainty (sd of log E, %);
+and the probability of being above the threshold with its one-half contour (the estimated
+boundary), the estimated centre with its 95 % box, and in simulation the inclusion's footprint
+(dashed) and centre (+). A survey that found nothing says so in the title.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from matplotlib.patches import Circle, Rectangle
+
+from palpate.campaigns.survey import SurveyResult
+
+MM = 1e-3
+COLOURS = {"ok": "k", "suspect": "tab:orange", "none": "0.6"}
+
+
+def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
+    """Draw ``result`` (see the module docstring) as a PNG at ``path``; returns ``path``."""
+    s = result.summary
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+    if s is None:
+        for ax in axes:
+            _probes(ax, result)
+        fig.suptitle(f"{title}: no map ({result.stopped})")
+        return _save(fig, path)
+    extent = (s.x[0] / MM, s.x[-1] / MM, s.y[0] / MM, s.y[-1] / MM)
+    panels = (
+        (s.mean / 1e3, "modulus (kPa), posterior median", "viridis"),
+        (100 * s.sd, "uncertainty: sd of log E (%)", "magma"),
+        (s.p_above, f"P(E > {s.threshold / 1e3:.0f} kPa)", "RdBu_r"),
+    )
+    for ax, (field, label, cmap) in zip(axes, panels, strict=True):
+        image = ax.imshow(field, origin="lower", extent=extent, cmap=cmap, aspect="equal")
+        fig.colorbar(image, ax=ax, shrink=0.85, label=label)
+        _probes(ax, result)
+        _truth(ax, result)
+    axes[2].contour(s.x / MM, s.y / MM, s.p_above, levels=[0.5], colors="k", linewidths=1.5)
+    if s.centre is not None and s.centre_ci is not None:
+        (x0, x1), (y0, y1) = s.centre_ci
+        axes[2].add_patch(
+            Rectangle((x0 / MM, y0 / MM), (x1 - x0) / MM, (y1 - y0) / MM, fill=False, color="k")
+        )
+        axes[2].plot(s.centre[0] / MM, s.centre[1] / MM, "kx", ms=9, label="estimated centre")
+    verdict = "inclusion found" if s.found else "no inclusion found"
+    fig.suptitle(
+        f"{title}: {verdict}; {len(result.probes)} probes, {result.lab_time:.0f} s of lab time "
+        f"({result.stopped})"
+    )
+    return _save(fig, path)
+
+
+def _probes(ax: Any, result: SurveyResult) -> None:
+    xy = np.array([[p.x, p.y] for p in result.probes]) / MM
+    if xy.size == 0:
+        return
+    ax.plot(xy[:, 0], xy[:, 1], "-", color="w", lw=0.6, alpha=0.8)
+    for k, p in enumerate(result.probes):
+        colour = COLOURS.get(p.status, "k") if p.usable else COLOURS["none"]
+        ax.plot(p.x / MM, p.y / MM, "x" if not p.usable else "o", ms=4, color=colour, mfc="w")
+        ax.annotate(
+            str(k + 1),
+            (p.x / MM, p.y / MM),
+            fontsize=6,
+            xytext=(2, 2),
+            textcoords="offset points",
+            color="w",
+        )
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+
+
+def _truth(ax: Any, result: SurveyResult) -> None:
+    t = result.truth
+    if t is None:
+        return
+    ax.add_patch(
+        Circle(
+            (t.centre[0] / MM, t.centre[1] / MM),
+            t.radius / MM,
+            fill=False,
+            ls="--",
+            color="w",
+            lw=1.2,
+        )
+    )
+    ax.plot(t.centre[0] / MM, t.centre[1] / MM, "w+", ms=9)
+
+
+def _save(fig: Any, path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
