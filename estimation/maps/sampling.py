@@ -112,7 +112,9 @@ class Active:
         if len(probes) < len(self.start):
             return self.start[len(probes)]
         try:
-            m = StiffnessMap.fit(list(probes), seed=self.seed, length_scale_max=self.length_scale_max)
+            m = StiffnessMap.fit(
+                list(probes), seed=self.seed, length_scale_max=self.length_scale_max
+            )
         except MapError:  # too few numbers yet: go on with what a raster would do
             return self._fallback(probes)
         mean, sd = m.predict(self.candidates)

@@ -32,7 +32,8 @@ def scene(campaign: dict[str, Any], samples: int = 1, inclusions: int = 1) -> di
 
 def test_the_shipped_map_scene_loads() -> None:
     s = load(SceneConfig, resolve("scenes/maps/inclusion.yaml"))
-    assert s.campaign.kind == "map" and not s.campaign.on_tubes
+    assert s.campaign.kind == "map"
+    assert not s.campaign.on_tubes
     assert s.campaign.stage_speed == pytest.approx(5e-3)
     assert [x.name for x in s.campaign_samples()] == ["stiff"]
 

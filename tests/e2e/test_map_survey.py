@@ -32,10 +32,10 @@ def test_a_probe_sees_the_inclusion_from_where_it_presses(scene: SceneConfig) ->
     over = moved_scene(scene, sample, (3e-3, -2e-3)).samples[0]
     away = moved_scene(scene, sample, (-7e-3, 8e-3)).samples[0]
     w_over, w_away = (fe_world(s, scene.fidelity, tip) for s in (over, away))
-    assert isinstance(w_over, MapWorld) and isinstance(w_away, MapWorld)
-    assert w_over.offset == 0.0 and w_away.offset == pytest.approx(
-        ((10e-3) ** 2 + (10e-3) ** 2) ** 0.5 / tip, rel=1e-6
-    )
+    assert isinstance(w_over, MapWorld)
+    assert isinstance(w_away, MapWorld)
+    assert w_over.offset == 0.0
+    assert w_away.offset == pytest.approx(((10e-3) ** 2 + (10e-3) ** 2) ** 0.5 / tip, rel=1e-6)
     f_over, f_away = (w.table().forces[-1] for w in (w_over, w_away))
     assert f_over > 1.2 * f_away  # over the sphere the layer is stiffer
 
@@ -56,7 +56,8 @@ def test_a_killed_survey_resumes_from_its_probes_file(scene: SceneConfig, tmp_pa
     assert len(read_probes(tmp_path / PROBES_FILE)) == 2
     again = run_survey(scene, stack, strategy="raster", max_probes=4, run_dir=tmp_path)
     assert again.probes[:2] == taken  # read back as written
-    assert len(read_probes(tmp_path / PROBES_FILE)) == 4 and len(again.outcomes) == 2
+    assert len(read_probes(tmp_path / PROBES_FILE)) == 4
+    assert len(again.outcomes) == 2
     assert len(list((tmp_path / "logs").glob("p*.jsonl"))) == 4  # every probe a logged trial
     assert all(p.lab_time > 0 for p in again.probes)
     assert again.summary is not None  # four probes with numbers make a map
@@ -73,7 +74,8 @@ def test_palpate_map_prints_the_map_and_writes_its_run_folder(
     for key in ("probes_used", "inclusion_found", "inclusion_center_mm", "inclusion_radius_mm",
                 "lab_time_s", "truth", "scores"):  # fmt: skip
         assert key in payload, key
-    assert payload["probes_used"] == 4 and payload["truth"]["contrast"] == pytest.approx(5.0)
+    assert payload["probes_used"] == 4
+    assert payload["truth"]["contrast"] == pytest.approx(5.0)
     run_dir = Path(payload["run_dir"])
     assert (run_dir / "map.png").stat().st_size > 0
     assert json.loads((run_dir / "map.json").read_text())["probes_used"] == 4

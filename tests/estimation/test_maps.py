@@ -51,7 +51,8 @@ def test_a_probe_s_noise_is_its_interval_and_a_suspect_one_counts_less() -> None
     assert s.log_sigma() == pytest.approx(0.05 * math.sqrt(SUSPECT_INFLATION))
     assert probe(0.0, 0.0, 3e5, sd=1e-5).log_sigma() == SIGMA_FLOOR
     none = Probe(0.0, 0.0, None, None, "none", ("no buckling",))
-    assert not none.usable and none.why_left_out() == "no buckling"
+    assert not none.usable
+    assert none.why_left_out() == "no buckling"
     with pytest.raises(ValueError, match="no usable interval"):
         none.log_sigma()
 
@@ -61,7 +62,8 @@ def test_a_map_needs_three_numbers_and_says_which_probes_it_left_out() -> None:
     with pytest.raises(MapError, match="1 usable probes"):
         StiffnessMap.fit(few)
     m = StiffnessMap.fit([*few, probe(2e-3, 0.0, E0), probe(0.0, 2e-3, E0)])
-    assert len(m.used) == 3 and m.left_out[0][1] == "tip slid"
+    assert len(m.used) == 3
+    assert m.left_out[0][1] == "tip slid"
     assert math.exp(m.background) == pytest.approx(E0)
 
 
@@ -77,12 +79,16 @@ def test_the_threshold_from_the_data_never_sits_below_the_floor() -> None:
 def test_an_active_survey_finds_a_bump_and_a_flat_patch_gives_no_alarm() -> None:
     centre = (3e-3, -2e-3)
     found = summarise(StiffnessMap.fit(survey("active", centre, 0.45, 1)), PATCH)
-    assert found.found and found.centre is not None and found.centre_ci is not None
+    assert found.found
+    assert found.centre is not None
+    assert found.centre_ci is not None
     assert math.hypot(found.centre[0] - centre[0], found.centre[1] - centre[1]) < 1e-3
     (x0, x1), (y0, y1) = found.centre_ci
-    assert x0 <= found.centre[0] <= x1 and y0 <= found.centre[1] <= y1
+    assert x0 <= found.centre[0] <= x1
+    assert y0 <= found.centre[1] <= y1
     flat = summarise(StiffnessMap.fit(survey("active", centre, 0.0, 1)), PATCH)
-    assert not flat.found and flat.centre is None
+    assert not flat.found
+    assert flat.centre is None
     assert flat.evidence.startswith("no inclusion found")
 
 
@@ -90,8 +96,10 @@ def test_the_raster_is_a_serpentine_of_cell_centres() -> None:
     points = raster_points(PATCH, 10)  # 3 x 3: the largest square within 10
     assert len(points) == 9
     xs = [round(p[0] * 1e3, 6) for p in points]
-    assert xs[:3] == sorted(xs[:3]) and xs[3:6] == sorted(xs[3:6], reverse=True)
-    assert min(p[0] for p in points) > PATCH.x_min and max(p[1] for p in points) < PATCH.y_max
+    assert xs[:3] == sorted(xs[:3])
+    assert xs[3:6] == sorted(xs[3:6], reverse=True)
+    assert min(p[0] for p in points) > PATCH.x_min
+    assert max(p[1] for p in points) < PATCH.y_max
 
 
 def test_the_active_plan_starts_on_a_raster_and_keeps_its_distance() -> None:
