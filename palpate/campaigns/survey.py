@@ -235,16 +235,24 @@ def run_survey(
             on_probe(probe)
     stopped = getattr(plan, "stopped", "") or f"{len(probes)} of {budget} probes"
     t0 = time.process_time()
-    try:
-        fitted = StiffnessMap.fit(probes, seed=seed, length_scale_max=scale)
-        summary: MapSummary | None = summarise(fitted, patch, threshold=c.map_threshold, seed=seed)
-    except MapError as exc:
-        summary, stopped = None, f"{stopped}; no map: {exc}"
+    summary, note = map_of(probes, patch, c.map_threshold, seed, scale)
     map_seconds += time.process_time() - t0
     lab = sum(p.lab_time for p in probes)
+    stopped = stopped + note
     return SurveyResult(
         probes, summary, stopped, lab, map_seconds, truth_of(sample), patch, outcomes
     )
+
+
+def map_of(
+    probes: list[Probe], patch: Patch, threshold: float | None, seed: int, scale: float
+) -> tuple[MapSummary | None, str]:
+    """The probes' map summarised over ``patch`` (None and why, when it cannot be made)."""
+    try:
+        fitted = StiffnessMap.fit(probes, seed=seed, length_scale_max=scale)
+    except MapError as exc:
+        return None, f"; no map: {exc}"
+    return summarise(fitted, patch, threshold=threshold, seed=seed), ""
 
 
 def read_probes(path: Path) -> list[Probe]:
