@@ -72,6 +72,7 @@ def survey_row(
         "map_s_per_probe": result.map_seconds / max(len(result.probes), 1),
         "found": bool(s is not None and s.found),
         **result.scores(),
+        "probe_list": [p.as_dict() for p in result.probes],  # to summarise again another way
     }
     if s is not None and result.truth is not None:
         xx, yy = np.meshgrid(s.x, s.y)
@@ -129,6 +130,8 @@ def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
             line["false_alarms"] = sum(r["found"] for r in rs)
         else:
             line["detected"] = sum(r["found"] for r in rs)
+            for key in ("center_in_ci", "radius_in_ci"):  # the intervals' coverage
+                line[key] = sum(bool(r.get(key)) for r in rs if r["found"])
             for key in ("center_error_mm", "sensitivity", "specificity", "boundary_error_mm2"):
                 line[f"{key}_median"] = _median([r[key] for r in rs if r.get(key) is not None])
         out.append(line)

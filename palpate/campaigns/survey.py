@@ -102,6 +102,10 @@ class SurveyResult:
             out["center_error_mm"] = (
                 math.hypot(s.centre[0] - t.centre[0], s.centre[1] - t.centre[1]) / MM
             )
+        if s.centre_ci is not None and s.radius_ci is not None:
+            (x0, x1), (y0, y1) = s.centre_ci
+            out["center_in_ci"] = bool(x0 <= t.centre[0] <= x1 and y0 <= t.centre[1] <= y1)
+            out["radius_in_ci"] = bool(s.radius_ci[0] <= t.radius <= s.radius_ci[1])
         return out
 
     def as_dict(self) -> dict[str, Any]:

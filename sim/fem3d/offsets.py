@@ -28,6 +28,7 @@ from ..fem.problem import LayerProblem, significant
 from ..fem.table import ForceTable, load_table, table_key
 from .problem import InclusionProblem
 from .table import load_ratios, ratio_key
+from .world import scaled_table
 
 # distances (tip radii) of the 3-D solves a map interpolates between: dense where the factor
 # changes fastest (over the sphere), sparse where it has nearly died away
@@ -82,16 +83,7 @@ class MapWorld:
         """The layer's forces times the factor interpolated at :attr:`offset`."""
         layer = load_table(self.layer)
         n = layer.depths.size
-        return ForceTable(
-            key=self.key,
-            problem=self.layer,
-            depths=layer.depths,
-            forces=layer.forces * factor_at(self.solid, self.offset)[:n],
-            contact_radii=layer.contact_radii,
-            success=layer.success,
-            message=layer.message,
-            build_seconds=layer.build_seconds,
-        )
+        return scaled_table(layer, factor_at(self.solid, self.offset)[:n], self.key)
 
 
 def factor_at(solid: InclusionProblem, offset: float) -> np.ndarray:

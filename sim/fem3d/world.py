@@ -63,13 +63,21 @@ def _table(world: InclusionWorld) -> ForceTable:
     n = layer.depths.size
     if not np.allclose(layer.depths, ratios.depths[:n], rtol=1e-12, atol=0.0):
         raise ValueError("the layer's and the 3-D problem's tabulated depths differ")
+    return scaled_table(layer, ratios.ratios[:n], world.key, ratios.build_seconds)
+
+
+def scaled_table(
+    layer: ForceTable, factor: np.ndarray, key: str, extra_seconds: float = 0.0
+) -> ForceTable:
+    """The layer's table with its forces times ``factor`` (one per tabulated depth), under
+    ``key``: a world with inclusions (this module's, ``offsets.MapWorld``)."""
     return ForceTable(
-        key=world.key,
-        problem=world.layer,
+        key=key,
+        problem=layer.problem,
         depths=layer.depths,
-        forces=layer.forces * ratios.ratios[:n],
+        forces=layer.forces * factor,
         contact_radii=layer.contact_radii,
         success=layer.success,
         message=layer.message,
-        build_seconds=layer.build_seconds + ratios.build_seconds,
+        build_seconds=layer.build_seconds + extra_seconds,
     )

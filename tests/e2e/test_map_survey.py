@@ -94,3 +94,37 @@ def test_a_map_scene_with_a_bad_key_is_refused(tmp_path: Path) -> None:
     text = SCENE.read_text(encoding="utf-8").replace("max_probes: 30", "max_probes: 0")
     bad.write_text(text, encoding="utf-8")
     assert main(["map", "--scene", str(bad), "--out", str(tmp_path)]) == 2
+
+
+def test_a_study_places_each_world_s_inclusion_inside_the_patch(scene: SceneConfig) -> None:
+    from palpate.campaigns.mapstudy import world_scene
+
+    x0, y0, x1, y1 = scene.campaign.patch_mm
+    centres = []
+    for k in range(20):
+        (inc,) = world_scene(scene, k, seed=3).samples[0].inclusions
+        cx, cy, depth = inc.center_mm
+        assert x0 + inc.radius_mm <= cx <= x1 - inc.radius_mm
+        assert y0 + inc.radius_mm <= cy <= y1 - inc.radius_mm
+        assert depth == scene.campaign_samples()[0].inclusions[0].center_mm[2]
+        centres.append((cx, cy))
+    assert len(set(centres)) == 20  # seeded apart
+    assert world_scene(scene, 4, seed=3) == world_scene(scene, 4, seed=3)
+    assert world_scene(scene, 4, seed=3, plain=True).samples[0].inclusions == ()
+
+
+def test_a_study_scores_every_survey_against_its_world(scene: SceneConfig) -> None:
+    from palpate.campaigns.mapstudy import run_map_study, summarise_study, wilson
+
+    stack = load_stack(resolve(scene.robot))
+    rows = run_map_study(scene, stack, worlds=1, plans=[("raster", 4)], seed=0, workers=1)
+    (row,) = rows
+    assert row["probes"] == 4
+    assert len(row["probe_list"]) == 4
+    assert "boundary_error_mm2" in row
+    (line,) = summarise_study(rows)
+    assert line["worlds"] == 1
+    assert line["detected"] == int(row["found"])
+    lo, hi = wilson(12, 12)
+    assert 0.7 < lo < 0.8
+    assert hi == 1.0
