@@ -40,6 +40,7 @@ from palpate.estimation.maps import (
     plan_for,
     summarise,
 )
+from palpate.estimation.maps.gp import LENGTH_SCALE_MAX
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 from palpate.simulation.world import TrialSpec
 
@@ -81,6 +82,7 @@ class SurveyResult:
     truth: Truth | None
     patch: Patch
     outcomes: list[TrialOutcome] = field(default_factory=list)
+    length_scale_max: float = LENGTH_SCALE_MAX  # the map's (m)
 
     def scores(self) -> dict[str, Any]:
         """Against the truth: the centre's error (mm), and the boundary's sensitivity and
@@ -244,7 +246,7 @@ def run_survey(
     lab = sum(p.lab_time for p in probes)
     stopped = stopped + note
     return SurveyResult(
-        probes, summary, stopped, lab, map_seconds, truth_of(sample), patch, outcomes
+        probes, summary, stopped, lab, map_seconds, truth_of(sample), patch, outcomes, scale
     )
 
 

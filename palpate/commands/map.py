@@ -93,6 +93,10 @@ def run(args: argparse.Namespace) -> int:
         result = _survey(scene, stack, args, run_dir)
         payload = _payload(result, info, run_dir)
         (run_dir / "map.json").write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
+        from palpate.reports.maprecording import write_map_recording
+
+        threshold = scene.campaign.map_threshold
+        payload["recording"] = str(write_map_recording(result, run_dir / "map.mcap", threshold))
         if not args.no_plots:
             from palpate.reports.mapfig import map_figure
 

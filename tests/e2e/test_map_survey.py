@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from palpate.campaigns.survey import PROBES_FILE, moved_scene, read_probes, run_survey
@@ -14,6 +15,7 @@ from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.estimation.maps import Probe
+from palpate.robot.records.recording import read_recording
 from palpate.sim.fem3d.offsets import MapWorld
 from palpate.sim.sample_law import fe_world
 
@@ -79,6 +81,16 @@ def test_palpate_map_prints_the_map_and_writes_its_run_folder(
     run_dir = Path(payload["run_dir"])
     assert (run_dir / "map.png").stat().st_size > 0
     assert json.loads((run_dir / "map.json").read_text())["probes_used"] == 4
+    rec = read_recording(run_dir / "map.mcap")  # the map after each probe, as ROS 2 messages
+    assert rec.complete
+    assert rec.types["/map/grid"] == "sensor_msgs/msg/PointCloud2"
+    assert rec.count("/map/probes") == 4
+    assert rec.count("/map/grid") == 2  # from the third usable probe on
+    _, grid = rec.messages["/map/grid"][-1]
+    assert [f.name for f in grid.fields] == ["x", "y", "z", "modulus_kpa", "sd", "p_above"]
+    values = np.frombuffer(bytes(grid.data), "<f8").reshape(grid.width, 6)
+    assert np.all((values[:, 5] >= 0) & (values[:, 5] <= 1))
+    assert np.all(values[:, 3] > 100)  # kPa: the phantom's hundreds
 
 
 def test_palpate_map_refuses_a_scene_that_is_not_a_map(
