@@ -18,7 +18,10 @@ only while a client listens:
   tube's forward kinematics (``robot.kinematics``);
 - ``/scene`` (``foxglove.SceneUpdate``): the tube's centreline (straight part and arc) and the
   sensor beam, bent as the elastica at the tick's end shortening (``estimation.elastica``), in
-  the tube's bend plane (the gratings' own plane is not measured: a drawing, not a fit).
+  the tube's bend plane (the gratings' own plane is not measured: a drawing, not a fit);
+- on ``palpate map --live``, after each probe: ``/map/grid`` and ``/map/probes``
+  (``foxglove.PointCloud``, frame ``sample``): the map over the patch (modulus, sd of log E,
+  P(above)) and the probes so far, the fields docs/maps.md lists for the recording.
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ import dataclasses
 import logging
 import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -136,6 +139,7 @@ class LiveView:
         )
         self.tf = FrameTransformsChannel("/tf", context=ctx)
         self.scene = SceneUpdateChannel("/scene", context=ctx)
+        self._clouds: dict[str, Any] = {}  # a map's channels, opened by its first frame
         self._closed = False
 
     def trial(self, stage: Stage) -> Publisher:
@@ -143,6 +147,43 @@ class LiveView:
         exposed length is fixed, on a tube it follows the translation."""
         feed = _Feed(self, stage.tube, stage)
         return feed.publish
+
+    def cloud(
+        self, topic: str, stamp: int, names: Sequence[str], columns: Sequence[FloatArray]
+    ) -> None:
+        """Float64 ``columns`` named ``names`` (x and y first, m) as a ``foxglove.PointCloud``
+        on ``topic`` at ``stamp`` (ns): ``palpate map --live``'s map and probes, in the
+        patch's frame ``sample``."""
+        from foxglove.channels import PointCloudChannel
+        from foxglove.messages import (
+            PackedElementField,
+            PackedElementFieldNumericType,
+            PointCloud,
+            Pose,
+            Quaternion,
+            Timestamp,
+            Vector3,
+        )
+
+        channel = self._clouds.get(topic)
+        if channel is None:
+            channel = self._clouds[topic] = PointCloudChannel(topic, context=self.context)
+        f64 = PackedElementFieldNumericType.Float64
+        fields = [PackedElementField(name=n, offset=8 * k, type=f64) for k, n in enumerate(names)]
+        data = np.column_stack(columns).astype("<f8")
+        channel.log(
+            PointCloud(
+                timestamp=Timestamp(*divmod(stamp, 1_000_000_000)),
+                frame_id="sample",
+                pose=Pose(
+                    position=Vector3(x=0.0, y=0.0, z=0.0),
+                    orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+                ),
+                point_stride=8 * len(names),
+                fields=fields,
+                data=data.tobytes(),
+            )
+        )
 
     def close(self) -> None:
         if not self._closed:

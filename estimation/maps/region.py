@@ -18,6 +18,7 @@ region's area; their intervals are the 2.5 and 97.5 percentiles over joint poste
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,7 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
 
-from .gp import MM, Patch, StiffnessMap
+from .gp import LENGTH_SCALE_MAX, MIN_PROBES, MM, MapError, Patch, StiffnessMap
+from .probes import Probe
 
 FloatArray = NDArray[np.float64]
 MIN_RISE = 0.10  # the smallest rise above the background a threshold from the data takes
@@ -178,3 +180,37 @@ def _intervals(
         return float(lo), float(hi)
 
     return (ci(cx), ci(cy)), ci(radius)
+
+
+GRID_FIELDS = ("x", "y", "z", "modulus_kpa", "sd", "p_above")
+PROBE_FIELDS = ("x", "y", "z", "modulus_kpa", "order")
+
+
+def grid_frame(
+    probes: Sequence[Probe],
+    patch: Patch,
+    *,
+    threshold: float | None = None,
+    length_scale_max: float = LENGTH_SCALE_MAX,
+) -> list[FloatArray] | None:
+    """The map of ``probes`` as columns of :data:`GRID_FIELDS` over the summary's grid (m,
+    kPa; z = 0, the surface), None while too few probes give a number: what a recording and
+    the live view draw after each probe."""
+    if sum(p.usable for p in probes) < MIN_PROBES:
+        return None
+    try:
+        m = StiffnessMap.fit(list(probes), length_scale_max=length_scale_max)
+    except MapError:
+        return None
+    points = patch.points(GRID)
+    mean, sd = m.predict(points)
+    p = above(mean, sd, log_threshold(m, mean, threshold))
+    return [points[:, 0], points[:, 1], np.zeros(len(points)), np.exp(mean) / 1e3, sd, p]
+
+
+def probe_frame(probes: Sequence[Probe]) -> list[FloatArray]:
+    """The probes as columns of :data:`PROBE_FIELDS` (kPa, NaN without a number; order from 1)."""
+    xy = np.array([[p.x, p.y] for p in probes], dtype=np.float64).reshape(-1, 2)
+    moduli = np.array([math.nan if p.modulus is None else p.modulus / 1e3 for p in probes])
+    order = np.arange(1.0, len(probes) + 1)
+    return [xy[:, 0], xy[:, 1], np.zeros(len(probes)), moduli, order]

@@ -24,7 +24,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,8 +41,13 @@ from palpate.estimation.maps import (
     summarise,
 )
 from palpate.estimation.maps.gp import LENGTH_SCALE_MAX
+from palpate.estimation.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
+from palpate.robot.records.ros2 import nanoseconds
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 from palpate.simulation.world import TrialSpec
+
+if TYPE_CHECKING:
+    from palpate.live import LiveView
 
 MM = 1e-3
 PROBES_FILE = "probes.jsonl"
@@ -198,10 +203,12 @@ def run_survey(
     max_probes: int | None = None,
     run_dir: Path | None = None,
     on_probe: Callable[[Probe], None] | None = None,
+    live: LiveView | None = None,
 ) -> SurveyResult:
     """Run the scene's map campaign (``strategy`` and ``max_probes`` override its keys); with
     ``run_dir``, trial logs under ``logs/`` and the probes in ``probes.jsonl``, read back first
-    (a resumed survey carries on from its last probe)."""
+    (a resumed survey carries on from its last probe); with ``live``, each probe's trial and
+    the map after it on the live view (``/map/grid``, ``/map/probes``)."""
     c = scene.campaign
     sample = scene.campaign_samples()[0]
     patch = Patch.from_mm((c.patch_mm[0], c.patch_mm[1], c.patch_mm[2], c.patch_mm[3]))
@@ -225,20 +232,15 @@ def run_survey(
         map_seconds += time.process_time() - t0
         if point is None:
             break
-        k = len(probes)
-        spec = probe_spec(scene, sample, k, point, seed)
-        o = run_sim_trial(
-            spec, moved_scene(scene, sample, point), stack, transport=scene.transport, log_dir=logs
-        )
-        last = (0.0, 0.0) if not probes else (probes[-1].x, probes[-1].y)
-        travel = math.hypot(point[0] - last[0], point[1] - last[1]) / c.stage_speed
-        probe = probe_of(o, point, travel)
+        probe, o = _probe_at(scene, stack, probes, point, seed, logs, live)
         probes.append(probe)
         outcomes.append(o)
         if run_dir is not None:
             _append(run_dir / PROBES_FILE, probe)
         if on_probe is not None:
             on_probe(probe)
+        if live is not None:
+            publish_map(live, probes, patch, c.map_threshold, scale)
     stopped = getattr(plan, "stopped", "") or f"{len(probes)} of {budget} probes"
     t0 = time.process_time()
     summary, note = map_of(probes, patch, c.map_threshold, seed, scale)
@@ -250,6 +252,31 @@ def run_survey(
     )
 
 
+def _probe_at(
+    scene: SceneConfig,
+    stack: StackConfig,
+    probes: list[Probe],
+    point: tuple[float, float],
+    seed: int,
+    logs: Path | None,
+    live: LiveView | None,
+) -> tuple[Probe, TrialOutcome]:
+    """The next probe's trial at ``point``, the stage's travel to it from the last probe."""
+    sample = scene.campaign_samples()[0]
+    spec = probe_spec(scene, sample, len(probes), point, seed)
+    o = run_sim_trial(
+        spec,
+        moved_scene(scene, sample, point),
+        stack,
+        transport=scene.transport,
+        log_dir=logs,
+        live=live,
+    )
+    last = (0.0, 0.0) if not probes else (probes[-1].x, probes[-1].y)
+    travel = math.hypot(point[0] - last[0], point[1] - last[1]) / scene.campaign.stage_speed
+    return probe_of(o, point, travel), o
+
+
 def map_of(
     probes: list[Probe], patch: Patch, threshold: float | None, seed: int, scale: float
 ) -> tuple[MapSummary | None, str]:
@@ -259,6 +286,17 @@ def map_of(
     except MapError as exc:
         return None, f"; no map: {exc}"
     return summarise(fitted, patch, threshold=threshold, seed=seed), ""
+
+
+def publish_map(
+    live: LiveView, probes: list[Probe], patch: Patch, threshold: float | None, scale: float
+) -> None:
+    """The probes so far and their map on the live view, stamped with the lab time."""
+    stamp = nanoseconds(sum(p.lab_time for p in probes))
+    live.cloud("/map/probes", stamp, PROBE_FIELDS, probe_frame(probes))
+    grid = grid_frame(probes, patch, threshold=threshold, length_scale_max=scale)
+    if grid is not None:
+        live.cloud("/map/grid", stamp, GRID_FIELDS, grid)
 
 
 def read_probes(path: Path) -> list[Probe]:

@@ -26,6 +26,7 @@ from palpate.config import InputError, load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.estimation.maps import STRATEGIES, Probe
 from palpate.exitcodes import EXIT_OK
+from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
 
 SHIPPED = "scenes/maps/inclusion.yaml"
@@ -42,6 +43,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--resume", action="store_true", help="carry on the newest run of this configuration"
     )
     parser.add_argument("--no-plots", action="store_true", help="skip map.png")
+    add_live_argument(parser, "each probe's trial and the map after it")
     parser.add_argument(
         "--worlds",
         type=positive_int,
@@ -118,15 +120,17 @@ def _survey(
         bar.set_postfix_str(f"({p.x * 1e3:+.1f}, {p.y * 1e3:+.1f}) mm {p.status}")
 
     try:
-        return run_survey(
-            scene,
-            stack,
-            seed=args.seed,
-            strategy=args.strategy,
-            max_probes=args.max_probes,
-            run_dir=run_dir,
-            on_probe=on_probe,
-        )
+        with live_view(args.live, stack) as view:
+            return run_survey(
+                scene,
+                stack,
+                seed=args.seed,
+                strategy=args.strategy,
+                max_probes=args.max_probes,
+                run_dir=run_dir,
+                on_probe=on_probe,
+                live=view,
+            )
     finally:
         bar.close()
 

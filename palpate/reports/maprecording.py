@@ -21,7 +21,6 @@ modulus, its uncertainty or the probability, chosen in the viewer), on any cell 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -32,9 +31,7 @@ from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,u
 from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
 
 from palpate.campaigns.survey import SurveyResult
-from palpate.estimation.maps import MapError, StiffnessMap
-from palpate.estimation.maps.gp import MIN_PROBES
-from palpate.estimation.maps.region import GRID, above, log_threshold
+from palpate.estimation.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
 from palpate.robot.records.ros2 import HEADER, SEP, TIME, header, nanoseconds
 
 CLOUD = "sensor_msgs/msg/PointCloud2"
@@ -80,8 +77,6 @@ def cloud(stamp_ns: int, names: Sequence[str], columns: Sequence[np.ndarray]) ->
 def write_map_recording(result: SurveyResult, path: Path, threshold: float | None = None) -> Path:
     """The survey's map after each probe (module docstring) as MCAP at ``path``."""
     encode = serialize_dynamic(CLOUD, CLOUD_SCHEMA)[CLOUD]
-    points = result.patch.points(GRID)
-    zeros = np.zeros(len(points))
     with open(path, "wb") as fh:
         writer = Writer(fh, compression=CompressionType.NONE)
         writer.start(profile="ros2", library="palpate")
@@ -93,25 +88,13 @@ def write_map_recording(result: SurveyResult, path: Path, threshold: float | Non
             lab += probe.lab_time
             stamp = nanoseconds(lab)
             so_far = result.probes[:k]
-            xy = np.array([[p.x, p.y] for p in so_far])
-            moduli = np.array([math.nan if p.modulus is None else p.modulus / 1e3 for p in so_far])
-            message = cloud(
-                stamp,
-                ("x", "y", "z", "modulus_kpa", "order"),
-                (xy[:, 0], xy[:, 1], np.zeros(k), moduli, np.arange(1.0, k + 1)),
+            data = encode(cloud(stamp, PROBE_FIELDS, probe_frame(so_far)))
+            writer.add_message(probes, log_time=stamp, data=data, publish_time=stamp)
+            columns = grid_frame(
+                so_far, result.patch, threshold=threshold, length_scale_max=result.length_scale_max
             )
-            writer.add_message(probes, log_time=stamp, data=encode(message), publish_time=stamp)
-            if sum(p.usable for p in so_far) < MIN_PROBES:
-                continue
-            try:
-                m = StiffnessMap.fit(list(so_far), length_scale_max=result.length_scale_max)
-            except MapError:
-                continue
-            mean, sd = m.predict(points)
-            p_above = above(mean, sd, log_threshold(m, mean, threshold))
-            columns = (points[:, 0], points[:, 1], zeros, np.exp(mean) / 1e3, sd, p_above)
-            names = ("x", "y", "z", "modulus_kpa", "sd", "p_above")
-            data = encode(cloud(stamp, names, columns))
-            writer.add_message(grid, log_time=stamp, data=data, publish_time=stamp)
+            if columns is not None:
+                data = encode(cloud(stamp, GRID_FIELDS, columns))
+                writer.add_message(grid, log_time=stamp, data=data, publish_time=stamp)
         writer.finish()  # type: ignore[no-untyped-call,unused-ignore]
     return path
