@@ -99,6 +99,8 @@ def test_palpate_map_refuses_a_scene_that_is_not_a_map(
     assert main(["map", "--scene", str(resolve("scenes/bench.yaml")), "--out", str(tmp_path)]) == 2
     assert "campaign.kind" in capsys.readouterr().err
     assert main(["map", "--sample", "nobody", "--out", str(tmp_path)]) == 2
+    assert main(["map", "--worlds", "1", "--plans", "spiral:3", "--out", str(tmp_path)]) == 2
+    assert "--plans" in capsys.readouterr().err
 
 
 def test_a_map_scene_with_a_bad_key_is_refused(tmp_path: Path) -> None:
