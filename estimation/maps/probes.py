@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 Z95 = 1.959963984540054  # the joint fit's intervals are 95 %
 SUSPECT_INFLATION = 4.0  # a suspect probe's variance on log E, times its interval's
+MM = 1e-3
 SIGMA_FLOOR = 0.01  # sd of log E below which no probe is believed (1 %: the world's own scatter)
 
 
@@ -66,6 +68,20 @@ class Probe:
         if self.status == "none" or self.modulus is None:
             return "; ".join(self.reasons) or "no number"
         return "no finite interval"
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Probe:
+        """The probe :meth:`as_dict` wrote (a survey's ``probes.jsonl`` line, read back)."""
+        ci = d["ci_kpa"]
+        return cls(
+            d["x_mm"] * MM,
+            d["y_mm"] * MM,
+            None if d["modulus_kpa"] is None else d["modulus_kpa"] * 1e3,
+            None if ci is None else (ci[0] * 1e3, ci[1] * 1e3),
+            d["status"],
+            tuple(d["reasons"]),
+            d["lab_time_s"],
+        )
 
     def as_dict(self) -> dict[str, object]:
         return {

@@ -26,7 +26,7 @@ import numpy as np
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 
-from .survey import MM, run_survey
+from .survey import run_survey
 
 Plan = tuple[str, int]  # (strategy, probe budget)
 
@@ -74,13 +74,6 @@ def survey_row(
         **result.scores(),
         "probe_list": [p.as_dict() for p in result.probes],  # to summarise again another way
     }
-    if s is not None and result.truth is not None:
-        xx, yy = np.meshgrid(s.x, s.y)
-        t = result.truth
-        inside = np.hypot(xx - t.centre[0], yy - t.centre[1]) <= t.radius
-        said = (s.p_above > 0.5) if s.found else np.zeros_like(inside)
-        cell = (s.x[1] - s.x[0]) * (s.y[1] - s.y[0]) / MM**2
-        row["boundary_error_mm2"] = float((said ^ inside).sum() * cell)
     return row
 
 

@@ -90,9 +90,10 @@ class SurveyResult:
     length_scale_max: float = LENGTH_SCALE_MAX  # the map's (m)
 
     def scores(self) -> dict[str, Any]:
-        """Against the truth: the centre's error (mm), and the boundary's sensitivity and
-        specificity on the summary's grid (the truth's region: the inclusion's footprint, a
-        disc of its radius about its centre); a homogeneous sample's "false alarm"."""
+        """Against the truth: the centre's error (mm), and the boundary's sensitivity,
+        specificity and error (the area where the two regions disagree, mm^2) on the summary's
+        grid (the truth's region: the inclusion's footprint, a disc of its radius about its
+        centre); a homogeneous sample's "false alarm"."""
         s = self.summary
         if self.truth is None:
             return {"false_alarm": bool(s is not None and s.found)}
@@ -105,6 +106,8 @@ class SurveyResult:
         said = s.p_above > 0.5 if s.found else np.zeros_like(inside)
         out["sensitivity"] = float((said & inside).sum() / max(inside.sum(), 1))
         out["specificity"] = float((~said & ~inside).sum() / max((~inside).sum(), 1))
+        cell = (s.x[1] - s.x[0]) * (s.y[1] - s.y[0]) / MM**2
+        out["boundary_error_mm2"] = float((said ^ inside).sum() * cell)
         if s.centre is not None:
             out["center_error_mm"] = (
                 math.hypot(s.centre[0] - t.centre[0], s.centre[1] - t.centre[1]) / MM
@@ -306,21 +309,9 @@ def read_probes(path: Path) -> list[Probe]:
     out = []
     for line in path.read_text(encoding="utf-8").splitlines():
         try:
-            d = json.loads(line)
+            out.append(Probe.from_dict(json.loads(line)))
         except ValueError:
             break  # a line cut by a kill: the probe is run again
-        ci = d["ci_kpa"]
-        out.append(
-            Probe(
-                d["x_mm"] * MM,
-                d["y_mm"] * MM,
-                None if d["modulus_kpa"] is None else d["modulus_kpa"] * 1e3,
-                None if ci is None else (ci[0] * 1e3, ci[1] * 1e3),
-                d["status"],
-                tuple(d["reasons"]),
-                d["lab_time_s"],
-            )
-        )
     return out
 
 
