@@ -20,7 +20,7 @@ from typing import Literal
 
 from .loader import ConfigError, limits, load, resolve
 from .sample import AssumedConfig
-from .scene import CampaignConfig
+from .scene import CampaignConfig, check_patch
 from .schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
 
 SIMULATION_ONLY = ("samples", "exposed_lengths_mm", "exposed_length_mm", "tubes", "orientations")
@@ -73,6 +73,29 @@ class BenchTrialConfig:
 
 
 @dataclass(frozen=True)
+class BenchMapConfig:
+    """A stiffness map on the bench (issue 40; docs/maps.md): the x-y stage (``stage:`` of the
+    robot file) puts the tip over each point of ``patch_mm`` (stage positions: the point of
+    the sample under the tip) and every probe is a trial of the ``trials`` entry at ``target``
+    (its sample, belief and stand-off pose). The plan picks the points (``strategy``), at most
+    ``max_probes``; ``threshold_kpa`` is the map's level (null: half-way to the peak)."""
+
+    target: str
+    patch_mm: tuple[float, ...] = (-10.0, -10.0, 10.0, 10.0)
+    strategy: Literal["active", "raster", "random"] = "active"
+    max_probes: int = field(default=30, metadata=limits(ge=1, le=10000))
+    threshold_kpa: float | None = field(default=None, metadata=limits(gt=0))
+    seed: int = field(default=0, metadata=limits(ge=0))
+
+    def validate(self) -> None:
+        check_patch(self.patch_mm, "patch_mm")
+
+    @property
+    def threshold(self) -> float | None:
+        return None if self.threshold_kpa is None else self.threshold_kpa * 1e3
+
+
+@dataclass(frozen=True)
 class BenchConfig:
     """``config/bench.yaml``: the hardware and the scripted protocol."""
 
@@ -87,8 +110,14 @@ class BenchConfig:
     retract_mm: float | None = field(default=None, metadata=limits(gt=0, le=500))
     campaign: CampaignConfig = field(default_factory=CampaignConfig)
     trials: tuple[BenchTrialConfig, ...] = ()
+    map: BenchMapConfig | None = None  # a survey of a patch on the x-y stage (after the trials)
 
     def validate(self) -> None:
+        if self.map is not None and not any(t.target == self.map.target for t in self.trials):
+            raise ValueError(
+                f"map.target: {self.map.target!r} is no trials entry's target (the entry says "
+                "what each probe presses: its sample and belief)"
+            )
         default = CampaignConfig()
         for key in SIMULATION_ONLY:
             if getattr(self.campaign, key) != getattr(default, key):
@@ -138,6 +167,7 @@ def load_bench(path: str | Path) -> LoadedBench:
             baudrate=bench.board.baudrate or stack.board.baudrate,
         ),
     )
+    _check_stage(p, bench, stack, robot)
     targets = Path(bench.targets)
     if not targets.exists():
         try:
@@ -145,3 +175,22 @@ def load_bench(path: str | Path) -> LoadedBench:
         except ConfigError:
             targets = Path(bench.targets)  # teleop may create it; trial reports it missing
     return LoadedBench(p, bench, stack, targets)
+
+
+def _check_stage(path: Path, bench: BenchConfig, stack: StackConfig, robot: Path) -> None:
+    """A map needs the robot's x-y stage, and its patch inside the stage's travel."""
+    if bench.map is None:
+        return
+    if stack.stage is None:
+        raise ConfigError(
+            str(path), "map", f"a map needs the x-y stage: {robot} has no stage: section"
+        )
+    x0, y0, x1, y1 = bench.map.patch_mm
+    (xl, xh), (yl, yh) = stack.stage.x_travel_mm, stack.stage.y_travel_mm
+    if x0 < xl or x1 > xh or y0 < yl or y1 > yh:
+        raise ConfigError(
+            str(path),
+            "map.patch_mm",
+            f"{list(bench.map.patch_mm)} reaches beyond the stage's travel "
+            f"(x {[xl, xh]}, y {[yl, yh]} mm in {robot})",
+        )

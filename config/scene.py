@@ -231,16 +231,19 @@ class SceneConfig:
         return tuple(s for s in self.samples if not wanted or s.name in wanted)
 
 
+def check_patch(patch_mm: tuple[float, ...], key: str) -> None:
+    """A map's patch: four corners in order (ValueError naming ``key``)."""
+    if len(patch_mm) != 4 or not (patch_mm[2] > patch_mm[0] and patch_mm[3] > patch_mm[1]):
+        raise ValueError(
+            f"{key}: [x_min, y_min, x_max, y_max] with x_max > x_min and y_max > "
+            f"y_min, got {list(patch_mm)}"
+        )
+
+
 def _check_map(scene: SceneConfig) -> None:
     """A map campaign's keys: a patch of four corners in order, one sample."""
     c = scene.campaign
-    if len(c.patch_mm) != 4 or not (
-        c.patch_mm[2] > c.patch_mm[0] and c.patch_mm[3] > c.patch_mm[1]
-    ):
-        raise ValueError(
-            f"campaign.patch_mm: [x_min, y_min, x_max, y_max] with x_max > x_min and y_max > "
-            f"y_min, got {list(c.patch_mm)}"
-        )
+    check_patch(c.patch_mm, "campaign.patch_mm")
     if len(scene.campaign_samples()) != 1:
         names = [s.name for s in scene.campaign_samples()]
         raise ValueError(f"campaign.samples: a map surveys one sample, got {names}")

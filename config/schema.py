@@ -14,6 +14,7 @@ from typing import Literal
 from .drive import DriveConfig
 from .loader import limits
 from .optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
+from .xystage import AxisServo, XYStageConfig
 
 __all__ = [
     "DEFAULT_CONTROL_RATE_HZ",
@@ -22,6 +23,7 @@ __all__ = [
     "NM",
     "PM",
     "UE",
+    "AxisServo",
     "BoardConfig",
     "CalibrationConfig",
     "DriveConfig",
@@ -32,6 +34,7 @@ __all__ = [
     "StackConfig",
     "TipGratingConfig",
     "TubeConfig",
+    "XYStageConfig",
     "check_compliance",
     "compliance_range",
 ]
@@ -288,9 +291,11 @@ class StackConfig:
     drive: DriveConfig = DriveConfig()  # noqa: RUF009 - frozen
     tubes: tuple[TubeConfig, ...] = DEFAULT_TUBES
     calibration: CalibrationConfig = CalibrationConfig()
+    stage: XYStageConfig | None = None  # the x-y stage under the sample, for maps (optional)
 
     def validate(self) -> None:
         self._validate_tip_grating()
+        self._validate_stage()
         names = [t.name for t in self.tubes]
         if len(set(names)) != len(names):
             raise ValueError(f"tubes: names must be unique, got {names}")
@@ -299,6 +304,19 @@ class StackConfig:
                 f"fbg.base_wavelengths_nm lists {len(self.fbg.base_wavelengths_nm)} gratings, "
                 f"sensor.grating_count is {self.sensor.grating_count}"
             )
+
+    def _validate_stage(self) -> None:
+        if self.stage is None:
+            return
+        s = self.servos
+        drive = {s.outer_roll.id, s.inner_roll.id, s.translation.id}
+        for axis in ("x", "y"):
+            servo_id = getattr(self.stage, axis).id
+            if servo_id in drive:
+                raise ValueError(
+                    f"stage.{axis}.id: {servo_id} is a drive servo's id (servos.*): "
+                    "the bus needs one id per servo"
+                )
 
     def _validate_tip_grating(self) -> None:
         tip = self.sensor.tip_grating

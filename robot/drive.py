@@ -126,6 +126,8 @@ class DriveController:
     def __init__(self, bus: MotorBus, cfg: DriveConfig) -> None:
         self.bus = bus
         self.drive = RollerGearDrive(cfg)
+        # a bus that carries more than the drive (the x-y stage): each tick reads the drive's
+        self._own = None if set(bus.names) == set(SERVOS) else SERVOS
 
     def start(self) -> None:
         self.bus.connect()
@@ -142,7 +144,7 @@ class DriveController:
 
     def read(self) -> tuple[JointState, dict[str, MotorState]]:
         """Measured joints and the raw motor states (one bus read)."""
-        state = self.bus.read_state()
+        state = self.bus.read_state(self._own)
         return self.drive.joints({n: s.position for n, s in state.items()}), state
 
     def close(self) -> None:

@@ -9,7 +9,7 @@ cables and power, maybe retry) or a servo answered that something is wrong
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol, Self
 
@@ -77,8 +77,9 @@ class MotorBus(Protocol):
         """Limit a servo's profile: shaft velocity (rad/s) and acceleration (rad/s^2)."""
         ...
 
-    def read_state(self) -> dict[str, MotorState]:
-        """One read of every servo's state (one bus transaction per control tick)."""
+    def read_state(self, names: Sequence[str] | None = None) -> dict[str, MotorState]:
+        """One read of every servo's state (one bus transaction per control tick); of those
+        ``names`` only, when given."""
         ...
 
     def write_goals(self, goals: Mapping[str, float]) -> dict[str, float]:

@@ -148,14 +148,21 @@ def relaxation(sample: SampleConfig, fidelity: FidelityConfig) -> Relaxation | N
     return StandardLinearSolid(sample.relaxation_time_s, sample.relaxed_ratio)
 
 
-def world_tissue(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueLaw:
-    """The world's (elastic, instantaneous when viscoelastic) force law of ``sample``."""
+def world_tissue(
+    sample: SampleConfig,
+    fidelity: FidelityConfig,
+    tip_radius: float,
+    at: tuple[float, float] = (0.0, 0.0),
+) -> TissueLaw:
+    """The world's (elastic, instantaneous when viscoelastic) force law of ``sample`` under a
+    tip pressing at ``at`` (m, :func:`fe_world`; a sample without inclusions is the same
+    everywhere)."""
     if sample.rigid:
         return RigidBlock(tip_radius)
     sls = relaxation(sample, fidelity)
     modulus = sample.modulus / (1.0 if sls is None else sls.ratio)
     if fidelity.tissue_model == "fe":
-        return FeTissueLaw(fe_world(sample, fidelity, tip_radius), modulus, tip_radius)
+        return FeTissueLaw(fe_world(sample, fidelity, tip_radius, at), modulus, tip_radius)
     from .tissue import TissueModel  # the estimator's family: only on this level
 
     return TissueModel(

@@ -28,6 +28,7 @@ from palpate.estimation.maps import STRATEGIES, Probe
 from palpate.exitcodes import EXIT_OK
 from palpate.live import add_live_argument, live_view
 from palpate.progress import progress_bar
+from palpate.reports.mapresults import map_lines, write_map_results
 
 SHIPPED = "scenes/maps/inclusion.yaml"
 
@@ -93,20 +94,18 @@ def run(args: argparse.Namespace) -> int:
     with locked(run_dir):
         write_run_info(run_dir, info)
         result = _survey(scene, stack, args, run_dir)
-        payload = _payload(result, info, run_dir)
-        (run_dir / "map.json").write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
-        from palpate.reports.maprecording import write_map_recording
-
-        threshold = scene.campaign.map_threshold
-        payload["recording"] = str(write_map_recording(result, run_dir / "map.mcap", threshold))
-        if not args.no_plots:
-            from palpate.reports.mapfig import map_figure
-
-            payload["figure"] = str(map_figure(result, run_dir / "map.png", scene.name))
+        payload = write_map_results(
+            result,
+            run_dir,
+            info,
+            threshold=scene.campaign.map_threshold,
+            title=scene.name,
+            plots=not args.no_plots,
+        )
     if args.json:
         print(json.dumps(payload, indent=2))
     else:
-        _print(result, payload, run_dir)
+        print("\n".join(map_lines(result, run_dir, scene.name, info["strategy"])))
     return EXIT_OK
 
 
@@ -133,37 +132,6 @@ def _survey(
             )
     finally:
         bar.close()
-
-
-def _payload(result: SurveyResult, info: dict[str, Any], run_dir: Path) -> dict[str, Any]:
-    return {**info, "run_dir": str(run_dir), **result.as_dict()}
-
-
-def _print(result: SurveyResult, payload: dict[str, Any], run_dir: Path) -> None:
-    s = result.summary
-    print(
-        f"{payload['scene']}: {len(result.probes)} probes ({payload['strategy']}), "
-        f"{result.lab_time:.0f} s of lab time; {result.stopped}"
-    )
-    if s is None:
-        print("no map: too few probes gave a number")
-    else:
-        print(s.evidence)
-        if s.found and s.centre is not None and s.centre_ci is not None and s.radius is not None:
-            (x0, x1), (y0, y1) = s.centre_ci
-            print(
-                f"centre ({s.centre[0] * 1e3:+.2f}, {s.centre[1] * 1e3:+.2f}) mm "
-                f"[x {x0 * 1e3:+.2f}..{x1 * 1e3:+.2f}, y {y0 * 1e3:+.2f}..{y1 * 1e3:+.2f}], "
-                f"radius {s.radius * 1e3:.2f} mm"
-            )
-    if result.truth is not None:
-        t = result.truth
-        print(
-            f"truth: centre ({t.centre[0] * 1e3:+.2f}, {t.centre[1] * 1e3:+.2f}) mm, "
-            f"radius {t.radius * 1e3:.2f} mm, {t.depth * 1e3:.1f} mm deep, {t.contrast:.1f}x; "
-            f"scores {result.scores()}"
-        )
-    print(f"run folder: {run_dir}")
 
 
 def parse_plans(text: str) -> list[tuple[str, int]]:

@@ -1,4 +1,5 @@
-"""Jog roll, advance and tube from the keyboard; live pose, strains and flags; store poses.
+"""Jog roll, advance and tube (and the x-y stage, when the robot has one) from the keyboard;
+live pose, strains and flags; store poses.
 
 ``palpate teleop`` runs on the simulator by default (both emulators in-process, real time, a
 world with a tissue sample of a scene, so strains and contact respond), on the real bench with
@@ -35,7 +36,9 @@ from palpate.live import LiveView, Publisher, add_live_argument, live_view
 from palpate.robot.indentation import State
 from palpate.robot.rig import ServoFbgRig
 from palpate.robot.teleop import Teleop
+from palpate.robot.teleop.stagejog import StageJog
 from palpate.robot.trial.setup import detector_for, guards_for, rig_settings
+from palpate.robot.xystage import StageController
 from palpate.sensor.clock import Clock, SystemClock
 from palpate.simulation.twin import SimulatedBench
 
@@ -73,6 +76,8 @@ class Session:
     saved: list[str] = field(default_factory=list)
     live: LiveView | None = None  # --live: the jog's ticks to Foxglove (palpate.live)
     feed: Publisher | None = None  # the live view's publisher for the current tube
+    stage: StageController | None = None  # the x-y stage, when the robot has one
+    stage_jog: StageJog | None = None
 
     def follow_tube(self) -> None:
         """A publisher for the model's current tube (after a swap)."""
@@ -157,6 +162,9 @@ def _body(where: _Where, args: argparse.Namespace, summary: dict[str, Any]) -> i
         session = _session(
             where.stack, where.campaign, hw.drive, hw.reader, hw.clock, args, where.targets
         )
+        if hw.stage is not None and where.stack.stage is not None:
+            session.stage = hw.stage
+            session.stage_jog = StageJog(where.stack.stage, hw.stage.position)
         session.title = f"palpate teleop ({where.mode})"
         session.sim = where.sim
         session.live = stack_.enter_context(live_view(args.live, where.stack))
@@ -208,6 +216,8 @@ def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
     while True:
         while (code := stdscr.getch()) != -1:
             name = key_name(code)
+            if name is not None and _stage_key(s, name):
+                continue
             effect = model.press(name) if name is not None else None
             if effect is None:
                 continue
@@ -229,15 +239,40 @@ def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
             recovered = True  # one reboot so the sensor can be pulled back, as in a trial
             rig.recover()
         rig.command(cmd)
+        if s.stage is not None and s.stage_jog is not None:
+            if model.state is not State.IDLE and model.state is not State.POSITIONING:
+                s.stage_jog.goal = s.stage.position  # a stop or a fault: the stage holds too
+            s.stage.follow(s.stage_jog.goal)
         if s.feed is not None:
             s.feed(obs, model.state)
         now = clock.now()
         if now >= next_draw:
-            draw(stdscr, render(model.view(), screen_width(stdscr), s.title))
+            draw(stdscr, render(model.view(), screen_width(stdscr), s.title, _stage_view(s)))
             next_draw = now + DRAW_PERIOD_S
         # fell behind (a slow draw)? then do not try to catch up in a burst
         next_tick = max(next_tick + s.tick, now)
         clock.sleep(next_tick - now)
+
+
+def _stage_key(s: Session, name: str) -> bool:
+    """A stage jog key (not while a name is typed): the stage's goal moves if the tip is free
+    (no contact, the jog model idle); True when the key was the stage's."""
+    model, jog = s.model, s.stage_jog
+    if jog is None or model.prompt is not None:
+        return False
+    obs = model.obs
+    free = obs is not None and not obs.contact and model.state is State.IDLE
+    if not jog.press(name, step=model.step_size[0], free=free):
+        return False
+    model.message = jog.message
+    return True
+
+
+def _stage_view(s: Session) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """The stage's measured position and its jog goal (m), for the screen."""
+    if s.stage is None or s.stage_jog is None:
+        return None
+    return s.stage.read(), s.stage_jog.goal
 
 
 def _save(s: Session, name: str) -> None:

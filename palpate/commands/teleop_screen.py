@@ -12,6 +12,7 @@ import math
 from typing import Any
 
 from palpate.robot.teleop import TeleopView
+from palpate.robot.teleop.stagejog import STAGE_HELP
 
 HELP = (
     "up/k advance  down/j retract  left/h right/l roll  t/T tube  +/- step  [/] speed",
@@ -33,8 +34,14 @@ def _xyz(v: tuple[float, float, float] | None, scale: float, digits: int) -> str
     return "  ".join(f"{axis} {c * scale:+8.{digits}f}" for axis, c in zip("xyz", v, strict=True))
 
 
-def render(view: TeleopView, width: int = 80, title: str = "palpate teleop") -> list[str]:
-    """The screen as lines of text (no terminal codes), each cut to ``width``."""
+def render(
+    view: TeleopView,
+    width: int = 80,
+    title: str = "palpate teleop",
+    stage: tuple[tuple[float, float], tuple[float, float]] | None = None,
+) -> list[str]:
+    """The screen as lines of text (no terminal codes), each cut to ``width``; with ``stage``
+    (the x-y stage's position and goal, m) its line and keys too."""
     g = view.goal
     roll_deg = None if view.roll is None else math.degrees(view.roll)
     goal_roll = "-" if g is None else f"{math.degrees(g.roll):8.2f}"
@@ -51,6 +58,7 @@ def render(view: TeleopView, width: int = 80, title: str = "palpate teleop") -> 
         f"exposed    {_mm(view.exposed_length)} mm",
         f"step       {view.step[0] * 1e3:.3g} mm / {math.degrees(view.step[1]):.3g} deg"
         f"   speed {view.speed * 1e3:.3g} mm/s",
+        *_stage_line(stage),
         "",
         f"tube tip   {_xyz(view.tube_tip, 1e3, 2)} mm",
         f"tangent    {_xyz(view.tangent, 1.0, 3)}",
@@ -68,8 +76,16 @@ def render(view: TeleopView, width: int = 80, title: str = "palpate teleop") -> 
     ]
     if view.prompt is not None:
         lines.append(f"save as: {view.prompt}_")
-    lines += ["", *HELP]
+    lines += ["", *HELP, *([] if stage is None else [STAGE_HELP])]
     return [line[:width] for line in lines]
+
+
+def _stage_line(stage: tuple[tuple[float, float], tuple[float, float]] | None) -> list[str]:
+    if stage is None:
+        return []
+    (x, y), (gx, gy) = stage
+    goal = f"goal {gx * 1e3:+.2f}, {gy * 1e3:+.2f} mm"
+    return [f"stage      x {x * 1e3:+8.2f}  y {y * 1e3:+8.2f} mm   {goal}"]
 
 
 # -- curses ----------------------------------------------------------------------------------

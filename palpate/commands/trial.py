@@ -14,24 +14,28 @@ import json
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from palpate.calibration import calibrate, config_lines
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.estimation.stiffness import summarize
 from palpate.estimation.verdict import STATUSES
 from palpate.lab.hardware import open_hardware, port_problem, run_on_hardware
+from palpate.lab.plan import describe_map, plan_session
 from palpate.lab.trial import (
     SKIPPED,
     BenchOutcome,
     BenchTrial,
-    plan_bench_trials,
+    Session,
     run_bench_trials,
 )
 from palpate.live import add_live_argument, live_view
 from palpate.reports.results import CampaignResults
 from palpate.sensor.clock import Clock
 from palpate.sensor.reader import SerialLike
+
+if TYPE_CHECKING:  # the maps import scikit-learn: only when a bench file maps
+    from palpate.campaigns.surveyloop import SurveyResult
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -67,6 +71,38 @@ def run_session(
     """Open the bench (ports from the file unless given) and run ``trials``; torque is off and
     the ports closed on return, whatever happened. Tests pass the emulators' ptys and a
     virtual clock (with ``sync_to_clock``). ``live``: the live view's port (``--live``)."""
+    outcomes, _ = run_map_session(
+        loaded,
+        trials,
+        None,
+        log_dir,
+        servo_port=servo_port,
+        board_port=board_port,
+        clock=clock,
+        sync_to_clock=sync_to_clock,
+        progress=progress,
+        live=live,
+    )
+    return outcomes
+
+
+def run_map_session(
+    loaded: LoadedBench,
+    trials: list[BenchTrial],
+    survey: BenchTrial | None,
+    log_dir: Path,
+    *,
+    servo_port: str | Any | None = None,
+    board_port: str | SerialLike | None = None,
+    clock: Clock | None = None,
+    sync_to_clock: bool = False,
+    progress: Callable[[BenchOutcome], None] | None = None,
+    live: int | None = None,
+) -> tuple[list[BenchOutcome], SurveyResult | None]:
+    """:func:`run_session`, then, with a ``survey`` (the trial each probe repeats,
+    ``palpate.lab.survey.plan_bench_map``), the bench file's map on the x-y stage with the
+    compliance the trials calibrated: the trials' outcomes and the map (None without one, or
+    when a trial before it ended the session)."""
     key = str(loaded.path)
     with (
         open_hardware(
@@ -79,9 +115,32 @@ def run_session(
         ) as hw,
         live_view(live, loaded.stack) as view,
     ):
-        return run_bench_trials(
-            hw, trials, loaded, log_dir, sync_to_clock=sync_to_clock, progress=progress, live=view
+        session = Session(loaded.stack)
+        outcomes = run_bench_trials(
+            hw,
+            trials,
+            loaded,
+            log_dir,
+            sync_to_clock=sync_to_clock,
+            progress=progress,
+            live=view,
+            session=session,
         )
+        if survey is None or any(o.state == SKIPPED for o in outcomes):
+            return outcomes, None
+        from palpate.lab.survey import run_bench_map
+
+        result = run_bench_map(
+            hw,
+            survey,
+            loaded,
+            session.stack,
+            log_dir,
+            sync_to_clock=sync_to_clock,
+            progress=progress,
+            live=view,
+        )
+        return outcomes, result
 
 
 def _with_ports(loaded: LoadedBench, servo: str | None, board: str | None) -> LoadedBench:
@@ -96,9 +155,9 @@ def _with_ports(loaded: LoadedBench, servo: str | None, board: str | None) -> Lo
 
 def run(args: argparse.Namespace) -> int:
     loaded = _with_ports(load_bench(args.config), args.servo_port, args.board_port)
-    trials = plan_bench_trials(loaded, args.target)
+    trials, survey = plan_session(loaded, args.target)
     if args.dry_run:
-        return _dry_run(loaded, trials, args.json)
+        return _dry_run(loaded, trials, args.json, survey)
     base = args.log_dir if args.log_dir is not None else Path(loaded.bench.log_dir)
     log_dir = base / time.strftime("%Y%m%d-%H%M%S")
     quiet = args.json
@@ -111,12 +170,17 @@ def run(args: argparse.Namespace) -> int:
             print(_row(o.as_dict()), flush=True)
 
     if not quiet:
-        print(f"{len(trials)} trial(s) from {loaded.path}; logs in {log_dir}")
+        then = describe_map(loaded, survey)
+        print(f"{len(trials)} trial(s) from {loaded.path}{then}; logs in {log_dir}")
         print(_HEAD)
     outcomes: list[BenchOutcome] = []
+    surveyed: list[SurveyResult | None] = [None]
 
     def body() -> int:
-        outcomes.extend(run_session(loaded, trials, log_dir, progress=progress, live=args.live))
+        done, surveyed[0] = run_map_session(
+            loaded, trials, survey, log_dir, progress=progress, live=args.live
+        )
+        outcomes.extend(done)
         return 0
 
     code = run_on_hardware("trial", body)
@@ -135,11 +199,33 @@ def run(args: argparse.Namespace) -> int:
         "calibration": {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()},
     }
     files = results.finish(trial_rows, samples, payload) if outcomes else []
+    mapped = surveyed[0]
+    if mapped is not None:
+        payload["map"] = _map_results(mapped, loaded, log_dir)
+        outcomes += [o for o in mapped.outcomes if o is not None]
     if args.json:
         print(json.dumps(payload, indent=2))
     else:
         _print_summary(outcomes, samples, found, loaded.bench.robot, files)
+        if mapped is not None:
+            from palpate.reports.mapresults import map_lines
+
+            m = loaded.bench.map
+            assert m is not None
+            print("\n".join(map_lines(mapped, log_dir, f"map at {m.target}", m.strategy)))
     return 0 if all(o.state == "done" for o in outcomes) else 1
+
+
+def _map_results(mapped: SurveyResult, loaded: LoadedBench, log_dir: Path) -> dict[str, Any]:
+    """The map's files in the session folder; its payload without the probes' trials."""
+    from palpate.reports.mapresults import write_map_results
+
+    m = loaded.bench.map
+    assert m is not None
+    info = {"target": m.target, "strategy": m.strategy, "max_probes": m.max_probes}
+    return write_map_results(
+        mapped, log_dir, info, threshold=m.threshold, title=f"map at {m.target}", plots=True
+    )
 
 
 def _print_summary(
@@ -171,7 +257,9 @@ def _print_summary(
         print(f"results: {f}")
 
 
-def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> int:
+def _dry_run(
+    loaded: LoadedBench, trials: list[BenchTrial], as_json: bool, survey: BenchTrial | None
+) -> int:
     stack = loaded.stack
     ports = {
         "servos": (stack.servos.port, port_problem(stack.servos.port, "servo bus", "servos.port")),
@@ -186,6 +274,7 @@ def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> in
             "targets": str(loaded.targets_path),
             "ports": {k: {"port": p, "problem": why} for k, (p, why) in ports.items()},
             "trials": [t.describe() for t in trials],
+            "map": None if survey is None else {**_dc(loaded.bench.map), **survey.describe()},
         }
         print(json.dumps(payload, indent=2))
         return 0
@@ -200,8 +289,14 @@ def _dry_run(loaded: LoadedBench, trials: list[BenchTrial], as_json: bool) -> in
             f"{d['contact_translation_mm']:.3f} mm (exposed {d['exposed_length_mm']:.2f} mm), "
             f"retract to {d['retract_translation_mm']:.3f} mm"
         )
+    if survey is not None:
+        print(f"  then{describe_map(loaded, survey)[len(', then') :]}")
     print("dry run: no port opened, nothing moved")
     return 0
+
+
+def _dc(obj: Any) -> dict[str, Any]:
+    return dataclasses.asdict(obj) if obj is not None else {}
 
 
 def _summaries(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[str, Any]]:

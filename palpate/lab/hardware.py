@@ -29,6 +29,7 @@ from palpate.config.schema import StackConfig
 from palpate.robot.drive import DriveController
 from palpate.robot.dynamixel.driver import DynamixelBus
 from palpate.robot.motors import ServoFaultError, ServoTransportError
+from palpate.robot.xystage import StageController
 from palpate.sensor.clock import Clock, SystemClock
 from palpate.sensor.ports import DIALOUT_HINT, os_errno
 from palpate.sensor.reader import FrameReader, SensorPortError, SerialLike
@@ -54,6 +55,7 @@ class Hardware:
     drive: DriveController
     reader: FrameReader
     clock: Clock
+    stage: StageController | None = None  # the x-y stage under the sample, when the robot has one
 
 
 def port_problem(port: str, role: str, key: str) -> str | None:
@@ -123,7 +125,8 @@ def open_hardware(
     servo_key: str = "servos.port",
     board_key: str = "board.port",
 ) -> Iterator[Hardware]:
-    """Open the board, then the servo bus (homed at the present pose, torque on); yield them.
+    """Open the board, then the servo bus (homed at the present pose, torque on; the x-y stage
+    too when the robot has one); yield them.
 
     Ports default to ``stack.servos.port`` and ``stack.board.port``. ``servo_key`` and
     ``board_key`` say where the ports are configured, for the messages. Raises
@@ -140,9 +143,13 @@ def open_hardware(
     except SensorPortError as exc:
         raise explain(exc, _name(bp), "acquisition board", board_key) from exc
     try:
-        drive = DriveController(DynamixelBus.from_config(stack.servos, port=sp), stack.drive)
+        bus = DynamixelBus.from_config(stack.servos, port=sp, stage=stack.stage)
+        drive = DriveController(bus, stack.drive)
+        stage = None if stack.stage is None else StageController(bus, stack.stage)
         try:
             drive.start()
+            if stage is not None:
+                stage.start()
         except ServoTransportError as exc:
             drive.close()
             raise explain(exc, _name(sp), "servo bus", servo_key) from exc
@@ -150,7 +157,7 @@ def open_hardware(
             drive.close()
             raise
         try:
-            yield Hardware(drive, reader, clock)
+            yield Hardware(drive, reader, clock, stage)
         finally:
             drive.close()  # torque off on every servo, then the port is released
     finally:

@@ -200,3 +200,37 @@ def _repeats(
             )
         )
     return trials
+
+
+def plan_bench_map(loaded: LoadedBench) -> BenchTrial:
+    """The trial every probe of the bench file's map repeats: the first ``trials`` entry at
+    ``map.target`` (checked against the drive's limits like any trial)."""
+    m = loaded.bench.map
+    if m is None:
+        raise ValueError(f"{loaded.path} has no map: section")
+    return plan_bench_trials(loaded, m.target)[0]
+
+
+def plan_session(
+    loaded: LoadedBench, target: str | None
+) -> tuple[list[BenchTrial], BenchTrial | None]:
+    """The trials to run and, when the bench file maps (and ``--target`` is not another
+    pose), the trial each probe repeats: the listed trials at other targets run first."""
+    m = loaded.bench.map
+    if m is None or (target is not None and target != m.target):
+        return plan_bench_trials(loaded, target), None
+    others = target is None and any(e.target != m.target for e in loaded.bench.trials)
+    trials = [t for t in plan_bench_trials(loaded) if t.target.name != m.target] if others else []
+    return trials, plan_bench_map(loaded)
+
+
+def describe_map(loaded: LoadedBench, survey: BenchTrial | None) -> str:
+    """ ", then a map at ..." for the session's first line; empty without a map."""
+    m = loaded.bench.map
+    if survey is None or m is None:
+        return ""
+    x0, y0, x1, y1 = m.patch_mm
+    return (
+        f", then a map at {m.target} ({m.strategy}, at most {m.max_probes} probes over "
+        f"x {x0:+g}..{x1:+g}, y {y0:+g}..{y1:+g} mm of the x-y stage)"
+    )

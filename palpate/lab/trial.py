@@ -44,7 +44,16 @@ from palpate.robot.trial.setup import (
     sensor_section,
 )
 
-__all__ = ["SKIPPED", "BenchOutcome", "BenchTrial", "plan_bench_trials", "run_bench_trials"]
+__all__ = [
+    "PLANNED",
+    "SKIPPED",
+    "BenchOutcome",
+    "BenchTrial",
+    "Session",
+    "plan_bench_trials",
+    "run_bench_trial",
+    "run_bench_trials",
+]
 
 SKIPPED = "skipped"
 PLANNED = frozenset(s.value for s in PLANNED_ENDS)  # trial ends that keep torque on
@@ -103,6 +112,7 @@ def run_bench_trials(
     sync_to_clock: bool = False,
     progress: Callable[[BenchOutcome], None] | None = None,
     live: LiveView | None = None,
+    session: Session | None = None,
 ) -> list[BenchOutcome]:
     """Run ``trials`` in order on opened hardware; one log per trial in ``log_dir``; each
     trial's ticks go to the ``live`` view when there is one (``palpate.live``).
@@ -110,11 +120,12 @@ def run_bench_trials(
     ``sync_to_clock`` is for emulators on a virtual clock (wait for each tick's frame); on
     hardware it stays False. With ``stop_on_fault`` a trial that does not complete ends the
     session: the rest are reported as skipped, torque is off. A trial on a rigid reference
-    calibrates the compliance of its tube (the stage) for the session's later trials.
+    calibrates the compliance of its tube (the stage) for the session's later trials (and,
+    with a ``session`` given, for what the caller runs after them).
     """
     bench = loaded.bench
     outcomes: list[BenchOutcome] = []
-    session = Session(loaded.stack)
+    session = session if session is not None else Session(loaded.stack)
     torque_on = True  # DriveController.start() turned it on
     stopped = False
     for trial in trials:
@@ -125,12 +136,9 @@ def run_bench_trials(
         if not torque_on:
             hw.drive.bus.set_torque(True)
             torque_on = True
-        publisher = None if live is None else live.trial(trial.stage)
-        before = bus_stats(hw)
-        outcome, rig = _run_one(
-            hw, trial, loaded, session.stack, log_dir, (sync_to_clock, publisher)
+        outcome, rig = run_bench_trial(
+            hw, trial, loaded, session.stack, log_dir, sync_to_clock=sync_to_clock, live=live
         )
-        outcome.bus = _bus_during(before, bus_stats(hw), rig.missed_reads)
         session.add(trial, outcome)
         outcomes.append(outcome)
         if progress is not None:
@@ -142,6 +150,26 @@ def run_bench_trials(
             rig.release()
             torque_on = False
     return outcomes
+
+
+def run_bench_trial(
+    hw: Hardware,
+    trial: BenchTrial,
+    loaded: LoadedBench,
+    stack: StackConfig,
+    log_dir: Path,
+    *,
+    sync_to_clock: bool = False,
+    live: LiveView | None = None,
+) -> tuple[BenchOutcome, ServoFbgRig]:
+    """One trial on opened hardware with ``stack`` (the session's calibration), its log in
+    ``log_dir`` and its ticks on the ``live`` view; the outcome (with what the bus did) and
+    the rig (to release the servos)."""
+    publisher = None if live is None else live.trial(trial.stage)
+    before = bus_stats(hw)
+    outcome, rig = _run_one(hw, trial, loaded, stack, log_dir, (sync_to_clock, publisher))
+    outcome.bus = _bus_during(before, bus_stats(hw), rig.missed_reads)
+    return outcome, rig
 
 
 class Session:

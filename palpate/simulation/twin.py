@@ -34,9 +34,10 @@ from palpate.config.scene import SceneConfig
 from palpate.config.schema import MM, StackConfig, TubeConfig
 from palpate.config.targets import load_targets
 from palpate.robot import kinematics
-from palpate.robot.drive import INNER_ROLL, OUTER_ROLL, TRANSLATION, RollerGearDrive
+from palpate.robot.drive import INNER_ROLL, OUTER_ROLL, SERVOS, TRANSLATION, RollerGearDrive
 from palpate.robot.dynamixel.units import rad_from_ticks
 from palpate.robot.trial.setup import sensor_section
+from palpate.robot.xystage import STAGE_SERVOS, STAGE_X, STAGE_Y, XYAxes
 from palpate.sensor.parser import layout_from_config
 from palpate.sim.board import BoardEmulator, BoardSample
 from palpate.sim.clock import VirtualClock
@@ -154,7 +155,11 @@ class SimulatedBench:
             INNER_ROLL: stack.servos.inner_roll.id,
             TRANSLATION: stack.servos.translation.id,
         }
-        self.bus = EmulatedBus.from_config(stack.servos, clock=clock)
+        self.bus = EmulatedBus.from_config(stack.servos, clock=clock, stage=stack.stage)
+        self._stage = None if stack.stage is None else XYAxes(stack.stage)  # home at power-up
+        if stack.stage is not None:
+            self._ids.update({STAGE_X: stack.stage.x.id, STAGE_Y: stack.stage.y.id})
+        self.at = self._stage_at()  # the point of the sample under the tip (m)
         self._world = self._new_world()
         self._touched = False
         layout = layout_from_config(stack.sensor, stack.board)
@@ -176,13 +181,29 @@ class SimulatedBench:
         return self._world
 
     def servo(self, name: str) -> Any:
-        """The emulated servo of a drive joint (``"translation"``, ``"outer_roll"``, ...)."""
+        """The emulated servo of a drive joint (``"translation"``, ``"outer_roll"``, ...) or
+        of a stage axis (``"stage_x"``, ``"stage_y"``)."""
         return self.bus.servo(self._ids[name])
 
     def _joints(self) -> tuple[float, float, int]:
-        ticks = {n: self.bus.servo(i).position_ticks for n, i in self._ids.items()}
+        ticks = {n: self.servo(n).position_ticks for n in SERVOS}
         q = self._truth.joints({n: rad_from_ticks(t) for n, t in ticks.items()})
         return q.roll, q.translation, ticks[TRANSLATION]
+
+    def _stage_at(self) -> tuple[float, float]:
+        """Where the x-y stage has the sample under the tip (m; (0, 0) without a stage)."""
+        if self._stage is None:
+            return (0.0, 0.0)
+        return self._stage.position(
+            {n: rad_from_ticks(self.servo(n).position_ticks) for n in STAGE_SERVOS}
+        )
+
+    def _stage_settled(self) -> bool:
+        """The stage stands still somewhere else than the world's point (a move has ended)."""
+        if self._stage is None or any(self.servo(n).velocity_ticks_per_s for n in STAGE_SERVOS):
+            return False
+        at = self._stage_at()
+        return max(abs(at[0] - self.at[0]), abs(at[1] - self.at[1])) > 1e-6
 
     def _pose(self, roll: float, translation: float) -> tuple[Any, Any, float]:
         p = kinematics.forward(self.tube, roll, translation)
@@ -205,7 +226,9 @@ class SimulatedBench:
             sensor=self.stack.sensor,
             fbg=self.stack.fbg,
             fidelity=self.scene.fidelity,
-            tissue=tissue_model(self.sample, self.scene.fidelity, self.stack.sensor.tip_radius),
+            tissue=tissue_model(
+                self.sample, self.scene.fidelity, self.stack.sensor.tip_radius, self.at
+            ),
             surface=self.surface,
             pose=self._pose,
             joints=self._joints,
@@ -219,6 +242,9 @@ class SimulatedBench:
     def _sample(self, t: float) -> BoardSample:
         if not self._touched and len(self.stations) > 1:
             self._face(self._nearest_station())
+        if not self._touched and self._stage_settled():
+            self.at = self._stage_at()  # the stage slid the sample: the tissue under the tip
+            self._world = self._new_world()
         world = self._world
         sample = world.sample(t)
         last = world.last

@@ -66,11 +66,16 @@ class TrialSpec:
         return self.modulus if self.reference is None else self.reference
 
 
-def tissue_model(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) -> TissueLaw:
+def tissue_model(
+    sample: SampleConfig,
+    fidelity: FidelityConfig,
+    tip_radius: float,
+    at: tuple[float, float] = (0.0, 0.0),
+) -> TissueLaw:
     """The simulated tissue's force law for a scene's sample and fidelity switches
     (``sim.sample_law``: the finite-element table or the closed forms; the instantaneous law
-    of a viscoelastic sample)."""
-    return world_tissue(sample, fidelity, tip_radius)
+    of a viscoelastic sample), the tip pressing at ``at`` (m) of the sample."""
+    return world_tissue(sample, fidelity, tip_radius, at)
 
 
 def tissue_description(scene: SceneConfig, stack: StackConfig, sample: str) -> dict[str, Any]:

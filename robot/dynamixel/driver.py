@@ -34,7 +34,7 @@ from typing import Any, Self, TypeVar
 
 import dynamixel_sdk as sdk
 
-from ...config.schema import ServoBusConfig
+from ...config.schema import ServoBusConfig, XYStageConfig
 from ...sensor.ports import PORT_ERRORS, open_failure
 from ...wire import dynamixel as tables
 from ..motors import (
@@ -99,6 +99,7 @@ class DynamixelBus:
         self._motors = {m.name: m for m in motors}
         self._by_id = {m.id: m for m in motors}
         self._ids = [m.id for m in motors]  # the sync read's parameter (made once, not per tick)
+        self._subsets: dict[tuple[str, ...], list[int]] = {}
         self._port = TimedPortHandler(port, timeout * 1e3) if isinstance(port, str) else port
         # the SDK's Protocol 2.0 packet handler, or one with its calls (the simulator's
         # register-level fast path, ``sim.dynamixel.direct``): this class decides the same
@@ -117,15 +118,25 @@ class DynamixelBus:
 
     @classmethod
     def from_config(
-        cls, cfg: ServoBusConfig, port: str | Any | None = None, packet_handler: Any | None = None
+        cls,
+        cfg: ServoBusConfig,
+        port: str | Any | None = None,
+        packet_handler: Any | None = None,
+        stage: XYStageConfig | None = None,
     ) -> Self:
-        """The drive's three servos; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty),
-        ``packet_handler`` the SDK's (see :meth:`__init__`)."""
+        """The drive's three servos, and the x-y stage's two after them when ``stage`` is
+        given; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty), ``packet_handler``
+        the SDK's (see :meth:`__init__`)."""
         motors = [
             Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
             Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
             Motor("translation", cfg.translation.id, cfg.translation.model),
         ]
+        if stage is not None:
+            motors += [
+                Motor("stage_x", stage.x.id, stage.x.model),
+                Motor("stage_y", stage.y.id, stage.y.model),
+            ]
         return cls(
             cfg.port if port is None else port,
             motors,
@@ -297,18 +308,29 @@ class DynamixelBus:
         )
         self.write_item(name, "Profile_Velocity", units.velocity_units_from_rad_s(velocity))
 
-    def read_state(self) -> dict[str, MotorState]:
-        """One sync read of Moving .. Present_Position of every servo."""
-        replies = self._transact("sync read of present state", self._sync_read_state, None)
+    def read_state(self, names: Sequence[str] | None = None) -> dict[str, MotorState]:
+        """One sync read of Moving .. Present_Position of every servo (of ``names`` only, when
+        given: the drive's three on a bus that also carries the x-y stage)."""
+        ids = self._ids if names is None else self._subset(names)
+        replies = self._transact(
+            "sync read of present state", lambda: self._sync_read_state(ids), None
+        )
         out: dict[str, MotorState] = {}
         for servo_id, (data, error) in replies.items():
             self._raise_for_status(servo_id, error)
             out[self._by_id[servo_id].name] = decode_state(servo_id, data)
         return out
 
-    def _sync_read_state(self) -> tuple[dict[int, tuple[list[int], int]], int, int]:
+    def _subset(self, names: Sequence[str]) -> list[int]:
+        """The bus IDs of ``names`` (made once per subset, not per tick)."""
+        key = tuple(names)
+        ids = self._subsets.get(key)
+        if ids is None:
+            ids = self._subsets[key] = [self._motors[n].id for n in key]
+        return ids
+
+    def _sync_read_state(self, ids: list[int]) -> tuple[dict[int, tuple[list[int], int]], int, int]:
         """One attempt of :meth:`read_state`: the sync read and every servo's reply, by ID."""
-        ids = self._ids
         result = self._ph.syncReadTx(self._port, STATE_START, STATE_LEN, ids, len(ids), False)
         replies: dict[int, tuple[list[int], int]] = {}
         if result != sdk.COMM_SUCCESS:

@@ -14,7 +14,7 @@ and the bus counters)::
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ...estimation.compliance import ComplianceFit
 from ...estimation.jointfit import JointFit
@@ -27,6 +27,9 @@ from ..plan import TrialMarks
 from .estimate import TrialEstimate
 from .record import estimate_row
 from .run import TrialResult
+
+if TYPE_CHECKING:  # the maps' package imports scikit-learn: not at a trial's start-up
+    from ...estimation.maps.probes import Probe
 
 
 @dataclass(kw_only=True)
@@ -98,3 +101,25 @@ def outcome_fields(
         "relaxation": estimate.relaxation,
         "relaxed_verdict": estimate.relaxed_verdict,
     }
+
+
+def probe_of(o: Outcome, point: tuple[float, float], lab_time: float) -> Probe:
+    """A finished trial as a map's probe at ``point`` (m): the joint fit's modulus and interval
+    when it succeeded, the verdict's status and reasons (the trial's end when it has none), and
+    the lab time it took (s, with the stage's travel to it)."""
+    from ...estimation.maps.probes import Probe
+
+    jf, v = o.joint, o.verdict
+    ok = jf is not None and jf.success and jf.modulus is not None
+    ci = None
+    if ok and jf is not None and jf.ci_low is not None and jf.ci_high is not None:
+        ci = (jf.ci_low, jf.ci_high)
+    return Probe(
+        point[0],
+        point[1],
+        jf.modulus if ok and jf is not None else None,
+        ci,
+        "none" if v is None else v.status,
+        () if v is None else tuple(v.reasons) or (() if ok else (o.reason,)),
+        lab_time,
+    )

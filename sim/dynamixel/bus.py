@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable, Iterable
 from typing import Self
 
-from ...config.schema import ServoBusConfig
+from ...config.schema import AxisServo, ServoBusConfig, ServoConfig, XYStageConfig
 from ...wire import dynamixel as tables
 from ..clock import VirtualClock
 from . import protocol
@@ -77,11 +77,14 @@ class EmulatedBus:
         *,
         clock: VirtualClock | None = None,
         timing: BusTiming | None = None,
+        stage: XYStageConfig | None = None,
     ) -> Self:
-        """The three servos of the roller-gear drive with the IDs and models of ``cfg``."""
-        servos = [
-            EmulatedServo(s.id, s.model) for s in (cfg.outer_roll, cfg.inner_roll, cfg.translation)
-        ]
+        """The three servos of the roller-gear drive with the IDs and models of ``cfg``, and the
+        x-y stage's two when ``stage`` is given."""
+        configs: list[ServoConfig | AxisServo] = [cfg.outer_roll, cfg.inner_roll, cfg.translation]
+        if stage is not None:
+            configs += [stage.x, stage.y]
+        servos = [EmulatedServo(s.id, s.model) for s in configs]
         return cls(servos, clock=clock, timing=timing)
 
     # --- the servos --------------------------------------------------------------------------

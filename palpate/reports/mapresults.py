@@ -1,0 +1,68 @@
+"""A map's run folder and its lines for a person, one for ``palpate map`` (simulation) and
+``palpate trial`` with a bench file's ``map:`` (the x-y stage): ``map.json`` (the probes, the
+map's answer, the truth in simulation), ``map.mcap`` (the map as point clouds) and ``map.png``::
+
+    payload = write_map_results(result, run_dir, info, threshold=None, title="S8", plots=True)
+    for line in map_lines(result, payload["run_dir"], info["strategy"]): print(line)
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from palpate.campaigns.surveyloop import SurveyResult
+
+
+def write_map_results(
+    result: SurveyResult,
+    run_dir: Path,
+    info: dict[str, Any],
+    *,
+    threshold: float | None,
+    title: str,
+    plots: bool,
+) -> dict[str, Any]:
+    """Write the run folder's map files; the payload of ``map.json`` with the recording's and
+    the figure's paths (``info``: what the run was asked, first in the payload)."""
+    payload = {**info, "run_dir": str(run_dir), **result.as_dict()}
+    (run_dir / "map.json").write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
+    from palpate.reports.maprecording import write_map_recording
+
+    payload["recording"] = str(write_map_recording(result, run_dir / "map.mcap", threshold))
+    if plots:
+        from palpate.reports.mapfig import map_figure
+
+        payload["figure"] = str(map_figure(result, run_dir / "map.png", title))
+    return payload
+
+
+def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) -> list[str]:
+    """The survey's answer as a person reads it: probes and lab time, the evidence, the centre
+    with its interval and the radius, the truth and scores in simulation, the run folder."""
+    s = result.summary
+    lines = [
+        f"{title}: {len(result.probes)} probes ({strategy}), "
+        f"{result.lab_time:.0f} s of lab time; {result.stopped}"
+    ]
+    if s is None:
+        lines.append("no map: too few probes gave a number")
+    else:
+        lines.append(s.evidence)
+        if s.found and s.centre is not None and s.centre_ci is not None and s.radius is not None:
+            (x0, x1), (y0, y1) = s.centre_ci
+            lines.append(
+                f"centre ({s.centre[0] * 1e3:+.2f}, {s.centre[1] * 1e3:+.2f}) mm "
+                f"[x {x0 * 1e3:+.2f}..{x1 * 1e3:+.2f}, y {y0 * 1e3:+.2f}..{y1 * 1e3:+.2f}], "
+                f"radius {s.radius * 1e3:.2f} mm"
+            )
+    if result.truth is not None:
+        t = result.truth
+        lines.append(
+            f"truth: centre ({t.centre[0] * 1e3:+.2f}, {t.centre[1] * 1e3:+.2f}) mm, "
+            f"radius {t.radius * 1e3:.2f} mm, {t.depth * 1e3:.1f} mm deep, {t.contrast:.1f}x; "
+            f"scores {result.scores()}"
+        )
+    lines.append(f"run folder: {run_dir}")
+    return lines

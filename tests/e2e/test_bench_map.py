@@ -1,0 +1,169 @@
+"""A stiffness map on the bench path (issue 40): the x-y stage's two servos on the drive's bus,
+emulated, driven through dynamixel-sdk; ``palpate trial`` with a bench file's ``map:`` runs the
+survey probe by probe, the stage sliding the sample between trials, on a virtual clock."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from palpate.commands.trial import run_map_session
+from palpate.config import ConfigError, load, resolve
+from palpate.config.bench import LoadedBench, load_bench
+from palpate.config.scene import SceneConfig
+from palpate.lab.plan import plan_bench_map, plan_session
+from palpate.robot.xystage import STAGE_SERVOS, StageMoveError
+from palpate.sim.clock import VirtualClock
+from palpate.simulation.twin import SimulatedBench, stations_for
+
+MAP_SCENE = load(SceneConfig, resolve("scenes/maps/inclusion.yaml"))
+# the shipped robot-stage.yaml with a quick drive powered up 2 mm behind the stand-off pose and a
+# generous reply timeout (the emulator answers from a thread; the trial runs on a virtual clock)
+ROBOT = (
+    (resolve("robot-stage.yaml").read_text(encoding="utf-8"))
+    .replace("  home_translation_mm: 0 ", "  home_translation_mm: 43 ")
+    .replace("  max_speed_mm_per_s: 5\n  max_roll", "  max_speed_mm_per_s: 20\n  max_roll")
+    .replace("  timeout_ms: 20 ", "  timeout_ms: 2000 ")
+)
+
+
+def bench_map(tmp_path: Path, map_keys: str, robot: str = ROBOT) -> LoadedBench:
+    """The shipped bench-map.yaml with its robot, targets and logs under ``tmp_path`` and the
+    ``map:`` keys given."""
+    (tmp_path / "robot.yaml").write_text(robot, encoding="utf-8")
+    text = resolve("bench-map.yaml").read_text(encoding="utf-8")
+    head = text[: text.index("map:\n")]
+    head = head.replace("robot: robot-stage.yaml", f"robot: {tmp_path}/robot.yaml")
+    head = head.replace("log_dir: out/trial", f"log_dir: {tmp_path}/logs")
+    path = tmp_path / "bench.yaml"
+    path.write_text(head + f"map: {{target: map-downward, {map_keys}}}\n", encoding="utf-8")
+    return load_bench(path)
+
+
+def test_robot_stage_yaml_loads_with_the_stage_on_the_bus() -> None:
+    loaded = load_bench("bench-map.yaml")
+    stage = loaded.stack.stage
+    assert stage is not None
+    assert {stage.x.id, stage.y.id}.isdisjoint({1, 2, 3})
+    trials, survey = plan_session(loaded, None)
+    assert trials == []
+    assert survey is not None
+    assert survey.target.name == "map-downward"
+
+
+@pytest.mark.parametrize(
+    ("keys", "robot", "where"),
+    [
+        ("patch_mm: [-20, -10, 10, 10]", ROBOT, "map.patch_mm"),
+        ("patch_mm: [5, -10, -5, 10]", ROBOT, "map: patch_mm"),
+        ("patch_mm: [-5, -5, 5, 5]", "servos: {timeout_ms: 2000}\n", "map"),
+        ("patch_mm: [-5, -5, 5, 5]", ROBOT.replace("id: 5,", "id: 3,"), "stage.y.id"),
+    ],
+)
+def test_a_bad_map_is_refused_with_its_key(
+    tmp_path: Path, keys: str, robot: str, where: str
+) -> None:
+    with pytest.raises(ConfigError) as err:
+        bench_map(tmp_path, keys, robot)
+    assert where in str(err.value)
+
+
+def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(tmp_path: Path) -> None:
+    """Nine probes of a 3 x 3 raster over the map scene's inclusion (5x, 2.5 mm radius, 3.5 mm
+    deep at (3, -2) mm): the stage's servos take the sample to each point (the world sees the
+    inclusion from where the stage is), every probe a whole trial over the wire path, the map
+    names the stiff corner."""
+    loaded = bench_map(tmp_path, "patch_mm: [-6, -8, 6, 4], strategy: raster, max_probes: 9")
+    clock = VirtualClock()
+    stations = stations_for(MAP_SCENE, loaded)
+    with SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=False, stations=stations) as sim:
+        outcomes, result = run_map_session(
+            loaded,
+            [],
+            plan_bench_map(loaded),
+            tmp_path / "logs",
+            servo_port=sim.servo_port,
+            board_port=sim.board_port,
+            clock=clock,
+            sync_to_clock=True,
+        )
+        last = sim.at
+    assert outcomes == []
+    assert result is not None
+    assert len(result.probes) == 9
+    assert all(p.usable for p in result.probes)
+    assert math.dist(last, (result.probes[-1].x, result.probes[-1].y)) < 0.05e-3
+    stiffest = max(result.probes, key=lambda p: p.modulus or 0.0)
+    assert math.dist((stiffest.x, stiffest.y), (3e-3, -2e-3)) < 3e-3
+    softest = min(result.probes, key=lambda p: p.modulus or math.inf)
+    assert (stiffest.modulus or 0.0) > 1.3 * (softest.modulus or math.inf)
+    assert result.summary is not None
+    assert result.summary.found
+    assert (tmp_path / "logs" / "probes.jsonl").read_text().count("\n") == 9
+    assert all(o.state == "done" for o in result.outcomes)
+    assert result.lab_time > sum(o.duration for o in result.outcomes)  # the stage's moves too
+
+
+def test_the_stage_will_not_move_while_the_sensor_is_out(tmp_path: Path) -> None:
+    """A stage move asked with the sensor away from its retract pose raises and holds."""
+    from palpate.lab.hardware import open_hardware
+
+    loaded = bench_map(tmp_path, "patch_mm: [-5, -5, 5, 5]")
+    clock = VirtualClock()
+    stations = stations_for(MAP_SCENE, loaded)
+    with (
+        SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=True, stations=stations) as sim,
+        open_hardware(
+            loaded.stack, servo_port=sim.servo_port, board_port=sim.board_port, clock=clock
+        ) as hw,
+    ):
+        assert hw.stage is not None
+        before = hw.stage.read()
+        with pytest.raises(StageMoveError, match="not back"):
+            hw.stage.move_to((4e-3, 0.0), clock, tick=0.004, clear=lambda: False)
+        assert hw.stage.read() == pytest.approx(before, abs=1e-6)
+        here = hw.stage.move_to((4e-3, -3e-3), clock, tick=0.004, clear=lambda: True)
+        assert here == pytest.approx((4e-3, -3e-3), abs=0.02e-3)
+        ticks = [sim.servo(n).position_ticks for n in STAGE_SERVOS]
+        assert ticks == pytest.approx([4 / 2 * 4096, -3 / 2 * 4096], abs=10)  # 2 mm a turn
+
+
+def test_teleop_jogs_the_stage_step_by_step_within_its_travel(tmp_path: Path) -> None:
+    """The jog's goal moves a step a key, clamps at the travel's end, holds while the tip is
+    not free; the stage follows it one clamped goal per tick over the bus."""
+    from palpate.lab.hardware import open_hardware
+    from palpate.robot.teleop.stagejog import StageJog
+
+    loaded = bench_map(tmp_path, "patch_mm: [-5, -5, 5, 5]")
+    cfg = loaded.stack.stage
+    assert cfg is not None
+    jog = StageJog(cfg, (0.0, 0.0))
+    assert not jog.press("k", step=1e-3, free=True)  # not the stage's key
+    assert jog.press("x", step=5e-3, free=True)
+    assert jog.press("Y", step=5e-3, free=True)
+    assert jog.goal == pytest.approx((5e-3, -5e-3))
+    assert jog.press("y", step=5e-3, free=False)
+    assert jog.goal == pytest.approx((5e-3, -5e-3))
+    assert "not free" in jog.message
+    for _ in range(3):
+        jog.press("x", step=5e-3, free=True)
+    assert jog.goal[0] == pytest.approx(15e-3)
+    assert "end of its travel" in jog.message
+    clock = VirtualClock()
+    stations = stations_for(MAP_SCENE, loaded)
+    with (
+        SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=False, stations=stations) as sim,
+        open_hardware(
+            loaded.stack, servo_port=sim.servo_port, board_port=sim.board_port, clock=clock
+        ) as hw,
+    ):
+        assert hw.stage is not None
+        sent = [hw.stage.follow((2e-3, -1e-3))]
+        assert sent[0][0] < 2e-3  # one tick: the bus's step clamp (10 deg of shaft)
+        for _ in range(200):
+            sent.append(hw.stage.follow((2e-3, -1e-3)))
+            clock.sleep(0.01)
+        assert sent[-1] == (2e-3, -1e-3)
+        assert hw.stage.read() == pytest.approx((2e-3, -1e-3), abs=2e-6)
