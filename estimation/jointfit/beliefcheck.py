@@ -26,7 +26,9 @@ from numpy.typing import NDArray
 
 from ..belief import Belief
 from ..corrections import ContactLaw
+from .envelope import other_forms
 from .grid import grid_fits
+from .pooling import FORM, STATED, Curve
 
 FloatArray = NDArray[np.float64]
 
@@ -63,7 +65,7 @@ def alternatives(belief: Belief, law: ContactLaw) -> list[tuple[str, ContactLaw]
     return out
 
 
-def contradictions(
+def law_curves(
     belief: Belief,
     law: ContactLaw,
     base: tuple[FloatArray, FloatArray],
@@ -71,40 +73,50 @@ def contradictions(
     window: tuple[float, float],
     offset: bool,
     scale2: float,
-) -> tuple[str, ...]:
-    """The warning (none or one) that the record prefers an alternative to the stated point
-    belief by more than MARGIN. ``base`` is the estimate's (depth base, weights), ``window``
-    the contact positions (m) to search, ``scale2`` the noise model's s^2."""
-    alts = alternatives(belief, law)
-    if not alts:
-        return ()
+) -> dict[str, Curve]:
+    """The record's :class:`pooling.Curve` (in noise variances) of the estimate's ``law``
+    (``"stated"``), its other model form (``"form"``) and each alternative to the belief's
+    point properties (keyed by its sentence), over the contact positions of ``window`` (m).
+    ``base`` is the estimate's (depth base, weights), ``scale2`` the noise model's s^2."""
     depth_base, w = base
     grid = np.linspace(window[0], window[1], CHECK_POINTS)
-    laws = [law, *(alt for _, alt in alts)]
-    best = [float(np.min(_rss(candidate, depth_base, P, w, grid, offset))) for candidate in laws]
-    gains = [(best[0] - rss) / scale2 for rss in best[1:]]
-    k = int(np.argmax(gains))
-    if gains[k] <= MARGIN:
+    laws = [(STATED, law), *((FORM, f) for f in other_forms(law)), *alternatives(belief, law)]
+    curves = {}
+    for key, candidate in laws:
+        E, rss, S = _grid(candidate, depth_base, P, w, grid, offset)
+        curves[key] = Curve(E, rss / scale2, S / scale2)
+    return curves
+
+
+def contradictions(curves: dict[str, Curve]) -> tuple[str, ...]:
+    """The warning (none or one) that the record prefers an alternative to the stated point
+    belief (``law_curves``) by more than MARGIN in chi^2, each at its best contact position
+    and modulus."""
+    best = {key: float(np.min(c.rss)) for key, c in curves.items()}
+    gains = {key: best[STATED] - v for key, v in best.items() if key not in (STATED, FORM)}
+    if not gains:
         return ()
-    return (
-        f"{CONTRADICTED} belief: the record prefers {alts[k][0]}: delta chi^2 = {gains[k]:.0f}",
-    )
+    worst = max(gains, key=lambda k: gains[k])
+    if gains[worst] <= MARGIN:
+        return ()
+    return (f"{CONTRADICTED} belief: the record prefers {worst}: delta chi^2 = {gains[worst]:.0f}",)
 
 
-def _rss(
+def _grid(
     law: ContactLaw,
     depth_base: FloatArray,
     P: FloatArray,
     w: FloatArray,
     grid: FloatArray,
     offset: bool,
-) -> FloatArray:
-    """The weighted RSS at every contact position of ``grid`` (E, P0 in closed form), refined
-    on a finer grid around its minimum."""
-    ((E, _, rss, _),) = grid_fits([law], depth_base, P, w, grid, offset)
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """E, the weighted RSS (inf where E <= 0) and S at every contact position of ``grid``
+    (E, P0 in closed form), and on a finer grid around the RSS's minimum."""
+    ((E, _, rss, S),) = grid_fits([law], depth_base, P, w, grid, offset)
     rss = np.where(E > 0.0, rss, np.inf)
     i = int(np.argmin(rss))
     step = grid[1] - grid[0] if grid.size > 1 else 0.0
     fine = np.linspace(grid[i] - step, grid[i] + step, 21)
-    ((E2, _, rss2, _),) = grid_fits([law], depth_base, P, w, fine, offset)
-    return np.concatenate([rss, np.where(E2 > 0.0, rss2, np.inf)])
+    ((E2, _, rss2, S2),) = grid_fits([law], depth_base, P, w, fine, offset)
+    rss2 = np.where(E2 > 0.0, rss2, np.inf)
+    return np.concatenate([E, E2]), np.concatenate([rss, rss2]), np.concatenate([S, S2])

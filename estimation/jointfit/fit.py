@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..belief import Belief, Hypothesis
 from ..corrections import ContactLaw
-from .beliefcheck import contradictions
+from .beliefcheck import contradictions, law_curves
 from .envelope import Found, envelope, profile_hypotheses
 from .noise import (
     Noise,
@@ -19,6 +19,7 @@ from .noise import (
     profile_span,
     require_significance,
 )
+from .pooling import Terms
 from .record import Record, check_options, checked_record
 from .refine import Refined, refine, require_contact
 from .result import FitFailed, JointFit
@@ -141,17 +142,21 @@ def _profiled(
         belief.open_keys,
         len(hypotheses),
     )
-    # 5. can the record contradict what the belief states as a point?
+    # 5. can the record contradict what the belief states as a point? (and the trial's share
+    # of its sample's pooled fit: the same curves)
     compliance = fit.hypothesis.compliance
     base = (record.depth_base_at(compliance), weights_at(compliance))
     start = refit.start
     window = (max(start.lo, fit.contact - 3.0 * span), min(start.hi, fit.contact + 3.0 * span))
-    found_against = contradictions(
+    curves = law_curves(
         belief, fit.hypothesis.law, base, record.force, window, start.load_offset, noise.scale2
     )
-    if not found_against:
-        return result
-    return dataclasses.replace(result, warnings=result.warnings + found_against)
+    found_against = contradictions(curves)
+    terms = None
+    if result.modulus is not None and result.modulus > 0.0:
+        trimmed = {k: c.trimmed() for k, c in curves.items()}
+        terms = Terms(result.modulus, result.model_form or 0.0, trimmed)
+    return dataclasses.replace(result, warnings=result.warnings + found_against, terms=terms)
 
 
 @dataclass(frozen=True)

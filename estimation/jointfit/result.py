@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .pooling import Terms
 
 
 @dataclass(frozen=True)
@@ -59,6 +63,8 @@ class JointFit:
     nfev: int = 0
     law: str = ""
     warnings: tuple[str, ...] = field(default=())
+    # the trial's share of its sample's pooled fit (``jointfit.pooling``): in memory only
+    terms: Terms | None = field(default=None, compare=False, repr=False)
 
     def covers(self, modulus: float) -> bool:
         """Whether the interval [ci_low, ci_high] holds ``modulus`` (Pa); False without one."""

@@ -40,7 +40,8 @@ from palpate.benchmarks.fuzzconfig import (
     mutate_text,
     plain,
 )
-from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.dynamixel.roster import Motor
 from palpate.robot.motors import ServoFaultError, ServoTransportError
 from palpate.sensor.parser import FrameParser
 from palpate.sim.dynamixel import protocol

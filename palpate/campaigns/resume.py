@@ -20,6 +20,7 @@ from palpate.campaigns.runs import set_aside
 from palpate.config.schema import StackConfig
 from palpate.estimation.compliance import ComplianceFit
 from palpate.estimation.jointfit import JointFit
+from palpate.estimation.jointfit.pooling import Terms
 from palpate.estimation.misalignment import Lean
 from palpate.estimation.relaxation import RelaxationFit
 from palpate.estimation.southwell import SouthwellFit
@@ -179,7 +180,11 @@ def _paper(record: dict[str, Any]) -> StiffnessEstimate | None:
 
 
 def _joint(record: dict[str, Any]) -> JointFit:
-    return _from_record(JointFit, record, "warnings")
+    """The joint fit, with its share of the sample's pooled fit when the log carries it."""
+    fields = {k: v for k, v in record.items() if k != "pooling"}
+    fit = _from_record(JointFit, fields, "warnings")
+    pooling = record.get("pooling")
+    return fit if pooling is None else dataclasses.replace(fit, terms=Terms.from_dict(pooling))
 
 
 def _relaxation(record: Any) -> RelaxationFit | None:

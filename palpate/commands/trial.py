@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING, Any
 
 from palpate.calibration import calibrate, config_lines
 from palpate.config.bench import LoadedBench, load_bench
-from palpate.estimation.stiffness import summarize
 from palpate.estimation.verdict import STATUSES
 from palpate.lab.hardware import open_hardware, port_problem, run_on_hardware
 from palpate.lab.plan import describe_map, plan_session
@@ -30,6 +29,7 @@ from palpate.lab.trial import (
     run_bench_trials,
 )
 from palpate.live import add_live_argument, live_view
+from palpate.reports.benchsamples import bench_samples
 from palpate.reports.results import CampaignResults
 from palpate.sensor.clock import Clock
 from palpate.sensor.reader import SerialLike
@@ -184,25 +184,35 @@ def run(args: argparse.Namespace) -> int:
         return 0
 
     code = run_on_hardware("trial", body)
-    if code:
-        return code
-    samples = _summaries(outcomes, loaded.bench.campaign.outlier_above)
+    return code or _report(args, loaded, log_dir, outcomes, surveyed[0], results)
+
+
+def _report(
+    args: argparse.Namespace,
+    loaded: LoadedBench,
+    log_dir: Path,
+    outcomes: list[BenchOutcome],
+    mapped: SurveyResult | None,
+    results: CampaignResults,
+) -> int:
+    """The session's results (files, then stdout); exit 0 when every trial and probe is done."""
+    samples = bench_samples(outcomes, loaded.bench.campaign.outlier_above)  # the trials, not probes
     found = calibrate(
         (o.trial.stage.rig_key, o.calibration) for o in outcomes if o.calibration is not None
     )
+    probes = [] if mapped is None else [o for o in mapped.outcomes if o is not None]
+    outcomes = outcomes + probes  # every trial's row; the samples' statistics leave probes out
     trial_rows = [o.as_dict() for o in outcomes]
-    payload = {
+    payload: dict[str, Any] = {
         "bench": str(loaded.path),
         "log_dir": str(log_dir),
         "trials": trial_rows,
         "samples": samples,
         "calibration": {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()},
     }
-    files = results.finish(trial_rows, samples, payload) if outcomes else []
-    mapped = surveyed[0]
     if mapped is not None:
         payload["map"] = _map_results(mapped, loaded, log_dir)
-        outcomes += [o for o in mapped.outcomes if o is not None]
+    files = results.finish(trial_rows, samples, payload) if outcomes else []
     if args.json:
         print(json.dumps(payload, indent=2))
     else:
@@ -217,7 +227,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _map_results(mapped: SurveyResult, loaded: LoadedBench, log_dir: Path) -> dict[str, Any]:
-    """The map's files in the session folder; its payload without the probes' trials."""
+    """The map's files in the session folder (``map.json``, ``.mcap``, ``.png``); its payload."""
     from palpate.reports.mapresults import write_map_results
 
     m = loaded.bench.map
@@ -253,6 +263,13 @@ def _print_summary(
             + ", ".join(f"{s[v]} {v}" for v in STATUSES)
             + f"); the paper's estimate's mean {_kpa(s['paper_mean_kpa'])} kPa"
         )
+        if s["pooled_kpa"] is not None:
+            why = f": {s['pooled_reasons']}" if s["pooled_reasons"] else ""
+            print(
+                f"  pooled over {s['pooled_trials']} trials: {s['pooled_kpa']:.2f} "
+                f"[{s['pooled_ci_low_kpa']:.2f}, {s['pooled_ci_high_kpa']:.2f}] kPa, "
+                f"{s['pooled_verdict']}{why}"
+            )
     for f in files:
         print(f"results: {f}")
 
@@ -299,41 +316,6 @@ def _dc(obj: Any) -> dict[str, Any]:
     return dataclasses.asdict(obj) if obj is not None else {}
 
 
-def _summaries(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[str, Any]]:
-    """Per sample with a known modulus: mean, RMSE, IQR, relative error (Tables I/II) of the
-    joint fit over the trials whose verdict is ok, and the verdict counts."""
-    by_sample: dict[str, list[BenchOutcome]] = {}
-    for o in outcomes:
-        if o.trial.modulus is not None and o.state != SKIPPED and o.calibration is None:
-            by_sample.setdefault(o.trial.sample, []).append(o)
-    rows = []
-    for name, outs in by_sample.items():
-        actual = outs[0].trial.modulus
-        assert actual is not None
-        kept = [o.modulus() if o.status == "ok" else None for o in outs]
-        s = summarize(kept, actual, outlier_above)
-        paper = summarize([_paper(o) for o in outs], actual, outlier_above)
-        counts: dict[str, int] = {v: sum(1 for o in outs if o.status == v) for v in STATUSES}
-        rows.append(
-            {
-                "sample": name,
-                "trials": len(outs),
-                **counts,
-                "actual_kpa": actual / 1e3,
-                "joint_mean_kpa": _pa_to_kpa(s.mean),
-                "joint_rmse_kpa": _pa_to_kpa(s.rmse),
-                "joint_iqr_kpa": _pa_to_kpa(s.iqr),
-                "joint_relative_error": s.relative_error,
-                "count": s.count,
-                "outliers": s.outliers,
-                "failed": s.failed,
-                "paper_mean_kpa": _pa_to_kpa(paper.mean),
-                "paper_relative_error": paper.relative_error,
-            }
-        )
-    return rows
-
-
 _HEAD = (
     f"{'trial':<28} {'state':<9} {'joint fit kPa [95 % interval]':>30} {'verdict':<8} "
     f"{'paper kPa':>9} {'actual':>9} {'rel.err':>8}  reason"
@@ -373,12 +355,3 @@ def _row(d: dict[str, Any]) -> str:
         f"{d['trial']:<28} {d['state']:<9} {joint:>30} {verdict:<8} "
         f"{_kpa(d['paper_kpa']):>9} {_kpa(d['actual_kpa']):>9} {rel:>8}  {why}"
     )
-
-
-def _paper(o: BenchOutcome) -> float | None:
-    """The paper's single-point estimate (Pa), None without one."""
-    return None if o.estimate is None else o.estimate.modulus
-
-
-def _pa_to_kpa(v: float | None) -> float | None:
-    return None if v is None else v / 1e3

@@ -12,6 +12,7 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from palpate.campaigns.campaign import SampleRow, summarize_campaign
+from palpate.campaigns.pooled import pooled_by_sample, pooled_fields
 from palpate.estimation.verdict import STATUSES
 from palpate.reports import verdicts
 from palpate.simulation.trial import TrialOutcome
@@ -35,6 +36,8 @@ def sample_records(
     tally and the paper's estimate over the same trials."""
     paper = {r.sample: r.summary for r in summarize_campaign(outcomes, outlier_above, "paper")}
     tallies = verdicts.by_sample(outcomes)
+    pooled = pooled_by_sample((o.spec.sample, o) for o in outcomes)
+    truth = {o.spec.sample: o.spec.modulus for o in outcomes}
     records = []
     for r in joint:
         s, p, t = r.summary, paper.get(r.sample), tallies.get(r.sample)
@@ -53,6 +56,7 @@ def sample_records(
                 "trials_with_number": None if t is None else t.numbers,
                 "paper_mean_kpa": None if p is None else _kpa(p.mean),
                 "paper_relative_error": None if p is None else p.relative_error,
+                **pooled_fields(pooled.get(r.sample), truth.get(r.sample)),
             }
         )
     return records
@@ -66,7 +70,9 @@ TITLE = (
     "{name} campaign: Young's modulus (kPa) per sample. joint: the joint fit (E and contact "
     "fitted on the whole record) over the trials whose verdict is ok, outliers > 3 MPa removed; "
     "paper: the paper's single-point estimate (Eqs. 13-14) over the same sample's trials; "
-    "ok/sus/none: verdicts; cover: 95 % intervals holding the truth / trials with a number"
+    "ok/sus/none: verdicts; cover: 95 % intervals holding the truth / trials with a number; "
+    "pooled: every trial of the sample fitted together (one modulus, each trial's own contact), "
+    "with its interval and verdict (the pooled belief check)"
 )
 
 
@@ -75,7 +81,7 @@ def print_table(name: str, records: Sequence[dict[str, Any]]) -> None:
     print(TITLE.format(name=name))
     cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("joint", 10), ("actual", 9)]
     cols += [("RMSE", 9), ("IQR", 9), ("rel.err", 8), ("cover", 6), ("paper", 9)]
-    cols += [("rel.err", 8)]
+    cols += [("rel.err", 8), ("pooled [95 % interval]", 26), ("verdict", 8)]
     head = " ".join(f"{c:>{w}}" for c, w in cols)
     print(head)
     print("-" * len(head))
@@ -86,8 +92,19 @@ def print_table(name: str, records: Sequence[dict[str, Any]]) -> None:
             f"{r['sample']:>8} {r['trials']:>6} {counts:>11} {_cell(r['joint_mean_kpa']):>10} "
             f"{_cell(r['actual_kpa']):>9} {_cell(r['joint_rmse_kpa']):>9} "
             f"{_cell(r['joint_iqr_kpa']):>9} {_pct(r['joint_relative_error']):>8} {cover:>6} "
-            f"{_cell(r['paper_mean_kpa']):>9} {_pct(r['paper_relative_error']):>8}"
+            f"{_cell(r['paper_mean_kpa']):>9} {_pct(r['paper_relative_error']):>8} "
+            f"{_pooled(r):>26} {r['pooled_verdict'] or '-':>8}"
         )
+    for r in records:
+        if r["pooled_reasons"]:
+            print(f"{r['sample']}: pooled {r['pooled_verdict']}: {r['pooled_reasons']}")
+
+
+def _pooled(r: dict[str, Any]) -> str:
+    """The pooled estimate and its interval (kPa), or '-'."""
+    if r["pooled_kpa"] is None:
+        return "-"
+    return f"{r['pooled_kpa']:.2f} [{r['pooled_ci_low_kpa']:.1f}, {r['pooled_ci_high_kpa']:.1f}]"
 
 
 def _cell(v: float | None) -> str:

@@ -27,6 +27,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from palpate.campaigns.pooled import POOLED_COLUMNS
+
 TRIALS_CSV, SAMPLES_CSV, RESULTS_JSON = "trials.csv", "samples.csv", "results.json"
 
 # (column, the trial row's key or a function of the row)
@@ -63,6 +65,7 @@ SAMPLE_COLUMNS = (
     "trials_with_number",
     "paper_mean_kpa",
     "paper_relative_error",
+    *POOLED_COLUMNS,
 )
 
 

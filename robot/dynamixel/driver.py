@@ -28,7 +28,6 @@ import logging
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Self, TypeVar
 
@@ -56,20 +55,12 @@ from .replies import (
     hardware_fault,
     status_fault,
 )
+from .roster import Motor, bus_motors
 from .stats import BusStats
 
 R = TypeVar("R")
 CONNECT_PATIENCE_S = 0.5
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class Motor:
-    """A servo on the bus: the name the drive uses, its bus ID and its model."""
-
-    name: str
-    id: int
-    model: str
 
 
 class DynamixelBus:
@@ -127,19 +118,9 @@ class DynamixelBus:
         """The drive's three servos, and the x-y stage's two after them when ``stage`` is
         given; ``port`` overrides ``cfg.port`` (e.g. an emulator's pty), ``packet_handler``
         the SDK's (see :meth:`__init__`)."""
-        motors = [
-            Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
-            Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
-            Motor("translation", cfg.translation.id, cfg.translation.model),
-        ]
-        if stage is not None:
-            motors += [
-                Motor("stage_x", stage.x.id, stage.x.model),
-                Motor("stage_y", stage.y.id, stage.y.model),
-            ]
         return cls(
             cfg.port if port is None else port,
-            motors,
+            bus_motors(cfg, stage),
             baudrate=cfg.baudrate,
             retries=cfg.retries,
             timeout=cfg.timeout,
@@ -324,10 +305,9 @@ class DynamixelBus:
     def _subset(self, names: Sequence[str]) -> list[int]:
         """The bus IDs of ``names`` (made once per subset, not per tick)."""
         key = tuple(names)
-        ids = self._subsets.get(key)
-        if ids is None:
-            ids = self._subsets[key] = [self._motors[n].id for n in key]
-        return ids
+        if key not in self._subsets:
+            self._subsets[key] = [self._motors[n].id for n in key]
+        return self._subsets[key]
 
     def _sync_read_state(self, ids: list[int]) -> tuple[dict[int, tuple[list[int], int]], int, int]:
         """One attempt of :meth:`read_state`: the sync read and every servo's reply, by ID."""

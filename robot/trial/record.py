@@ -65,7 +65,9 @@ def joint_record(fit: JointFit | None) -> dict[str, Any]:
     """The joint fit as it goes into the log's estimate record and ``--json``."""
     if fit is None:
         return {"success": False, "message": "no loading record"}
-    return fit.as_dict()
+    if fit.terms is None:
+        return fit.as_dict()
+    return {**fit.as_dict(), "pooling": fit.terms.as_dict()}  # its share of a per-sample fit
 
 
 def estimate_record(estimate: TrialEstimate) -> dict[str, Any]:

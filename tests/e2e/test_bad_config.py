@@ -14,7 +14,8 @@ import serial
 
 from palpate.cli import main
 from palpate.config import resolve
-from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.dynamixel.roster import Motor
 from palpate.robot.motors import ServoTransportError
 from palpate.sensor.ports import open_failure
 from palpate.sensor.reader import FrameReader, SensorPortError

@@ -16,7 +16,8 @@ import dynamixel_sdk as sdk
 import pytest
 
 from palpate.config.schema import ServoBusConfig, ServoConfig
-from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.dynamixel.driver import DynamixelBus
+from palpate.robot.dynamixel.roster import Motor
 from palpate.robot.motors import ServoFaultError, ServoIdentityError, ServoTransportError
 from palpate.sensor.ports import Backoff
 from palpate.sim.clock import VirtualClock

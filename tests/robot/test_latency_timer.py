@@ -11,8 +11,9 @@ from pathlib import Path
 import pytest
 
 from palpate.config.schema import ServoBusConfig
-from palpate.robot.dynamixel.driver import DynamixelBus, Motor
+from palpate.robot.dynamixel.driver import DynamixelBus
 from palpate.robot.dynamixel.latency import latency_timer_ms, latency_timer_path, latency_warning
+from palpate.robot.dynamixel.roster import Motor
 from palpate.sim.clock import VirtualClock
 from palpate.sim.dynamixel.bus import EmulatedBus
 

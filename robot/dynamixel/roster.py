@@ -1,0 +1,32 @@
+"""Which servos a bus carries, by the names the drive and the stage use: the roller-gear drive's
+three, and the x-y stage's two when the robot has one (``stage:`` of the robot file)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...config.schema import ServoBusConfig, XYStageConfig
+
+
+@dataclass(frozen=True)
+class Motor:
+    """A servo on the bus: the name the drive uses, its bus ID and its model."""
+
+    name: str
+    id: int
+    model: str
+
+
+def bus_motors(cfg: ServoBusConfig, stage: XYStageConfig | None = None) -> list[Motor]:
+    """The drive's servos of ``cfg``, then the stage's (``stage_x``, ``stage_y``) if any."""
+    motors = [
+        Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
+        Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
+        Motor("translation", cfg.translation.id, cfg.translation.model),
+    ]
+    if stage is not None:
+        motors += [
+            Motor("stage_x", stage.x.id, stage.x.model),
+            Motor("stage_y", stage.y.id, stage.y.model),
+        ]
+    return motors
