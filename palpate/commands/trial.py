@@ -253,6 +253,14 @@ def _print_summary(
     for line in config_lines(found):
         print(f"calibrated on the rigid reference (store in {robot}): {line}")
     for s in samples:
+        if s["actual_kpa"] is None:
+            print(
+                f"sample {s['sample']} (modulus not given): joint fit mean "
+                f"{_kpa(s['joint_mean_kpa'])} kPa over {s['count']} ok trials; verdicts "
+                + ", ".join(f"{s[v]} {v}" for v in STATUSES)
+            )
+            _print_pooled(s)
+            continue
         rel = s["joint_relative_error"]
         print(
             f"sample {s['sample']}: joint fit mean {_kpa(s['joint_mean_kpa'])} kPa vs "
@@ -263,15 +271,21 @@ def _print_summary(
             + ", ".join(f"{s[v]} {v}" for v in STATUSES)
             + f"); the paper's estimate's mean {_kpa(s['paper_mean_kpa'])} kPa"
         )
-        if s["pooled_kpa"] is not None:
-            why = f": {s['pooled_reasons']}" if s["pooled_reasons"] else ""
-            print(
-                f"  pooled over {s['pooled_trials']} trials: {s['pooled_kpa']:.2f} "
-                f"[{s['pooled_ci_low_kpa']:.2f}, {s['pooled_ci_high_kpa']:.2f}] kPa, "
-                f"{s['pooled_verdict']}{why}"
-            )
+        _print_pooled(s)
     for f in files:
         print(f"results: {f}")
+
+
+def _print_pooled(s: dict[str, Any]) -> None:
+    """The sample's trials pooled, under its line."""
+    if s["pooled_kpa"] is None:
+        return
+    why = f": {s['pooled_reasons']}" if s["pooled_reasons"] else ""
+    print(
+        f"  pooled over {s['pooled_trials']} trials: {s['pooled_kpa']:.2f} "
+        f"[{s['pooled_ci_low_kpa']:.2f}, {s['pooled_ci_high_kpa']:.2f}] kPa, "
+        f"{s['pooled_verdict']}{why}"
+    )
 
 
 def _dry_run(

@@ -16,21 +16,35 @@ from palpate.lab.trial import SKIPPED, BenchOutcome
 
 
 def bench_samples(outcomes: list[BenchOutcome], outlier_above: float) -> list[dict[str, Any]]:
-    """Per sample with a known modulus: mean, RMSE, IQR, relative error (Tables I/II) of the
-    joint fit over the trials whose verdict is ok, and the verdict counts."""
+    """Per sample: the verdict counts and its trials pooled (one answer per sample); with a
+    known modulus also mean, RMSE, IQR, relative error (Tables I/II) of the joint fit over the
+    trials whose verdict is ok; without one the mean of those."""
     by_sample: dict[str, list[BenchOutcome]] = {}
     for o in outcomes:
-        if o.trial.modulus is not None and o.state != SKIPPED and o.calibration is None:
+        if o.state != SKIPPED and o.calibration is None:
             by_sample.setdefault(o.trial.sample, []).append(o)
     pooled = pooled_by_sample((o.trial.sample, o) for outs in by_sample.values() for o in outs)
     rows = []
     for name, outs in by_sample.items():
         actual = outs[0].trial.modulus
-        assert actual is not None
+        counts: dict[str, int] = {v: sum(1 for o in outs if o.status == v) for v in STATUSES}
+        if actual is None:
+            ok = [m for o in outs if o.status == "ok" and (m := o.modulus()) is not None]
+            rows.append(
+                {
+                    "sample": name,
+                    "trials": len(outs),
+                    **counts,
+                    "actual_kpa": None,
+                    "joint_mean_kpa": _pa_to_kpa(sum(ok) / len(ok)) if ok else None,
+                    "count": len(ok),
+                    **pooled_fields(pooled.get(name), None),
+                }
+            )
+            continue
         kept = [o.modulus() if o.status == "ok" else None for o in outs]
         s = summarize(kept, actual, outlier_above)
         paper = summarize([_paper(o) for o in outs], actual, outlier_above)
-        counts: dict[str, int] = {v: sum(1 for o in outs if o.status == v) for v in STATUSES}
         rows.append(
             {
                 "sample": name,

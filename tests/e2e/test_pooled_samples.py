@@ -31,3 +31,26 @@ def test_the_bench_campaign_pools_a_samples_five_lengths(
         (row,) = list(csv.DictReader(fh))
     assert float(row["pooled_kpa"]) == pytest.approx(s1["pooled_kpa"])
     assert row["pooled_verdict"] == "ok"
+
+
+def test_a_bench_sample_without_a_stated_modulus_gets_its_pooled_answer(tmp_path: Path) -> None:
+    """On the bench the modulus is what a lab wants to learn: a sample pressed twice with no
+    ``modulus_kpa`` still gets its row, its trials pooled (the emulators on a virtual clock)."""
+    from palpate.config.bench import load_bench
+    from palpate.lab.trial import plan_bench_trials
+    from palpate.reports.benchsamples import bench_samples
+    from palpate.sim.clock import VirtualClock
+    from tests.e2e.test_trial_cli import bench_file, run_on, simulated
+
+    trials = "  - {target: down, sample: S8}\n  - {target: down, sample: S8}\n"
+    loaded = load_bench(bench_file(tmp_path, trials))
+    assert len(plan_bench_trials(loaded)) == 2
+    clock = VirtualClock()
+    with simulated(loaded, clock) as sim:
+        outcomes = run_on(sim, loaded, clock, tmp_path / "logs")
+    (row,) = bench_samples(outcomes, outlier_above=3e6)
+    assert row["sample"] == "S8"
+    assert row["actual_kpa"] is None
+    assert row["pooled_trials"] == 2
+    assert row["pooled_kpa"] == pytest.approx(314.53, rel=0.05)  # S8 in the twin's world
+    assert row["pooled_ci_low_kpa"] <= row["pooled_kpa"] <= row["pooled_ci_high_kpa"]
