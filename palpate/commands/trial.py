@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from palpate.calibration import calibrate, config_lines
+from palpate.commands.benchsamples import bench_samples
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.estimation.verdict import STATUSES
 from palpate.lab.hardware import open_hardware, port_problem, run_on_hardware
@@ -29,7 +30,6 @@ from palpate.lab.trial import (
     run_bench_trials,
 )
 from palpate.live import add_live_argument, live_view
-from palpate.reports.benchsamples import bench_samples
 from palpate.reports.results import CampaignResults
 from palpate.sensor.clock import Clock
 from palpate.sensor.reader import SerialLike
@@ -100,7 +100,7 @@ def run_map_session(
     live: int | None = None,
 ) -> tuple[list[BenchOutcome], SurveyResult | None]:
     """:func:`run_session`, then, with a ``survey`` (the trial each probe repeats,
-    ``palpate.lab.survey.plan_bench_map``), the bench file's map on the x-y stage with the
+    ``palpate.commands.benchmap.plan_bench_map``), the bench file's map on the x-y stage with the
     compliance the trials calibrated: the trials' outcomes and the map (None without one, or
     when a trial before it ended the session)."""
     key = str(loaded.path)
@@ -128,7 +128,7 @@ def run_map_session(
         )
         if survey is None or any(o.state == SKIPPED for o in outcomes):
             return outcomes, None
-        from palpate.lab.survey import run_bench_map
+        from palpate.commands.benchmap import run_bench_map
 
         result = run_bench_map(
             hw,
