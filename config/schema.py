@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
 
 from .drive import DriveConfig
 from .loader import limits
 from .optics import MM, NM, PM, UE, FbgConfig, TipGratingConfig
-from .xystage import AxisServo, XYStageConfig
+from .servo import ServoConfig
+from .xystage import XYStageConfig
 
 __all__ = [
     "DEFAULT_CONTROL_RATE_HZ",
@@ -23,7 +23,6 @@ __all__ = [
     "NM",
     "PM",
     "UE",
-    "AxisServo",
     "BoardConfig",
     "CalibrationConfig",
     "DriveConfig",
@@ -149,14 +148,6 @@ class BoardConfig:
 
 
 @dataclass(frozen=True)
-class ServoConfig:
-    """One Dynamixel servo: its bus ID and model (checked against the model number on connect)."""
-
-    id: int = field(default=1, metadata=limits(ge=0, le=252))
-    model: Literal["XM430-W350", "XL430-W250"] = "XM430-W350"
-
-
-@dataclass(frozen=True)
 class ServoBusConfig:
     """The Dynamixel bus: port, baud rate, and the three servos of the roller-gear drive.
 
@@ -174,9 +165,9 @@ class ServoBusConfig:
     retries: int = field(default=3, metadata=limits(ge=0, le=20))
     silence_ms: float = field(default=250.0, metadata=limits(gt=0, le=10000))
     max_goal_step_deg: float = field(default=10.0, metadata=limits(gt=0, le=360))
-    outer_roll: ServoConfig = ServoConfig(id=1)
-    inner_roll: ServoConfig = ServoConfig(id=2)
-    translation: ServoConfig = ServoConfig(id=3, model="XL430-W250")
+    outer_roll: ServoConfig = ServoConfig(id=1)  # noqa: RUF009 - frozen
+    inner_roll: ServoConfig = ServoConfig(id=2)  # noqa: RUF009 - frozen
+    translation: ServoConfig = ServoConfig(id=3, model="XL430-W250")  # noqa: RUF009 - frozen
 
     def validate(self) -> None:
         ids = [self.outer_roll.id, self.inner_roll.id, self.translation.id]

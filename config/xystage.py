@@ -18,18 +18,10 @@ sample's single-trial point (where the tip presses at the stage's home, ``(0, 0)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
 
 from .loader import limits
 from .optics import MM
-
-
-@dataclass(frozen=True)
-class AxisServo:
-    """One stage axis's servo: its bus ID and model."""
-
-    id: int = field(default=4, metadata=limits(ge=0, le=252))
-    model: Literal["XM430-W350", "XL430-W250"] = "XL430-W250"
+from .servo import ServoConfig
 
 
 @dataclass(frozen=True)
@@ -39,8 +31,8 @@ class XYStageConfig:
     acceleration, the home pose the stage is in at power-up (software homing, as the drive's),
     and how close to a goal counts as arrived."""
 
-    x: AxisServo = AxisServo(id=4)
-    y: AxisServo = AxisServo(id=5)
+    x: ServoConfig = ServoConfig(id=4, model="XL430-W250")  # noqa: RUF009 - frozen
+    y: ServoConfig = ServoConfig(id=5, model="XL430-W250")  # noqa: RUF009 - frozen
     lead_mm_per_rev: float = field(default=2.0, metadata=limits(gt=0, le=100))
     x_travel_mm: tuple[float, float] = (-15.0, 15.0)
     y_travel_mm: tuple[float, float] = (-15.0, 15.0)

@@ -57,32 +57,13 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 
 def run_session(
-    loaded: LoadedBench,
-    trials: list[BenchTrial],
-    log_dir: Path,
-    *,
-    servo_port: str | Any | None = None,
-    board_port: str | SerialLike | None = None,
-    clock: Clock | None = None,
-    sync_to_clock: bool = False,
-    progress: Callable[[BenchOutcome], None] | None = None,
-    live: int | None = None,
+    loaded: LoadedBench, trials: list[BenchTrial], log_dir: Path, **options: Any
 ) -> list[BenchOutcome]:
     """Open the bench (ports from the file unless given) and run ``trials``; torque is off and
-    the ports closed on return, whatever happened. Tests pass the emulators' ptys and a
-    virtual clock (with ``sync_to_clock``). ``live``: the live view's port (``--live``)."""
-    outcomes, _ = run_map_session(
-        loaded,
-        trials,
-        None,
-        log_dir,
-        servo_port=servo_port,
-        board_port=board_port,
-        clock=clock,
-        sync_to_clock=sync_to_clock,
-        progress=progress,
-        live=live,
-    )
+    the ports closed on return, whatever happened: :func:`run_map_session` without a map
+    (``options``: its keywords). Tests pass the emulators' ptys and a virtual clock (with
+    ``sync_to_clock``)."""
+    outcomes, _ = run_map_session(loaded, trials, None, log_dir, **options)
     return outcomes
 
 
@@ -99,7 +80,9 @@ def run_map_session(
     progress: Callable[[BenchOutcome], None] | None = None,
     live: int | None = None,
 ) -> tuple[list[BenchOutcome], SurveyResult | None]:
-    """:func:`run_session`, then, with a ``survey`` (the trial each probe repeats,
+    """Open the bench (ports from the file unless given: the emulators' ptys in tests, with a
+    virtual clock and ``sync_to_clock``; ``live``: the live view's port, ``--live``), run
+    ``trials``, then, with a ``survey`` (the trial each probe repeats,
     ``palpate.commands.benchmap.plan_bench_map``), the bench file's map on the x-y stage with the
     compliance the trials calibrated: the trials' outcomes and the map (None without one, or
     when a trial before it ended the session)."""

@@ -4,7 +4,9 @@ survey probe by probe, the stage sliding the sample between trials, on a virtual
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -13,6 +15,7 @@ from palpate.commands.trial import run_map_session
 from palpate.config import ConfigError, load, resolve
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.config.scene import SceneConfig
+from palpate.lab.hardware import Hardware, open_hardware
 from palpate.lab.plan import plan_bench_map, plan_session
 from palpate.robot.xystage import STAGE_SERVOS, StageMoveError
 from palpate.sim.clock import VirtualClock
@@ -40,6 +43,21 @@ def bench_map(tmp_path: Path, map_keys: str, robot: str = ROBOT) -> LoadedBench:
     path = tmp_path / "bench.yaml"
     path.write_text(head + f"map: {{target: map-downward, {map_keys}}}\n", encoding="utf-8")
     return load_bench(path)
+
+
+@contextlib.contextmanager
+def stage_bench(loaded: LoadedBench, *, wire: bool) -> Iterator[tuple[SimulatedBench, Hardware]]:
+    """The map scene's emulated bench (its stage on the bus) opened as the hardware is, on a
+    virtual clock (``hw.clock``)."""
+    clock = VirtualClock()
+    stations = stations_for(MAP_SCENE, loaded)
+    with (
+        SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=wire, stations=stations) as sim,
+        open_hardware(
+            loaded.stack, servo_port=sim.servo_port, board_port=sim.board_port, clock=clock
+        ) as hw,
+    ):
+        yield sim, hw
 
 
 def test_robot_stage_yaml_loads_with_the_stage_on_the_bus() -> None:
@@ -108,17 +126,9 @@ def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(tmp_path: Path) 
 
 def test_the_stage_will_not_move_while_the_sensor_is_out(tmp_path: Path) -> None:
     """A stage move asked with the sensor away from its retract pose raises and holds."""
-    from palpate.lab.hardware import open_hardware
-
     loaded = bench_map(tmp_path, "patch_mm: [-5, -5, 5, 5]")
-    clock = VirtualClock()
-    stations = stations_for(MAP_SCENE, loaded)
-    with (
-        SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=True, stations=stations) as sim,
-        open_hardware(
-            loaded.stack, servo_port=sim.servo_port, board_port=sim.board_port, clock=clock
-        ) as hw,
-    ):
+    with stage_bench(loaded, wire=True) as (sim, hw):
+        clock = hw.clock
         assert hw.stage is not None
         before = hw.stage.read()
         with pytest.raises(StageMoveError, match="not back"):
@@ -133,7 +143,6 @@ def test_the_stage_will_not_move_while_the_sensor_is_out(tmp_path: Path) -> None
 def test_teleop_jogs_the_stage_step_by_step_within_its_travel(tmp_path: Path) -> None:
     """The jog's goal moves a step a key, clamps at the travel's end, holds while the tip is
     not free; the stage follows it one clamped goal per tick over the bus."""
-    from palpate.lab.hardware import open_hardware
     from palpate.robot.teleop.stagejog import StageJog
 
     loaded = bench_map(tmp_path, "patch_mm: [-5, -5, 5, 5]")
@@ -151,14 +160,8 @@ def test_teleop_jogs_the_stage_step_by_step_within_its_travel(tmp_path: Path) ->
         jog.press("x", step=5e-3, free=True)
     assert jog.goal[0] == pytest.approx(15e-3)
     assert "end of its travel" in jog.message
-    clock = VirtualClock()
-    stations = stations_for(MAP_SCENE, loaded)
-    with (
-        SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=False, stations=stations) as sim,
-        open_hardware(
-            loaded.stack, servo_port=sim.servo_port, board_port=sim.board_port, clock=clock
-        ) as hw,
-    ):
+    with stage_bench(loaded, wire=False) as (_, hw):
+        clock = hw.clock
         assert hw.stage is not None
         sent = [hw.stage.follow((2e-3, -1e-3))]
         assert sent[0][0] < 2e-3  # one tick: the bus's step clamp (10 deg of shaft)
