@@ -284,3 +284,43 @@ def test_the_default_simulator_shows_contact_and_strains(tmp_path: Path) -> None
         term.wait_for("palpate exited 0", "torque off")
     finally:
         term.close()
+
+
+@needs_tmux
+def test_the_x_y_stage_jogs_from_the_keyboard(tmp_path: Path) -> None:
+    """A robot with an x-y stage (``stage:``): x and Y move its goal a step each, the stage's
+    servos follow on the bus, the screen shows where it is."""
+    data = yaml.safe_load(patient_robot(tmp_path / "plain.yaml").read_text(encoding="utf-8"))
+    data["stage"] = yaml.safe_load(resolve("robot-stage.yaml").read_text(encoding="utf-8"))["stage"]
+    robot = tmp_path / "robot.yaml"
+    robot.write_text(yaml.safe_dump(data), encoding="utf-8")
+    stack = load_stack(robot)
+    assert stack.stage is not None
+    scene = load(SceneConfig, resolve("scenes/robot.yaml"))
+    with SimulatedBench(stack, scene, wire=True) as sim:
+        argv = [
+            sys.executable,
+            "-m",
+            "palpate.cli",
+            "teleop",
+            "--servo-port",
+            sim.servo_port,
+            "--board-port",
+            sim.board_port,
+            "--targets",
+            str(tmp_path / "targets.yaml"),
+            "--robot",
+            str(robot),
+        ]
+        term = Terminal(tmp_path / "tmux.sock", shell_command(argv))
+        try:
+            term.wait_for(r"state\s+IDLE", r"stage\s+x\s+\+0\.00\s+y\s+\+0\.00 mm")
+            term.keys("x", "x", "Y")  # 1 mm steps: +2 mm in x, -1 mm in y
+            term.wait_for(r"stage\s+x\s+\+2\.00\s+y\s+-1\.00 mm\s+goal \+2\.00, -1\.00 mm")
+            per_mm = TICKS_PER_REV / stack.stage.lead_mm_per_rev
+            assert abs(sim.servo("stage_x").position_ticks - 2 * per_mm) <= 3
+            assert abs(sim.servo("stage_y").position_ticks + 1 * per_mm) <= 3
+            term.keys("q")
+            term.wait_for("palpate exited 0")
+        finally:
+            term.close()
