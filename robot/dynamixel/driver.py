@@ -56,7 +56,7 @@ from .replies import (
     status_fault,
 )
 from .roster import Motor, bus_motors
-from .stats import BusStats
+from .stats import GOALS_WRITE, BusStats
 
 R = TypeVar("R")
 CONNECT_PATIENCE_S = 0.5
@@ -343,7 +343,7 @@ class DynamixelBus:
             result = self._ph.syncWriteTxOnly(self._port, GOAL_ADDR, GOAL_LEN, param, len(param))
             return None, result, 0
 
-        self._transact("sync write of goals", call, servo_id=None)
+        self._transact(GOALS_WRITE, call, servo_id=None)
         self._last_goals.update(sent)
         return sent
 
@@ -383,7 +383,7 @@ class DynamixelBus:
                     self._raise_for_status(servo_id, error)
                 return value
             self._port.is_using = False  # the SDK leaves it set after some failures
-        stats.failures += 1
+        stats.failed(what)
         if self.recovery.lost:
             name = self._port.getPortName()
             lost = self.recovery.lost

@@ -32,7 +32,8 @@ def test_the_rehearsal_completes_with_a_joint_fit_beside_a_cpu_load(tmp_path: Pa
         assert low <= trial["joint_kpa"] <= high
         bus = trial["bus"]
         assert bus["transactions"] > 1000  # the servos answered the whole trial
-        assert bus["failures"] <= bus["missed_reads"]  # no failed read went unhandled
+        reads_failed = bus["failures"] - bus["write_failures"]  # a failed write holds its goal
+        assert reads_failed <= bus["missed_reads"]  # no failed read went unhandled
         log = read_log(Path(trial["log"]))
         assert log.complete
         assert not log.problems
