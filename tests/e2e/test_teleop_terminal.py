@@ -115,23 +115,27 @@ def bench() -> Iterator[SimulatedBench]:
         yield sim
 
 
-@pytest.fixture
-def terminal(tmp_path: Path, bench: SimulatedBench) -> Iterator[Terminal]:
-    targets = tmp_path / "targets.yaml"
-    argv = [
+def teleop_argv(sim: SimulatedBench, targets: Path, robot: Path) -> list[str]:
+    """``palpate teleop`` on the simulated bench's ports, saving to ``targets``."""
+    return [
         sys.executable,
         "-m",
         "palpate.cli",
         "teleop",
         "--servo-port",
-        bench.servo_port,
+        sim.servo_port,
         "--board-port",
-        bench.board_port,
+        sim.board_port,
         "--targets",
         str(targets),
         "--robot",
-        str(patient_robot(tmp_path / "robot.yaml")),
+        str(robot),
     ]
+
+
+@pytest.fixture
+def terminal(tmp_path: Path, bench: SimulatedBench) -> Iterator[Terminal]:
+    argv = teleop_argv(bench, tmp_path / "targets.yaml", patient_robot(tmp_path / "robot.yaml"))
     term = Terminal(tmp_path / "tmux.sock", shell_command(argv))
     try:
         yield term
@@ -298,20 +302,7 @@ def test_the_x_y_stage_jogs_from_the_keyboard(tmp_path: Path) -> None:
     assert stack.stage is not None
     scene = load(SceneConfig, resolve("scenes/robot.yaml"))
     with SimulatedBench(stack, scene, wire=True) as sim:
-        argv = [
-            sys.executable,
-            "-m",
-            "palpate.cli",
-            "teleop",
-            "--servo-port",
-            sim.servo_port,
-            "--board-port",
-            sim.board_port,
-            "--targets",
-            str(tmp_path / "targets.yaml"),
-            "--robot",
-            str(robot),
-        ]
+        argv = teleop_argv(sim, tmp_path / "targets.yaml", robot)
         term = Terminal(tmp_path / "tmux.sock", shell_command(argv))
         try:
             term.wait_for(r"state\s+IDLE", r"stage\s+x\s+\+0\.00\s+y\s+\+0\.00 mm")
