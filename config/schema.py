@@ -36,6 +36,7 @@ __all__ = [
     "XYStageConfig",
     "check_compliance",
     "compliance_range",
+    "servo_roster",
 ]
 
 GPA = 1e9
@@ -187,6 +188,19 @@ class ServoBusConfig:
     def max_goal_step(self) -> float:
         """Largest change of a servo goal per control tick, rad of servo shaft."""
         return math.radians(self.max_goal_step_deg)
+
+
+def servo_roster(servos: ServoBusConfig, stage: XYStageConfig | None) -> dict[str, ServoConfig]:
+    """Every servo on the bus by the name the drive and the stage use, in bus order: the
+    roller-gear drive's three, then the x-y stage's two when the robot has one."""
+    roster = {
+        "outer_roll": servos.outer_roll,
+        "inner_roll": servos.inner_roll,
+        "translation": servos.translation,
+    }
+    if stage is not None:
+        roster |= {"stage_x": stage.x, "stage_y": stage.y}
+    return roster
 
 
 @dataclass(frozen=True)

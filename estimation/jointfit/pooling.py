@@ -150,7 +150,7 @@ def pool(terms: Sequence[Terms], confidence: float = 0.95) -> PooledFit:
         lows.append(float(inside.min()))
         highs.append(float(inside.max()))
     eps = max(t.model_form for t in terms)
-    lo, hi = widened(E_hat, min(*lows, E_HAT_GUARD * E_hat), max(*highs, E_hat), eps)
+    lo, hi = widened(E_hat, min(*lows, E_hat), max(*highs, E_hat), eps)  # holds the estimate
     alts = {k: v for k, v in totals.items() if k not in (STATED, FORM)}
     gains = {k: float(stated.min() - v.min()) for k, v in alts.items()}
     # an alternative contradicts the belief when the record prefers it beyond the margin and
@@ -165,9 +165,6 @@ def pool(terms: Sequence[Terms], confidence: float = 0.95) -> PooledFit:
             f"{gains[k]:.0f}, and {moved[k] / 1e3:.4g} kPa under it (outside the interval)"
         )
     return PooledFit(len(terms), E_hat, lo, hi, contradiction, gains)
-
-
-E_HAT_GUARD = 1.0  # the interval always holds the estimate
 
 
 def _totals(terms: Sequence[Terms], moduli: FloatArray) -> dict[str, FloatArray]:

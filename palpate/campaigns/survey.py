@@ -31,6 +31,7 @@ from palpate.campaigns.surveyloop import (
     SurveyResult,
     Truth,
     map_of,
+    probe_name,
     publish_map,
     read_probes,
     run_plan,
@@ -93,7 +94,7 @@ def probe_spec(
     """The k-th probe's trial: the bench column at the campaign's first exposed length."""
     length = scene.campaign.exposed_lengths[0]
     return TrialSpec(
-        trial_id=f"p{k:03d}-x{point[0] / MM:+.2f}-y{point[1] / MM:+.2f}",
+        trial_id=probe_name(k, point),
         kind="bench",
         sample=sample.name,
         modulus=sample.modulus,

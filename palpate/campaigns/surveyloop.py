@@ -48,6 +48,11 @@ Point = tuple[float, float]
 ProbeAt = Callable[[list[Probe], Point], tuple[Probe, Any]]
 
 
+def probe_name(k: int, point: Point) -> str:
+    """The k-th probe's trial name, with its point (m) in mm: ``p007-x+3.33-y-3.33``."""
+    return f"p{k:03d}-x{point[0] / MM:+.2f}-y{point[1] / MM:+.2f}"
+
+
 class SurveyStopped(Exception):  # noqa: N818 - an ending, not an error
     """A probe's trial ended the survey (a fault: the robot stopped and retracted): the probe
     as recorded, the trial's outcome, and why."""

@@ -25,6 +25,7 @@ from palpate.campaigns.surveyloop import (
     SurveyPlan,
     SurveyResult,
     SurveyStopped,
+    probe_name,
     run_plan,
 )
 from palpate.config.bench import LoadedBench
@@ -42,8 +43,7 @@ CLEAR_MARGIN = 0.5 * MM  # the sensor counts as back within this of the retract 
 
 def probe_trial(template: BenchTrial, k: int, point: Point) -> BenchTrial:
     """The k-th probe's trial (1-based) at ``point`` (m): the template renamed."""
-    name = f"p{k:03d}-x{point[0] / MM:+.2f}-y{point[1] / MM:+.2f}"
-    return dataclasses.replace(template, trial_id=name)
+    return dataclasses.replace(template, trial_id=probe_name(k, point))
 
 
 def run_bench_map(

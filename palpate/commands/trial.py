@@ -153,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
             print(_row(o.as_dict()), flush=True)
 
     if not quiet:
-        then = describe_map(loaded, survey)
+        then = f", then {describe_map(loaded, survey)}" if survey is not None else ""
         print(f"{len(trials)} trial(s) from {loaded.path}{then}; logs in {log_dir}")
         print(_HEAD)
     outcomes: list[BenchOutcome] = []
@@ -274,7 +274,7 @@ def _print_pooled(s: dict[str, Any]) -> None:
 def _dry_run(
     loaded: LoadedBench, trials: list[BenchTrial], as_json: bool, survey: BenchTrial | None
 ) -> int:
-    stack = loaded.stack
+    stack, m = loaded.stack, loaded.bench.map
     ports = {
         "servos": (stack.servos.port, port_problem(stack.servos.port, "servo bus", "servos.port")),
         "board": (
@@ -288,7 +288,9 @@ def _dry_run(
             "targets": str(loaded.targets_path),
             "ports": {k: {"port": p, "problem": why} for k, (p, why) in ports.items()},
             "trials": [t.describe() for t in trials],
-            "map": None if survey is None else {**_dc(loaded.bench.map), **survey.describe()},
+            "map": None
+            if m is None or survey is None
+            else {**dataclasses.asdict(m), **survey.describe()},
         }
         print(json.dumps(payload, indent=2))
         return 0
@@ -304,13 +306,9 @@ def _dry_run(
             f"retract to {d['retract_translation_mm']:.3f} mm"
         )
     if survey is not None:
-        print(f"  then{describe_map(loaded, survey)[len(', then') :]}")
+        print(f"  then {describe_map(loaded, survey)}")
     print("dry run: no port opened, nothing moved")
     return 0
-
-
-def _dc(obj: Any) -> dict[str, Any]:
-    return dataclasses.asdict(obj) if obj is not None else {}
 
 
 _HEAD = (

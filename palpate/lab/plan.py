@@ -225,12 +225,12 @@ def plan_session(
 
 
 def describe_map(loaded: LoadedBench, survey: BenchTrial | None) -> str:
-    """ ", then a map at ..." for the session's first line; empty without a map."""
+    """ "a map at ... of the x-y stage" for the session's lines; empty without a map."""
     m = loaded.bench.map
     if survey is None or m is None:
         return ""
     x0, y0, x1, y1 = m.patch_mm
     return (
-        f", then a map at {m.target} ({m.strategy}, at most {m.max_probes} probes over "
+        f"a map at {m.target} ({m.strategy}, at most {m.max_probes} probes over "
         f"x {x0:+g}..{x1:+g}, y {y0:+g}..{y1:+g} mm of the x-y stage)"
     )

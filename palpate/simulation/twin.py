@@ -31,13 +31,13 @@ from palpate.config.bench import LoadedBench
 from palpate.config.loader import ConfigError, InputError
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
-from palpate.config.schema import MM, StackConfig, TubeConfig
+from palpate.config.schema import MM, StackConfig, TubeConfig, servo_roster
 from palpate.config.targets import load_targets
 from palpate.robot import kinematics
-from palpate.robot.drive import INNER_ROLL, OUTER_ROLL, SERVOS, TRANSLATION, RollerGearDrive
+from palpate.robot.drive import SERVOS, TRANSLATION, RollerGearDrive
 from palpate.robot.dynamixel.units import rad_from_ticks
 from palpate.robot.trial.setup import sensor_section
-from palpate.robot.xystage import STAGE_SERVOS, STAGE_X, STAGE_Y, XYAxes
+from palpate.robot.xystage import STAGE_SERVOS, XYAxes
 from palpate.sensor.parser import layout_from_config
 from palpate.sim.board import BoardEmulator, BoardSample
 from palpate.sim.clock import VirtualClock
@@ -150,15 +150,9 @@ class SimulatedBench:
         self._section = sensor_section(stack)
         self._rng = np.random.default_rng(seed)
         self._truth = RollerGearDrive(stack.drive)  # the servos power up at the home pose
-        self._ids = {
-            OUTER_ROLL: stack.servos.outer_roll.id,
-            INNER_ROLL: stack.servos.inner_roll.id,
-            TRANSLATION: stack.servos.translation.id,
-        }
+        self._ids = {n: s.id for n, s in servo_roster(stack.servos, stack.stage).items()}
         self.bus = EmulatedBus.from_config(stack.servos, clock=clock, stage=stack.stage)
         self._stage = None if stack.stage is None else XYAxes(stack.stage)  # home at power-up
-        if stack.stage is not None:
-            self._ids.update({STAGE_X: stack.stage.x.id, STAGE_Y: stack.stage.y.id})
         self.at = self._stage_at()  # the point of the sample under the tip (m)
         self._world = self._new_world()
         self._touched = False

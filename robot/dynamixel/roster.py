@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ...config.schema import ServoBusConfig, XYStageConfig
+from ...config.schema import ServoBusConfig, XYStageConfig, servo_roster
 
 
 @dataclass(frozen=True)
@@ -19,14 +19,4 @@ class Motor:
 
 def bus_motors(cfg: ServoBusConfig, stage: XYStageConfig | None = None) -> list[Motor]:
     """The drive's servos of ``cfg``, then the stage's (``stage_x``, ``stage_y``) if any."""
-    motors = [
-        Motor("outer_roll", cfg.outer_roll.id, cfg.outer_roll.model),
-        Motor("inner_roll", cfg.inner_roll.id, cfg.inner_roll.model),
-        Motor("translation", cfg.translation.id, cfg.translation.model),
-    ]
-    if stage is not None:
-        motors += [
-            Motor("stage_x", stage.x.id, stage.x.model),
-            Motor("stage_y", stage.y.id, stage.y.model),
-        ]
-    return motors
+    return [Motor(name, s.id, s.model) for name, s in servo_roster(cfg, stage).items()]

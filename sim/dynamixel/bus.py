@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable, Iterable
 from typing import Self
 
-from ...config.schema import ServoBusConfig, XYStageConfig
+from ...config.schema import ServoBusConfig, XYStageConfig, servo_roster
 from ...wire import dynamixel as tables
 from ..clock import VirtualClock
 from . import protocol
@@ -81,10 +81,7 @@ class EmulatedBus:
     ) -> Self:
         """The three servos of the roller-gear drive with the IDs and models of ``cfg``, and the
         x-y stage's two when ``stage`` is given."""
-        configs = [cfg.outer_roll, cfg.inner_roll, cfg.translation]
-        if stage is not None:
-            configs += [stage.x, stage.y]
-        servos = [EmulatedServo(s.id, s.model) for s in configs]
+        servos = [EmulatedServo(s.id, s.model) for s in servo_roster(cfg, stage).values()]
         return cls(servos, clock=clock, timing=timing)
 
     # --- the servos --------------------------------------------------------------------------
