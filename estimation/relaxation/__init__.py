@@ -41,18 +41,30 @@ is where more than ``INCOMPLETE`` of the last sample's load is still relaxing (t
 low end then reaches what it would lose). The law's model-form bound and ``SPECTRUM_FORM``
 (a fixed spectrum's misfit of a time constant between its own) widen both intervals.
 
+Beliefs left open (a Poisson ratio's range, an unknown thickness): ``beliefs``
+(:func:`fit_over_beliefs`) fits each hypothesis and takes the envelope of the plausible ones'
+intervals, as the joint fit does.
+
 Failure (no hold, too few points in contact, no finite solution) is a :class:`RelaxationFit`
 with ``success`` False and the reason; bad input raises ValueError.
 
-Layout: ``fit`` (the recipe, :func:`fit_relaxation`), ``spectrum`` (the fixed-time spectrum,
-the memory basis, one x0's non-negative least squares, the intervals), ``result``
+Layout: ``fit`` (the recipe, :func:`fit_relaxation`), ``beliefs`` (over hypotheses),
+``spectrum`` (the fixed-time spectrum, the memory basis, one x0's non-negative least squares,
+the intervals), ``result``
 (:class:`RelaxationFit`, :class:`RelaxationRecord`).
 """
 
 from __future__ import annotations
 
+from .beliefs import fit_over_beliefs
 from .fit import fit_relaxation
 from .result import RelaxationFit, RelaxationRecord
 from .spectrum import memory_basis
 
-__all__ = ["RelaxationFit", "RelaxationRecord", "fit_relaxation", "memory_basis"]
+__all__ = [
+    "RelaxationFit",
+    "RelaxationRecord",
+    "fit_over_beliefs",
+    "fit_relaxation",
+    "memory_basis",
+]

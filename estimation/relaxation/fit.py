@@ -33,6 +33,11 @@ SPECTRUM_FORM = 0.005  # relative: a fixed spectrum's own misfit of a relaxation
 MIN_HOLD_POINTS = 20
 
 
+def chi2_quantile(p: float) -> float:
+    """chi^2(1)'s quantile at probability ``p``."""
+    return float(2.0 * gammaincinv(0.5, p))
+
+
 @dataclass(frozen=True)
 class _Profiles:
     """The contact grid and, on it, the fits with the spectrum reaching past the record
@@ -70,7 +75,7 @@ def fit_relaxation(
     p = _profiles(record, law, modulus, taus, contact)
     floor = p.tail[int(np.argmin([s.rss for s in p.tail]))]
     s2 = scale2(floor, n)
-    q = float(2.0 * gammaincinv(0.5, confidence))  # chi2(1).ppf(confidence)
+    q = chi2_quantile(confidence)
     # relaxation slower than the record: only where the record needs it (chi^2 by q)
     slow_gain = (min(s.rss for s in p.inside) - floor.rss) / s2
     complete = slow_gain <= q
@@ -133,7 +138,26 @@ def _result(
         contact=float(p.grid[best]),
         confidence=confidence,
         warnings=warnings,
+        rss=min(s.rss for s in p.tail),
+        noise_scale=s2,
     )
+
+
+def floor_rss(
+    record: RelaxationRecord,
+    law: ContactLaw,
+    contact: tuple[float, float, float],
+    modulus: float,
+) -> float:
+    """The lowest weighted RSS of ``record`` under ``law`` (the spectrum reaching past the
+    record, profiled over the contact): what :attr:`RelaxationFit.rss` is, without the rest of
+    the fit (the belief check's alternatives need no moduli)."""
+    _check(record, contact, modulus, 0.5)
+    taus = spectrum(record, float(np.max(record.depth_base) - contact[0]), contact[0])
+    if taus.size == 0:
+        return math.inf
+    _, tail = _profile(record, law, modulus, taus, contact)
+    return min(s.rss for s in tail)
 
 
 def _extrapolated(

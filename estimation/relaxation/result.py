@@ -24,6 +24,12 @@ class RelaxationFit:
         delta_chi2: how much better the spectrum fits than the elastic law (noise variances).
         hold: the hold's length (s); n_points: samples fitted; contact: x0 (m).
         warnings: one sentence each.
+        hypotheses: how many of the belief's hypotheses were fitted; plausible: how many of them
+            the record allows (within the chi^2 quantile of the best), whose intervals the
+            moduli's are the envelope of (``estimation.relaxation.beliefs``).
+        rss, noise_scale: the lowest weighted RSS over the contact (the spectrum reaching past
+            the record) and the noise inflation, for comparing hypotheses (not in
+            :meth:`as_dict`).
     """
 
     success: bool
@@ -43,6 +49,10 @@ class RelaxationFit:
     contact: float | None = None
     confidence: float = 0.95
     warnings: tuple[str, ...] = field(default=())
+    hypotheses: int = 1
+    plausible: int = 1
+    rss: float | None = None
+    noise_scale: float | None = None
 
     def covers(self, modulus: float) -> bool:
         """Whether the relaxed modulus's interval holds ``modulus`` (Pa)."""
@@ -68,6 +78,8 @@ class RelaxationFit:
             "contact": self.contact,
             "confidence": self.confidence,
             "warnings": list(self.warnings),
+            "hypotheses": self.hypotheses,
+            "plausible": self.plausible,
         }
 
     def summary(self) -> str:

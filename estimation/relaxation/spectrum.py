@@ -3,6 +3,7 @@ position's non-negative least squares, and the intervals (``estimation.relaxatio
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -68,29 +69,67 @@ def spectrum(record: RelaxationRecord, depth: float, x0: float) -> FloatArray:
     return np.geomspace(lo, hi, n)
 
 
+SCAN_EXPONENT = 600.0  # exp(600) < 1e308: the longest stretch of exp(t/tau) a scan holds
+
+
 def memory_basis(times: FloatArray, shape: FloatArray, taus: FloatArray) -> FloatArray:
     """h_k(t_i) (N, K): the exact recursion of a piecewise-linear ``shape`` in time (the
-    module docstring), at rest before ``times[0]``."""
+    module docstring), at rest before ``times[0]``: ``h_i = exp(-dt_i/tau) h_(i-1) +
+    (1 - exp(-dt_i/tau))/(dt_i/tau) df_i``. A record's steps come in runs of one length (its
+    ticks, then its averaged blocks); within a run of step dt the recursion is the scan
+    ``h_(i0+r) = a^(r+1) h_(i0-1) + a^r sum_(s<=r) a^(-s) g df_(i0+s)``, a = exp(-dt/tau),
+    every time at once, cut where a^(-s) would overflow. Before the shape first moves it is 0.
+    A jittered clock (runs of a few steps) is stepped a row at a time, every time at once."""
     df = np.diff(shape, prepend=0.0)
     dt = np.diff(times, prepend=times[0])
-    out = np.empty((times.size, taus.size))
-    uniform = np.allclose(dt[1:], dt[1], rtol=1e-6) if times.size > 2 else True
-    for k, tau in enumerate(taus):
-        x = dt / tau
+    out = np.zeros((times.size, taus.size))
+    moved = np.flatnonzero(df)
+    if moved.size == 0:
+        return out
+    first = int(moved[0])
+    runs = _equal_steps(dt[first:])
+    if len(runs) > max(8, (dt.size - first) // 8):
+        x = dt[:, None] / taus[None, :]
         decay = np.exp(-x)
-        gain = np.where(x > 0, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0)
-        drive = gain * df
-        if uniform and times.size > 2:
-            # imported here: scipy.signal costs 0.1 s to import, and few trials hold
-            from scipy.signal import lfilter  # type: ignore[import-untyped,unused-ignore]
-
-            out[:, k] = lfilter([1.0], [1.0, -decay[1]], drive)
-            continue
-        h = 0.0
-        for i in range(times.size):
+        drive = np.where(x > 0, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0) * df[:, None]
+        h = np.zeros(taus.size)
+        for i in range(first, dt.size):
             h = decay[i] * h + drive[i]
-            out[i, k] = h
+            out[i] = h
+        return out
+    carried = np.zeros(taus.size)
+    for start, stop in runs:
+        rows = _scan(df[first + start : first + stop], float(dt[first + start]), taus, carried)
+        out[first + start : first + stop] = rows
+        carried = rows[-1]
     return out
+
+
+def _equal_steps(dt: FloatArray) -> list[tuple[int, int]]:
+    """[start, stop) runs of equal steps (to 1e-6); the first step is a run of its own (the
+    record's first sample has none)."""
+    if dt.size <= 2:
+        return [(i, i + 1) for i in range(dt.size)]
+    cut = np.flatnonzero(~np.isclose(dt[2:], dt[1:-1], rtol=1e-6, atol=0.0)) + 2
+    edges = [0, 1, *cut.tolist(), dt.size]
+    return list(itertools.pairwise(edges))
+
+
+def _scan(df: FloatArray, step: float, taus: FloatArray, before: FloatArray) -> FloatArray:
+    """The recursion over a run of equal steps ``step`` (s), every time at once, from the
+    state ``before`` (K,); in stretches short enough that exp(s step/tau) stays finite."""
+    x = step / taus
+    gain = -np.expm1(-x) / x if step > 0 else np.ones_like(taus)
+    length = max(1, int(SCAN_EXPONENT / float(np.max(x)))) if step > 0 else df.size
+    rows = np.empty((df.size, taus.size))
+    h = before
+    for lo in range(0, df.size, length):
+        r = np.arange(min(length, df.size - lo), dtype=np.float64)[:, None]
+        grow = np.exp(r * x)  # a^(-r)
+        summed = np.cumsum(df[lo : lo + r.size, None] * gain * grow, axis=0)
+        rows[lo : lo + r.size] = (h * np.exp(-x) + summed) / grow
+        h = rows[lo + r.size - 1]
+    return rows
 
 
 def solve(

@@ -2,7 +2,9 @@
 
 On the shipped viscoelastic scenes (``config/scenes/viscoelastic/``: gels with a standard
 linear solid, power-law tissue, and the same gels elastic as the control), one exposed length
-(46 mm) and every speed the scene sweeps (0.1, 0.5, 2 mm/s), each hold length of ``HOLDS_S``:
+(46 mm) and every speed the scene sweeps (0.1, 0.5, 2 mm/s), and on the relaxing lung-like
+layers through the lung sensor (``config/scenes/lung/relaxing.yaml``, on the robot: one tube,
+bent30, every orientation), each hold length of ``HOLDS_S``:
 the trials that relax, the relaxed modulus's median and worst |error| (over every trial with a
 number, and over ``ok``), its 95 % interval's coverage, the ``ok`` count, and the time a trial
 costs (simulated: the stage's; wall: the simulator's, on the campaign's workers). ``--quick``:
@@ -25,21 +27,30 @@ from palpate.config.scene import SceneConfig
 from palpate.reports.verdicts import relaxed_tally
 
 HOLDS_S = (0.5, 1.0, 2.0, 5.0, 10.0)
-SCENES = ("gels", "power-law", "elastic-hold")
+SCENES = (
+    "viscoelastic/gels",
+    "viscoelastic/power-law",
+    "viscoelastic/elastic-hold",
+    "lung/relaxing",
+)
+ROBOT_TUBE = "bent30"
 
 
 def hold_scene(base: SceneConfig, hold_s: float, quick: bool) -> SceneConfig:
-    """``base`` at one hold length, one exposed length (46 mm); with ``quick`` two samples and
-    the slowest and fastest speeds."""
+    """``base`` at one hold length, one exposed length (46 mm on the bench; the robot's own,
+    on one tube); with ``quick`` two samples and the slowest and fastest speeds."""
     c = base.campaign
     speeds = c.speeds_mm_per_s()
     campaign = dataclasses.replace(
         c,
         hold_s=hold_s,
-        exposed_lengths_mm=(46.0,),
         indent_speeds_mm_per_s=(speeds[0], speeds[-1]) if quick else speeds,
         samples=tuple(s.name for s in base.samples[:2]) if quick else c.samples,
     )
+    if c.on_tubes:
+        campaign = dataclasses.replace(campaign, tubes=(ROBOT_TUBE,))
+    else:
+        campaign = dataclasses.replace(campaign, exposed_lengths_mm=(46.0,))
     return dataclasses.replace(base, campaign=campaign)
 
 
@@ -77,7 +88,7 @@ def run(ctx: BenchContext) -> BenchSection:
     tables: list[Table] = []
     summary: dict[str, Any] = {}
     for name in SCENES:
-        base = load(SceneConfig, resolve(f"scenes/viscoelastic/{name}.yaml"))
+        base = load(SceneConfig, resolve(f"scenes/{name}.yaml"))
         rows: list[Sequence[Any]] = []
         for hold in HOLDS_S:
             row, summary[f"{name}/{hold:g}"] = hold_row(hold_scene(base, hold, ctx.quick), ctx)
@@ -101,12 +112,19 @@ def run(ctx: BenchContext) -> BenchSection:
                 note=(
                     "|relative error| of the relaxed modulus against the world's (the truth); "
                     "median and worst over every trial with a number, cover: its 95 % interval "
-                    f"holds the truth; L = 46 mm, speeds {scene_speeds(base, ctx.quick)} mm/s, "
-                    f"seed {ctx.seed}; wall time on the campaign's workers"
+                    f"holds the truth; {_where(base)}, speeds {scene_speeds(base, ctx.quick)} "
+                    f"mm/s, seed {ctx.seed}; wall time on the campaign's workers"
                 ),
             )
         )
     return BenchSection(name="hold", tables=tables, summary=summary)
+
+
+def _where(base: SceneConfig) -> str:
+    c = base.campaign
+    if c.on_tubes:
+        return f"L = {c.exposed_length_mm:g} mm on {ROBOT_TUBE}, every orientation"
+    return "L = 46 mm"
 
 
 def scene_speeds(base: SceneConfig, quick: bool) -> str:

@@ -187,7 +187,9 @@ def fit_rows(
     lean = lean_of_rows(rows, stack.sensor, section, inputs)
     relaxation = None
     if times is not None:
-        relaxation = relaxation_of(rows, times, inputs, stack.sensor, section, fitted.joint)
+        relaxation = relaxation_of(
+            rows, times, inputs, stack.sensor, section, fitted.joint, tip_forces
+        )
     return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
 
 

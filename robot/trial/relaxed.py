@@ -3,24 +3,30 @@ record or a log's samples: the same function on ``palpate sim``, ``trial`` and `
 
 The rows from the approach to the end of the hold (state, advance, strains, with each row's
 time) give the beam's load and end shortening (``estimation.beamstate``, the strain noise
-measured on these rows as for the joint fit); the joint fit (which reads the loading rows only,
-so its number is what it is without a hold) gives the contact, the load offset, the best
-hypothesis's contact law and compliance, and its model-form bound. A record without a hold
+measured on these rows as for the joint fit); with a tip force grating the load is the
+grating's, as the joint fit reads it (its noise measured on the same rows,
+``sensor.tipforce.force_sigma``): a light sensor's strains carry its load at a few noise
+widths, the grating at hundreds. The joint fit (which reads the loading rows only,
+so its number is what it is without a hold) gives the contact, the load offset and its
+model-form bound; the relaxation is fitted under every hypothesis of the belief
+(``estimation.relaxation.beliefs``), not at the elastic fit's best, which a relaxing record
+misleads. A record without a hold
 has no relaxation estimate (None): old logs replay as they were.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ...config.schema import SensorConfig
-from ...estimation.belief import Hypothesis
 from ...estimation.jointfit import JointFit
-from ...estimation.relaxation import RelaxationFit, RelaxationRecord, fit_relaxation
+from ...estimation.relaxation import RelaxationFit, RelaxationRecord, fit_over_beliefs
 from ...estimation.section import Section
+from ...sensor.tipforce import force_sigma
 from .inputs import EstimatorInputs
 from .lean import row_in, rows_in
 from .states import LOADING_STATES, record_states
@@ -44,36 +50,39 @@ def relaxation_of(
     sensor: SensorConfig,
     section: Section,
     joint: JointFit | None,
+    tip_forces: Sequence[float | None] | None = None,
 ) -> RelaxationFit | None:
-    """The relaxation fit of a record with a hold (None without one); ``times`` (s) one per row."""
+    """The relaxation fit of a record with a hold (None without one); ``times`` (s) one per row,
+    ``tip_forces`` (N) one per row from a tip grating (None: the load from the strains)."""
     if not has_hold(rows) or inputs.rigid:
         return None
     if len(times) != len(rows):
         raise ValueError(f"{len(times)} times for {len(rows)} rows: one time per row")
     if joint is None or not joint.success or joint.modulus is None or joint.best is None:
         return RelaxationFit(False, "no joint fit to start from")
-    t, advance, strains, counts = _blocks(rows, times, len(sensor.used_gratings))
+    gratings = len(sensor.used_gratings)
+    tips = _tips(rows, tip_forces, gratings)
+    t, advance, strains, counts = _blocks(rows, times, gratings, tips)
     hold_t = [times[i] for i, r in enumerate(rows) if r[0] == HOLD_STATE]
-    _, k = record_states(
-        *rows_in(rows, RECORD_STATES, len(sensor.used_gratings)), inputs, sensor, section
-    )
-    states, _ = record_states(advance, strains, inputs, sensor, section)
+    _, k = record_states(*rows_in(rows, RECORD_STATES, gratings), inputs, sensor, section)
+    states, _ = record_states(advance, strains[:, :gratings], inputs, sensor, section)
     thin = 1.0 / np.sqrt(counts)  # a block's mean has 1/sqrt(n) of a row's noise
-    best = Hypothesis.described(joint.best, inputs.contact_radius, inputs.belief().layer_law)
-    law, compliance = best.law, best.compliance
+    load, sigma_load = states.P, k * thin * states.sigma_P
+    if tips is not None:
+        load, sigma_load = strains[:, gratings], force_sigma(tips[np.isfinite(tips)]) * thin
     record = RelaxationRecord(
         times=t,
-        load=np.asarray(states.P - (joint.load_offset or 0.0)),
-        depth_base=np.asarray(advance - states.e - compliance * states.P),
-        sigma_load=np.asarray(k * thin * states.sigma_P),
+        load=np.asarray(load - (joint.load_offset or 0.0)),
+        depth_base=np.asarray(advance - states.e),
+        sigma_load=np.asarray(sigma_load),
         sigma_depth=np.sqrt((k * thin * states.sigma_e) ** 2 + inputs.encoder_resolution**2 / 12),
         hold=_held(hold_t),
     )
     x0 = float(joint.contact or 0.0)
     contact = (joint.contact_low or x0, x0, joint.contact_high or x0)
-    return fit_relaxation(
+    return fit_over_beliefs(
         record,
-        law,
+        inputs.belief(),
         contact,
         joint.modulus,
         model_form=joint.model_form or 0.0,
@@ -88,11 +97,24 @@ def _held(times: Sequence[float]) -> float:
     return float(times[-1] - times[0] + np.median(np.diff(times)))
 
 
+def _tips(
+    rows: Sequence[Row], tip_forces: Sequence[float | None] | None, gratings: int
+) -> FloatArray | None:
+    """The tip grating's load (N) of every row (NaN where a row has none), None without a
+    grating or where a row of the record has no finite load."""
+    if not tip_forces or len(tip_forces) != len(rows):
+        return None
+    tips = np.array([math.nan if f is None else float(f) for f in tip_forces])
+    picked = [row_in(*r, RECORD_STATES, gratings) for r in rows]
+    return tips if np.all(np.isfinite(tips[picked])) else None
+
+
 def _blocks(
-    rows: Sequence[Row], times: Sequence[float], gratings: int
+    rows: Sequence[Row], times: Sequence[float], gratings: int, tips: FloatArray | None = None
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """(times, advance, strains, rows per block) of the record: the loading rows one by one,
-    the buckled and held rows averaged ``BLOCK`` at a time. Past buckling the load is nearly
+    the buckled and held rows averaged ``BLOCK`` at a time (with ``tips``, the tip load is the
+    strains' last column, averaged alike). Past buckling the load is nearly
     constant and the creep slow, while the end shortening read from the strains is noisy; a
     depth that noisy, regressed on, pulls the fit (errors in variables: the noise of e is also
     squared into e = z^2 L). Averaging the strains before the beam states are inferred takes
@@ -107,7 +129,10 @@ def _blocks(
         if block:
             out_t.append(float(np.mean([times[i] for i in block])))
             out_u.append(float(np.mean([rows[i][1] for i in block])))
-            out_s.append(np.mean(np.asarray([rows[i][2] for i in block]), axis=0))
+            block_strains = np.mean(np.asarray([rows[i][2] for i in block]), axis=0)
+            if tips is not None:
+                block_strains = np.r_[block_strains, np.mean(tips[block])]
+            out_s.append(block_strains)
             counts.append(len(block))
             block.clear()
 
@@ -125,5 +150,5 @@ def _blocks(
         if len(block) == BLOCK:
             flush()
     flush()
-    averaged = np.asarray(out_s, dtype=np.float64).reshape(-1, gratings)
+    averaged = np.asarray(out_s, dtype=np.float64).reshape(-1, gratings + (tips is not None))
     return np.asarray(out_t), np.asarray(out_u), averaged, np.asarray(counts, dtype=np.float64)
