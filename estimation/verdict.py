@@ -291,7 +291,7 @@ def _wider_than_imprecise(
 def _relaxation_explains(warning: str, facts: TrialFacts) -> bool:
     """Whether ``warning`` is the elastic belief check's on a record that relaxes: the elastic
     law's misfit is then the relaxation's, which a thicker layer or a softer base mimics (on
-    relaxing lung-like layers it blamed the thickness in 26 of 72 trials with true beliefs);
+    relaxing lung-like layers it blamed the thickness in 39 of 72 trials with true beliefs);
     the check on the relaxed curve (``estimation.relaxation.beliefs``) replaces it."""
     relaxes = facts.relaxation is not None and facts.relaxation.relaxes
     return relaxes and warning.startswith(CONTRADICTED)

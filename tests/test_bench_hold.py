@@ -15,14 +15,21 @@ STACK = load_stack()
 
 @pytest.mark.parametrize("name", SCENES)
 def test_each_hold_scene_changes_only_the_hold_length_and_speed(name: str) -> None:
-    base = load(SceneConfig, resolve(f"scenes/viscoelastic/{name}.yaml"))
+    base = load(SceneConfig, resolve(f"scenes/{name}.yaml"))
     assert base.campaign.hold_s > 0  # the shipped scenes hold
-    assert base.campaign.speeds_mm_per_s() == (0.1, 0.5, 2.0)
+    robot = base.campaign.on_tubes
+    speeds = base.campaign.speeds_mm_per_s()
+    assert speeds == ((0.5,) if robot else (0.1, 0.5, 2.0))
     for hold in HOLDS_S:
         scene = hold_scene(base, hold, quick=True)
         assert scene.campaign.hold_s == hold
-        assert scene.campaign.exposed_lengths_mm == (46.0,)
-        assert scene.campaign.speeds_mm_per_s() == (0.1, 2.0)
+        if robot:  # one tube, every orientation, the robot's exposed length
+            assert scene.campaign.tubes == ("bent30",)
+            assert scene.campaign.orientations == base.campaign.orientations
+            assert scene.campaign.speeds_mm_per_s() == (0.5,)
+        else:
+            assert scene.campaign.exposed_lengths_mm == (46.0,)
+            assert scene.campaign.speeds_mm_per_s() == (0.1, 2.0)
         assert scene.samples == base.samples
         assert scene.fidelity == base.fidelity
 

@@ -44,7 +44,7 @@ def hold_scene(base: SceneConfig, hold_s: float, quick: bool) -> SceneConfig:
     campaign = dataclasses.replace(
         c,
         hold_s=hold_s,
-        indent_speeds_mm_per_s=(speeds[0], speeds[-1]) if quick else speeds,
+        indent_speeds_mm_per_s=(speeds[0], speeds[-1]) if quick and len(speeds) > 1 else speeds,
         samples=tuple(s.name for s in base.samples[:2]) if quick else c.samples,
     )
     if c.on_tubes:

@@ -2,7 +2,9 @@
 ``estimation.jointfit.pooling``), with a verdict: ``ok``, ``suspect`` when the pooled record
 contradicts a stated belief (which one, by how much) or when most trials are suspect for a
 reason pooling does not remove (outside the trusted domain, misaligned, ...), ``none``
-without two trials to pool::
+without two trials to pool. A sample most of whose trials relax in their hold answers with
+its relaxed modulus instead (``estimation.relaxation.pooled``; ``PooledSample.modulus`` says
+which), judged on the trials' relaxed verdicts::
 
     for name, p in pooled_by_sample(outcomes).items():
         print(name, p.fit.modulus, p.status, p.reasons)
@@ -15,6 +17,7 @@ from dataclasses import dataclass
 
 from palpate.estimation.jointfit.beliefcheck import CONTRADICTED
 from palpate.estimation.jointfit.pooling import PooledFit, pool
+from palpate.estimation.relaxation.pooled import pool_relaxed
 from palpate.robot.trial.outcome import Outcome
 
 
@@ -25,6 +28,7 @@ class PooledSample:
     fit: PooledFit
     status: str
     reasons: tuple[str, ...]
+    modulus: str = "elastic"  # or "relaxed": the sample relaxes, its answer is E_inf
 
 
 POOLABLE = (CONTRADICTED, "imprecise")
@@ -51,6 +55,9 @@ def pooled_sample(outcomes: list[Outcome]) -> PooledSample:
     interval); when fewer than two are, every fitted trial, and the answer is ``suspect`` with
     the reason most of the others share."""
     fitted = [o for o in outcomes if _fitted(o) and o.joint is not None and o.joint.terms]
+    relaxing = [o for o in fitted if o.relaxation is not None and o.relaxation.relaxes]
+    if len(relaxing) >= 2 and 2 * len(relaxing) > len(fitted):
+        return _relaxed(relaxing)
     clean = [o for o in fitted if _clean(o)]
     used: list[Outcome] = clean
     why: tuple[str, ...] = ()
@@ -64,6 +71,24 @@ def pooled_sample(outcomes: list[Outcome]) -> PooledSample:
     if fit.contradiction is not None:
         why = (fit.contradiction, *why)
     return PooledSample(fit, "suspect" if why else "ok", why)
+
+
+def _relaxed(relaxing: list[Outcome]) -> PooledSample:
+    """A relaxing sample's relaxed modulus: its trials whose relaxed verdict is ``ok``; fewer
+    than two, every relaxing trial, ``suspect`` with the first suspect trial's reason."""
+    verdicts = [o.relaxed_verdict for o in relaxing]
+    why: tuple[str, ...]
+    clean = [o for o, v in zip(relaxing, verdicts, strict=True) if v and v.status == "ok"]
+    used, why = clean, ()
+    if len(clean) < 2:
+        used = relaxing
+        first = next((v.reasons[0] for v in verdicts if v and v.reasons), "no relaxed verdict")
+        suspect = len(relaxing) - len(clean)
+        why = (f"{suspect} of {len(relaxing)} relaxed moduli are suspect, e.g. {first}",)
+    fit = pool_relaxed([o.relaxation for o in used if o.relaxation is not None])
+    if fit.modulus is None:
+        return PooledSample(fit, "none", (fit.message,), "relaxed")
+    return PooledSample(fit, "suspect" if why else "ok", why, "relaxed")
 
 
 def pooled_by_sample(pairs: Iterable[tuple[str, Outcome]]) -> dict[str, PooledSample]:
@@ -87,6 +112,7 @@ def pooled_fields(p: PooledSample | None, actual: float | None) -> dict[str, obj
         rel = (f.modulus - actual) / actual
         covered = f.covers(actual)
     return {
+        "pooled_modulus": p.modulus,
         "pooled_kpa": None if f.modulus is None else f.modulus / 1e3,
         "pooled_ci_low_kpa": None if f.ci_low is None else f.ci_low / 1e3,
         "pooled_ci_high_kpa": None if f.ci_high is None else f.ci_high / 1e3,
@@ -100,6 +126,7 @@ def pooled_fields(p: PooledSample | None, actual: float | None) -> dict[str, obj
 
 
 POOLED_COLUMNS = (
+    "pooled_modulus",
     "pooled_kpa",
     "pooled_ci_low_kpa",
     "pooled_ci_high_kpa",

@@ -4,6 +4,7 @@ and the belief check on the relaxed curve does not blame the relaxation on the t
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -56,3 +57,21 @@ def test_the_log_replays_to_the_same_relaxation(relaxing: TrialOutcome) -> None:
     assert relaxing.log_path is not None
     report = replay(Path(relaxing.log_path))
     assert report["identical"] is True, report
+
+
+def test_a_relaxing_sample_answers_with_its_relaxed_modulus(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two trials of N1 (1.2 kPa relaxed, a power law): the sample's one answer is the relaxed
+    modulus, not the pooled elastic fit's apparent one, and no thickness is blamed."""
+    from palpate.cli import main
+
+    scene = str(resolve("scenes/lung/relaxing.yaml"))
+    args = ["sim", "--scene", scene, "--limit", "2", "--no-plots", "--json"]
+    assert main([*args, "--workers", "1", "--out", str(tmp_path)]) == 0
+    (n1,) = json.loads(capsys.readouterr().out)["samples"]
+    assert n1["pooled_modulus"] == "relaxed"
+    assert n1["pooled_trials"] == 2
+    assert n1["pooled_kpa"] == pytest.approx(1.2, rel=0.08)
+    assert n1["pooled_interval_holds_truth"] is True
+    assert "prefers" not in n1["pooled_reasons"]

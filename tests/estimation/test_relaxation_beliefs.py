@@ -23,6 +23,7 @@ from palpate.estimation.relaxation import (
     fit_relaxation,
     memory_basis,
 )
+from palpate.estimation.relaxation.pooled import pool_relaxed
 from palpate.estimation.verdict import TrialFacts, judge
 from palpate.sim.viscoelastic import StandardLinearSolid, force_history
 
@@ -136,3 +137,15 @@ def test_the_memory_basis_in_runs_is_the_recursion(tau: float) -> None:
             prev = shape[i]
             manual[i, k] = h
     np.testing.assert_allclose(scanned, manual, rtol=1e-10, atol=1e-13)
+
+
+def test_a_samples_relaxed_modulus_is_the_typical_trials() -> None:
+    def trial(value: float, down: float, up: float) -> RelaxationFit:
+        return RelaxationFit(True, "ok", value, value - down, value + up, relaxes=True)
+
+    fits = [trial(1.00e3, 50.0, 60.0), trial(1.04e3, 40.0, 80.0), trial(1.30e3, 90.0, 70.0)]
+    pooled = pool_relaxed([*fits, RelaxationFit(False, "no hold in the record")])
+    assert pooled.trials == 3
+    assert pooled.modulus == pytest.approx(1.04e3)  # the median: one odd trial does not pull
+    assert (pooled.ci_low, pooled.ci_high) == pytest.approx((1.04e3 - 50.0, 1.04e3 + 70.0))
+    assert pool_relaxed(fits[:1]).modulus is None
