@@ -264,8 +264,9 @@ def _print_pooled(s: dict[str, Any]) -> None:
     if s["pooled_kpa"] is None:
         return
     why = f": {s['pooled_reasons']}" if s["pooled_reasons"] else ""
+    what = "relaxed modulus " if s.get("pooled_modulus") == "relaxed" else ""
     print(
-        f"  pooled over {s['pooled_trials']} trials: {s['pooled_kpa']:.2f} "
+        f"  pooled over {s['pooled_trials']} trials: {what}{s['pooled_kpa']:.2f} "
         f"[{s['pooled_ci_low_kpa']:.2f}, {s['pooled_ci_high_kpa']:.2f}] kPa, "
         f"{s['pooled_verdict']}{why}"
     )

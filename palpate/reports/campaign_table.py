@@ -72,7 +72,8 @@ TITLE = (
     "paper: the paper's single-point estimate (Eqs. 13-14) over the same sample's trials; "
     "ok/sus/none: verdicts; cover: 95 % intervals holding the truth / trials with a number; "
     "pooled: every trial of the sample fitted together (one modulus, each trial's own contact), "
-    "with its interval and verdict (the pooled belief check)"
+    "with its interval and verdict (the pooled belief check); marked 'relaxed': the sample "
+    "relaxes in its holds, the answer is its relaxed modulus (docs/viscoelastic.md)"
 )
 
 
@@ -104,7 +105,8 @@ def _pooled(r: dict[str, Any]) -> str:
     """The pooled estimate and its interval (kPa), or '-'."""
     if r["pooled_kpa"] is None:
         return "-"
-    return f"{r['pooled_kpa']:.2f} [{r['pooled_ci_low_kpa']:.1f}, {r['pooled_ci_high_kpa']:.1f}]"
+    cell = f"{r['pooled_kpa']:.2f} [{r['pooled_ci_low_kpa']:.1f}, {r['pooled_ci_high_kpa']:.1f}]"
+    return f"relaxed {cell}" if r.get("pooled_modulus") == "relaxed" else cell
 
 
 def _cell(v: float | None) -> str:
