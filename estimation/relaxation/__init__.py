@@ -2,8 +2,9 @@
 
 A buckled beam is nearly a constant-force spring, so holding the stage after buckling is a creep
 test the gratings see: the tissue creeps, the beam straightens a little, and the strains give
-the load P and the beam's end shortening e at every tick (``estimation.beamstate``). With the
-contact position x0, the depth is ``delta = u - x0 - e - c P`` as in the joint fit.
+the load P (or a tip grating's) and the beam's end shortening e at every tick
+(``estimation.beamstate``). With the contact position x0, the depth is ``delta = u - x0 - e -
+c P`` as in the joint fit.
 
 Model (quasi-linear viscoelasticity, the form-free way). With f the elastic contact law's shape
 (``estimation.corrections.ContactLaw.shape``, F = E f), a relaxation modulus written as a

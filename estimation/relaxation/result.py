@@ -25,11 +25,11 @@ class RelaxationFit:
         hold: the hold's length (s); n_points: samples fitted; contact: x0 (m).
         warnings: one sentence each.
         hypotheses: how many of the belief's hypotheses were fitted; plausible: how many of them
-            the record allows (within the chi^2 quantile of the best), whose intervals the
+            the record allows (within the chi^2 quantile and the model-form allowance), whose intervals the
             moduli's are the envelope of (``estimation.relaxation.beliefs``).
         rss, noise_scale: the lowest weighted RSS over the contact (the spectrum reaching past
             the record) and the noise inflation, for comparing hypotheses (not in
-            :meth:`as_dict`).
+            :meth:`as_dict`, nor compared: a fit read back from a log is the same fit).
     """
 
     success: bool
@@ -51,8 +51,8 @@ class RelaxationFit:
     warnings: tuple[str, ...] = field(default=())
     hypotheses: int = 1
     plausible: int = 1
-    rss: float | None = None
-    noise_scale: float | None = None
+    rss: float | None = field(default=None, compare=False, repr=False)
+    noise_scale: float | None = field(default=None, compare=False, repr=False)
 
     def covers(self, modulus: float) -> bool:
         """Whether the relaxed modulus's interval holds ``modulus`` (Pa)."""
