@@ -62,8 +62,9 @@ def fit_relaxation(
     confidence: float = 0.95,
 ) -> RelaxationFit:
     """E_inf, E_0 and the relaxation time of ``record`` with the contact law ``law`` (one
-    hypothesis of the belief: ``beliefs.fit_over_beliefs`` runs each); ``contact`` the joint fit's (low, x0, high) (m), ``modulus``
-    its E (Pa, for the depth noise's weight). See ``estimation.relaxation``."""
+    hypothesis of the belief: ``beliefs.fit_over_beliefs`` runs each); ``contact`` the joint
+    fit's (low, x0, high) (m), ``modulus`` its E (Pa, for the depth noise's weight). See
+    ``estimation.relaxation``."""
     _check(record, contact, modulus, confidence)
     n = record.times.size
     if record.hold <= 0:

@@ -25,8 +25,8 @@ class RelaxationFit:
         hold: the hold's length (s); n_points: samples fitted; contact: x0 (m).
         warnings: one sentence each.
         hypotheses: how many of the belief's hypotheses were fitted; plausible: how many of them
-            the record allows (within the chi^2 quantile and the model-form allowance), whose intervals the
-            moduli's are the envelope of (``estimation.relaxation.beliefs``).
+            the record allows (within the chi^2 quantile and the model-form allowance), whose
+            intervals the moduli's are the envelope of (``estimation.relaxation.beliefs``).
         rss, noise_scale: the lowest weighted RSS over the contact (the spectrum reaching past
             the record) and the noise inflation, for comparing hypotheses (not in
             :meth:`as_dict`, nor compared: a fit read back from a log is the same fit).
