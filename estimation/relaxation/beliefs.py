@@ -37,6 +37,7 @@ from ..jointfit.beliefcheck import CONTRADICTED, alternatives
 from .fit import chi2_quantile, fit_relaxation, floor_rss
 from .result import RelaxationFit, RelaxationRecord
 
+PER_AXIS = 4  # values of each open property fitted (``thinned``)
 MARGIN = 25.0
 """delta chi^2 past which an alternative to a stated point belief contradicts it on a relaxing
 record (the elastic check's is 9): set from the relaxing lung-like layers with true beliefs,
@@ -56,7 +57,7 @@ def fit_over_beliefs(
     hypothesis's ``c P`` is taken off) under each of ``belief``'s hypotheses, combined, and the
     belief check on the relaxed curve (module docstring)."""
     depth = float(np.max(record.depth_base)) - contact[0]
-    hypotheses = belief.hypotheses(depth, float(np.max(record.load)))
+    hypotheses = thinned(belief.hypotheses(depth, float(np.max(record.load))))
     fits = [
         fit_relaxation(
             _less_compliance(record, h.compliance),
@@ -121,6 +122,29 @@ def _contradictions(
         f"{CONTRADICTED} belief: the relaxed record prefers {worst}: delta chi^2 = "
         f"{gains[worst]:.0f}",
     )
+
+
+def thinned(hypotheses: Sequence[Hypothesis], per_axis: int = PER_AXIS) -> list[Hypothesis]:
+    """The hypotheses at most ``per_axis`` values of each property apart: each axis's ends and
+    the values nearest evenly between (an unknown thickness's grid has up to 51, and a fit a
+    hypothesis costs tens of ms; E moves monotonically along each axis, so the ends carry the
+    envelope and the inner points the middle)."""
+    points = [_axes(h) for h in hypotheses]
+    kept = []
+    for axis in range(4):
+        values = sorted({p[axis] for p in points})
+        picks = np.unique(np.round(np.linspace(0, len(values) - 1, min(per_axis, len(values)))))
+        kept.append({values[int(i)] for i in picks})
+    return [
+        h
+        for h, p in zip(hypotheses, points, strict=True)
+        if all(v in k for v, k in zip(p, kept, strict=True))
+    ]
+
+
+def _axes(h: Hypothesis) -> tuple[float, float, float, float]:
+    """A hypothesis's thickness (0: the half-space), base, Poisson ratio and compliance."""
+    return (h.law.thickness or 0.0, float(h.law.bonded), h.law.poisson, h.compliance)
 
 
 def allowance(record: RelaxationRecord, model_form: float) -> float:

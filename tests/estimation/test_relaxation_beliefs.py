@@ -23,6 +23,7 @@ from palpate.estimation.relaxation import (
     fit_relaxation,
     memory_basis,
 )
+from palpate.estimation.relaxation.beliefs import thinned
 from palpate.estimation.relaxation.pooled import pool_relaxed
 from palpate.estimation.verdict import TrialFacts, judge
 from palpate.sim.viscoelastic import StandardLinearSolid, force_history
@@ -149,3 +150,17 @@ def test_a_samples_relaxed_modulus_is_the_typical_trials() -> None:
     assert pooled.modulus == pytest.approx(1.04e3)  # the median: one odd trial does not pull
     assert (pooled.ci_low, pooled.ci_high) == pytest.approx((1.04e3 - 50.0, 1.04e3 + 70.0))
     assert pool_relaxed(fits[:1]).modulus is None
+
+
+def test_an_open_belief_is_fitted_at_a_few_points_of_each_property() -> None:
+    """An unknown thickness, either base and a Poisson range: 408 hypotheses on the joint fit's
+    grid, 32 fitted, every property's ends among them."""
+    wide = Belief(R, poisson=(0.45, 0.49), thickness=(0.0, float("inf")), bonded=(True, False))
+    grid = wide.hypotheses(0.6e-3, 0.4)
+    kept = thinned(grid)
+    assert len(kept) <= 4 * 2 * 4 < len(grid)
+    for values in (lambda h: h.law.thickness or 0.0, lambda h: h.law.poisson):
+        assert {min(map(values, grid)), max(map(values, grid))} <= set(map(values, kept))
+    assert thinned(belief((0.45, 0.49)).hypotheses(0.6e-3, 0.4)) == list(
+        belief((0.45, 0.49)).hypotheses(0.6e-3, 0.4)
+    )
