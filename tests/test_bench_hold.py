@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from palpate.benchmarks.hold import HOLDS_S, SCENES, hold_scene
+from palpate.benchmarks.hold import HOLDS_S, SCENES, hold_scene, scene_speeds
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
@@ -20,6 +20,7 @@ def test_each_hold_scene_changes_only_the_hold_length_and_speed(name: str) -> No
     robot = base.campaign.on_tubes
     speeds = base.campaign.speeds_mm_per_s()
     assert speeds == ((0.5,) if robot else (0.1, 0.5, 2.0))
+    assert scene_speeds(base, quick=True) == ("0.5" if robot else "0.1, 2")  # the table's note
     for hold in HOLDS_S:
         scene = hold_scene(base, hold, quick=True)
         assert scene.campaign.hold_s == hold

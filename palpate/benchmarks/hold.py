@@ -40,11 +40,10 @@ def hold_scene(base: SceneConfig, hold_s: float, quick: bool) -> SceneConfig:
     """``base`` at one hold length, one exposed length (46 mm on the bench; the robot's own,
     on one tube); with ``quick`` two samples and the slowest and fastest speeds."""
     c = base.campaign
-    speeds = c.speeds_mm_per_s()
     campaign = dataclasses.replace(
         c,
         hold_s=hold_s,
-        indent_speeds_mm_per_s=(speeds[0], speeds[-1]) if quick and len(speeds) > 1 else speeds,
+        indent_speeds_mm_per_s=_speeds(base, quick),
         samples=tuple(s.name for s in base.samples[:2]) if quick else c.samples,
     )
     if c.on_tubes:
@@ -127,6 +126,11 @@ def _where(base: SceneConfig) -> str:
     return "L = 46 mm"
 
 
-def scene_speeds(base: SceneConfig, quick: bool) -> str:
+def _speeds(base: SceneConfig, quick: bool) -> tuple[float, ...]:
+    """The scene's speeds (mm/s); with ``quick`` the slowest and the fastest."""
     speeds = base.campaign.speeds_mm_per_s()
-    return ", ".join(f"{v:g}" for v in ((speeds[0], speeds[-1]) if quick else speeds))
+    return (speeds[0], speeds[-1]) if quick and len(speeds) > 1 else speeds
+
+
+def scene_speeds(base: SceneConfig, quick: bool) -> str:
+    return ", ".join(f"{v:g}" for v in _speeds(base, quick))
