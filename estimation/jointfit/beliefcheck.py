@@ -93,13 +93,20 @@ def contradictions(curves: dict[str, Curve]) -> tuple[str, ...]:
     belief (``law_curves``) by more than MARGIN in chi^2, each at its best contact position
     and modulus."""
     best = {key: float(np.min(c.rss)) for key, c in curves.items()}
-    gains = {key: best[STATED] - v for key, v in best.items() if key not in (STATED, FORM)}
+    return contradiction({k: best[STATED] - v for k, v in best.items() if k not in (STATED, FORM)})
+
+
+def contradiction(
+    gains: dict[str, float], margin: float = MARGIN, record: str = "the record"
+) -> tuple[str, ...]:
+    """The warning (none or one) that ``record`` prefers the alternative of largest ``gains``
+    (its delta chi^2 over the stated belief, keyed by its sentence) by more than ``margin``."""
     if not gains:
         return ()
     worst = max(gains, key=lambda k: gains[k])
-    if gains[worst] <= MARGIN:
+    if gains[worst] <= margin:
         return ()
-    return (f"{CONTRADICTED} belief: the record prefers {worst}: delta chi^2 = {gains[worst]:.0f}",)
+    return (f"{CONTRADICTED} belief: {record} prefers {worst}: delta chi^2 = {gains[worst]:.0f}",)
 
 
 def _grid(

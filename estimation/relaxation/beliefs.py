@@ -33,8 +33,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..belief import Belief, Hypothesis
-from ..jointfit.beliefcheck import CONTRADICTED, alternatives
-from .fit import chi2_quantile, fit_relaxation, floor_rss
+from ..jointfit.beliefcheck import alternatives, contradiction
+from ..jointfit.pooling import chi2_quantile
+from .fit import fit_relaxation, floor_rss
 from .result import RelaxationFit, RelaxationRecord
 
 PER_AXIS = 4  # values of each open property fitted (``thinned``)
@@ -75,8 +76,6 @@ def fit_over_beliefs(
     at = min(done, key=lambda i: fits[i].rss or 0.0)
     best, scale = fits[at], fits[at].noise_scale or 1.0
     checked = _contradictions(record, belief, hypotheses[at], (contact, modulus), best)
-    if len(fits) == 1:
-        return dataclasses.replace(best, warnings=best.warnings + checked)
     reach = chi2_quantile(confidence) + allowance(record, model_form) / scale
     floor = best.rss or 0.0
     plausible = [fits[i] for i in done if ((fits[i].rss or 0.0) - floor) / scale <= reach]
@@ -113,15 +112,7 @@ def _contradictions(
         what: (fit.rss - floor_rss(shifted, law, contact, modulus)) / (fit.noise_scale or 1.0)
         for what, law in alternatives(belief, stated.law)
     }
-    if not gains:
-        return ()
-    worst = max(gains, key=lambda k: gains[k])
-    if gains[worst] <= MARGIN:
-        return ()
-    return (
-        f"{CONTRADICTED} belief: the relaxed record prefers {worst}: delta chi^2 = "
-        f"{gains[worst]:.0f}",
-    )
+    return contradiction(gains, MARGIN, "the relaxed record")
 
 
 def thinned(hypotheses: Sequence[Hypothesis], per_axis: int = PER_AXIS) -> list[Hypothesis]:

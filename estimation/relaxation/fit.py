@@ -7,11 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# chi2(1)'s quantile from scipy.special, as scipy.stats computes it (2 gammaincinv(df/2, p)),
-# without stats' 0.4 s import on every process that estimates
-from scipy.special import gammaincinv  # type: ignore[import-untyped,unused-ignore]
-
 from ..corrections import ContactLaw
+from ..jointfit.pooling import chi2_quantile
 from .result import FloatArray, RelaxationFit, RelaxationRecord
 from .spectrum import (
     Solved,
@@ -31,11 +28,6 @@ RELAXES_MIN = 0.03  # and E_0 / E_inf - 1 above this, for "the record relaxes"
 INCOMPLETE = 0.02  # of the last sample's load still relaxing: the relaxed modulus not reached
 SPECTRUM_FORM = 0.005  # relative: a fixed spectrum's own misfit of a relaxation between its times
 MIN_HOLD_POINTS = 20
-
-
-def chi2_quantile(p: float) -> float:
-    """chi^2(1)'s quantile at probability ``p``."""
-    return float(2.0 * gammaincinv(0.5, p))
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,8 @@ has no relaxation estimate (None): old logs replay as they were.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -62,14 +63,18 @@ def relaxation_of(
         return RelaxationFit(False, "no joint fit to start from")
     gratings = len(sensor.used_gratings)
     tips = _tips(rows, tip_forces, gratings)
-    t, advance, strains, counts = _blocks(rows, times, gratings, tips)
+    blocks = _blocks(rows, gratings)
+    t = _means(blocks, lambda i: times[i])
+    advance = _means(blocks, lambda i: rows[i][1])
+    strains = _means(blocks, lambda i: rows[i][2]).reshape(-1, gratings)
     hold_t = [times[i] for i, r in enumerate(rows) if r[0] == HOLD_STATE]
     _, k = record_states(*rows_in(rows, RECORD_STATES, gratings), inputs, sensor, section)
-    states, _ = record_states(advance, strains[:, :gratings], inputs, sensor, section)
-    thin = 1.0 / np.sqrt(counts)  # a block's mean has 1/sqrt(n) of a row's noise
+    states, _ = record_states(advance, strains, inputs, sensor, section)
+    thin = 1.0 / np.sqrt([len(b) for b in blocks])  # a block's mean has 1/sqrt(n) of a row's
     load, sigma_load = states.P, k * thin * states.sigma_P
     if tips is not None:
-        load, sigma_load = strains[:, gratings], force_sigma(tips[np.isfinite(tips)]) * thin
+        load = _means(blocks, lambda i: tips[i])
+        sigma_load = force_sigma(tips[np.isfinite(tips)]) * thin
     record = RelaxationRecord(
         times=t,
         load=np.asarray(load - (joint.load_offset or 0.0)),
@@ -109,31 +114,19 @@ def _tips(
     return tips if np.all(np.isfinite(tips[picked])) else None
 
 
-def _blocks(
-    rows: Sequence[Row], times: Sequence[float], gratings: int, tips: FloatArray | None = None
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """(times, advance, strains, rows per block) of the record: the loading rows one by one,
-    the buckled and held rows averaged ``BLOCK`` at a time (with ``tips``, the tip load is the
-    strains' last column, averaged alike). Past buckling the load is nearly
-    constant and the creep slow, while the end shortening read from the strains is noisy; a
-    depth that noisy, regressed on, pulls the fit (errors in variables: the noise of e is also
-    squared into e = z^2 L). Averaging the strains before the beam states are inferred takes
-    both down by the block's size."""
-    out_t: list[float] = []
-    out_u: list[float] = []
-    out_s: list[FloatArray] = []
-    counts: list[int] = []
+def _blocks(rows: Sequence[Row], gratings: int) -> list[list[int]]:
+    """The record's rows (indices) in blocks: the loading rows one by one, the buckled and held
+    rows ``BLOCK`` at a time. Past buckling the load is nearly constant and the creep slow,
+    while the end shortening read from the strains is noisy; a depth that noisy, regressed on,
+    pulls the fit (errors in variables: the noise of e is also squared into e = z^2 L).
+    Averaging the strains before the beam states are inferred takes both down by the block's
+    size."""
+    blocks: list[list[int]] = []
     block: list[int] = []
 
     def flush() -> None:
         if block:
-            out_t.append(float(np.mean([times[i] for i in block])))
-            out_u.append(float(np.mean([rows[i][1] for i in block])))
-            block_strains = np.mean(np.asarray([rows[i][2] for i in block]), axis=0)
-            if tips is not None:
-                block_strains = np.r_[block_strains, np.mean(tips[block])]
-            out_s.append(block_strains)
-            counts.append(len(block))
+            blocks.append(block.copy())
             block.clear()
 
     for i, (state, advance, row_strains) in enumerate(rows):
@@ -150,5 +143,9 @@ def _blocks(
         if len(block) == BLOCK:
             flush()
     flush()
-    averaged = np.asarray(out_s, dtype=np.float64).reshape(-1, gratings + (tips is not None))
-    return np.asarray(out_t), np.asarray(out_u), averaged, np.asarray(counts, dtype=np.float64)
+    return blocks
+
+
+def _means(blocks: list[list[int]], value: Callable[[int], Any]) -> FloatArray:
+    """Each block's mean of ``value`` (a row's number or vector, by the row's index)."""
+    return np.asarray([np.mean(np.asarray([value(i) for i in b]), axis=0) for b in blocks])
