@@ -25,8 +25,10 @@ class TipGratingConfig:
     axial compliance, stage travel that is not indentation; ``temperature_coefficient_pm_per_degc``:
     its thermal shift, compensated with the strain-free reference grating
     (``fbg.reference_wavelength_nm``, sent by the board: ``board.has_reference``) when
-    ``temperature_compensation`` is ``reference``; ``base_wavelength_nm``: its Bragg wavelength
-    at rest. The board sends its peak in every frame (frame protocol revision 1.1).
+    ``temperature_compensation`` is ``reference``; ``thermal_ratio``: its thermal shift per the
+    reference's, as calibrated (``palpate calibrate --thermal``; null: the two coefficients'
+    ratio); ``base_wavelength_nm``: its Bragg wavelength at rest. The board sends its peak in
+    every frame (frame protocol revision 1.1).
     """
 
     sensitivity_pm_per_mn: float = field(default=10.0, metadata=limits(gt=0, le=1000))
@@ -34,6 +36,7 @@ class TipGratingConfig:
     compliance_mm_per_n: float = field(default=0.03, metadata=limits(ge=0, le=100))
     temperature_coefficient_pm_per_degc: float = field(default=10.0, metadata=limits(ge=0, le=100))
     temperature_compensation: Literal["none", "reference"] = "reference"
+    thermal_ratio: float | None = field(default=None, metadata=limits(gt=0, le=10))
     base_wavelength_nm: float = field(default=1560.0, metadata=limits(gt=0, le=4000))
 
     @property
@@ -73,6 +76,11 @@ class FbgConfig:
     temperature_compensation: Literal["none", "reference"] = "none"
     base_wavelengths_nm: tuple[float, ...] = (1530.0, 1535.0, 1540.0, 1545.0, 1550.0)
     reference_wavelength_nm: float | None = None
+    # Each grating's thermal shift per the reference grating's (S_T,i / S_T,ref), one per
+    # base_wavelengths_nm, as calibrated on a record through a temperature change (`palpate
+    # calibrate --thermal`): gratings bonded on the beam see its expansion too, and S_T grows
+    # with the Bragg wavelength. null: 1 each (the same S_T for every grating).
+    thermal_ratios: tuple[float, ...] | None = None
     strain_limit_ue: float = field(default=5000.0, metadata=limits(gt=0, le=20000))
 
     def validate(self) -> None:
@@ -81,6 +89,21 @@ class FbgConfig:
                 "temperature_compensation 'reference' needs reference_wavelength_nm "
                 "(a strain-free grating)"
             )
+        ratios = self.thermal_ratios
+        if ratios is not None:
+            if len(ratios) != len(self.base_wavelengths_nm):
+                raise ValueError(
+                    f"thermal_ratios: one per base_wavelengths_nm ({len(self.base_wavelengths_nm)}"
+                    f"), got {len(ratios)}"
+                )
+            if not all(0 < r <= 10 for r in ratios):
+                raise ValueError(f"thermal_ratios: each in (0, 10], got {list(ratios)}")
+
+    def ratios(self, gratings: tuple[int, ...]) -> tuple[float, ...]:
+        """The thermal ratios of the gratings numbered ``gratings`` (1-based), 1 without any."""
+        if self.thermal_ratios is None:
+            return tuple(1.0 for _ in gratings)
+        return tuple(self.thermal_ratios[g - 1] for g in gratings)
 
     @property
     def strain_coefficient(self) -> float:

@@ -17,6 +17,7 @@ from .loader import limits
 from .optics import MM, PM, UE
 from .sample import PAPER_SAMPLES, SampleConfig
 from .schema import DEFAULT_CONTROL_RATE_HZ
+from .thermal import TemperatureConfig
 from .units import SI, SIOptional, SITuple
 
 Orientation = Literal["downward", "sideways", "upward"]
@@ -39,6 +40,9 @@ class FidelityConfig:
     large_indentation: bool = True
     tube_tip_stiffness_n_per_mm: float | None = field(default=None, metadata=limits(gt=0))
     temperature_drift_degc_per_s: float = field(default=0.0, metadata=limits(ge=-10, le=10))
+    # An insertion's temperature step and each grating's own thermal shift (config/thermal.py);
+    # null: one coefficient for every grating, the drift alone.
+    temperature: TemperatureConfig | None = None
     # The tissue's force law (sim/sample_law.py): "fe", each sample's own finite-element table
     # (sim/fem; independent of the estimator, so the default: a world that shares the
     # estimator's model measures self-consistency, not accuracy; tables of the shipped scenes

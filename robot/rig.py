@@ -104,7 +104,8 @@ class ServoFbgRig:
     ) -> ServoFbgRig:
         """The rig of a robot configuration: its strain chain, and its tip grating's if any."""
         tip = tip_chain(stack.sensor.tip_grating, stack.fbg)
-        return cls(drive, reader, StrainChain.from_config(stack.fbg), clock, settings, tip)
+        chain = StrainChain.from_config(stack.fbg, stack.sensor.used_gratings)
+        return cls(drive, reader, chain, clock, settings, tip)
 
     @property
     def tick(self) -> float:

@@ -9,16 +9,18 @@ Temperature modes (``FbgConfig.temperature_compensation``):
 - ``"measured"``: a measured ``dT`` (K, scalar or per sample) is removed as ``S_T * dT``; for
   offline use only (a dT series from elsewhere): the board's frame protocol carries no
   temperature, so the configuration (``FbgConfig.temperature_compensation``) does not offer it;
-- ``"reference"``: a strain-free reference grating's shift is ``S_T * dT`` and is subtracted
-  from every peak's shift (same ``S_T`` for all gratings; the 1-2 % spread of S_T with Bragg
-  wavelength across 1530-1550 nm is neglected).
+- ``"reference"``: a strain-free reference grating's shift is ``S_T,ref * dT``; each peak's
+  shift loses it times the grating's own ratio ``S_T,i / S_T,ref`` (``fbg.thermal_ratios``,
+  calibrated with ``palpate calibrate --thermal``; 1 each without: then a grating bonded on the
+  beam, which reads the beam's expansion too, and S_T's growth with the Bragg wavelength, about
+  1 % across 1530-1550 nm, are left in the strain: docs/temperature.md).
 
 All quantities are SI: wavelengths in m, ``k_eps`` in m per unit strain, ``S_T`` in m/K.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -73,11 +75,13 @@ def wavelength_to_strain(
     temperature_coefficient: float = 10e-12,
     delta_t: ArrayLike | None = None,
     reference: ArrayLike | None = None,
+    ratios: ArrayLike | None = None,
 ) -> FloatArray:
     """Strain per peak from wavelengths of shape (..., N) (Eq. 1 solved for eps).
 
     ``delta_t`` (K) has shape () or (...) in mode ``"measured"``; ``reference`` (m) has shape
-    (...) in mode ``"reference"``. Returns shape (..., N), dimensionless.
+    (...) in mode ``"reference"``, its shift scaled by each grating's ``ratios`` (N,) (1 each
+    when None). Returns shape (..., N), dimensionless.
     """
     if not k_eps > 0:
         raise ValueError(f"k_eps must be > 0, got {k_eps}")
@@ -99,6 +103,8 @@ def wavelength_to_strain(
                 "temperature mode 'reference' needs a reference grating and its baseline"
             )
         thermal = (np.asarray(reference, dtype=np.float64) - baseline.reference)[..., None]
+        if ratios is not None:
+            thermal = thermal * np.asarray(ratios, dtype=np.float64)
     else:
         raise ValueError(f"unknown temperature mode {mode!r}; expected one of {MODES}")
     return np.asarray((shift - thermal) / k_eps, dtype=np.float64)
@@ -112,23 +118,27 @@ class StrainChain:
     temperature_coefficient: float
     mode: TemperatureMode
     baseline: Baseline | None = None
+    ratios: tuple[float, ...] | None = None  # S_T,i / S_T,ref per peak; None: 1 each
 
     @classmethod
-    def from_config(cls, fbg: FbgConfig) -> StrainChain:
+    def from_config(cls, fbg: FbgConfig, gratings: tuple[int, ...] | None = None) -> StrainChain:
+        """The chain of ``fbg`` for the peaks of the gratings numbered ``gratings`` (the
+        sensor's ``used_gratings``; their thermal ratios), or 1 each without them."""
+        ratios = None
+        if gratings is not None and fbg.thermal_ratios is not None:
+            ratios = fbg.ratios(gratings)
         return cls(
-            fbg.strain_coefficient, fbg.temperature_coefficient, fbg.temperature_compensation
+            fbg.strain_coefficient,
+            fbg.temperature_coefficient,
+            fbg.temperature_compensation,
+            ratios=ratios,
         )
 
     def zeroed(self, wavelengths: ArrayLike, reference: ArrayLike | None = None) -> StrainChain:
         """A copy zeroed on rest samples (n, N); the reference is required in mode 'reference'."""
         if self.mode == "reference" and reference is None:
             raise ValueError("temperature mode 'reference' needs reference samples to zero on")
-        return StrainChain(
-            self.k_eps,
-            self.temperature_coefficient,
-            self.mode,
-            capture_baseline(wavelengths, reference),
-        )
+        return replace(self, baseline=capture_baseline(wavelengths, reference))
 
     def strains(
         self,
@@ -148,6 +158,7 @@ class StrainChain:
             temperature_coefficient=self.temperature_coefficient,
             delta_t=delta_t,
             reference=reference,
+            ratios=self.ratios,
         )
 
     def strain_noise(self) -> FloatArray:

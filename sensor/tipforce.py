@@ -48,8 +48,8 @@ class TipForceChain:
 
     @classmethod
     def from_config(cls, tip: TipGratingConfig, fbg: FbgConfig) -> TipForceChain:
-        ratio = 0.0
-        if fbg.temperature_coefficient > 0:
+        ratio = 0.0 if tip.thermal_ratio is None else tip.thermal_ratio
+        if tip.thermal_ratio is None and fbg.temperature_coefficient > 0:
             ratio = tip.temperature_coefficient / fbg.temperature_coefficient
         return cls(tip.sensitivity, ratio, tip.temperature_compensation == "reference")
 

@@ -1,5 +1,6 @@
 """What the interrogator reads off the gratings: each peak's wavelength from the fiber's strain
-and the temperature drift, the strain-free reference grating, and the interrogator's noise.
+and the temperature (each grating's own thermal shift, sim/thermal.py), the strain-free
+reference grating, the tip force grating, and the interrogator's noise.
 
 Plain floats, with the same IEEE operations in the same order as the array expressions they
 replaced, so the same bits (``sim.world.World.sample`` calls it at every board sample).
@@ -12,6 +13,29 @@ from numpy.typing import NDArray
 
 from ..config.scene import FidelityConfig
 from ..config.schema import FbgConfig, SensorConfig, TipGratingConfig
+from .thermal import ThermalHistory, true_coefficients
+
+
+class BoardReadout:
+    """Every peak the board sends at one instant: the gratings', the reference's and the tip
+    grating's, at the world's temperature then (:class:`sim.thermal.ThermalHistory`)."""
+
+    def __init__(self, sensor: SensorConfig, fbg: FbgConfig, fidelity: FidelityConfig) -> None:
+        self.history = ThermalHistory.of(fidelity)
+        self.gratings = GratingReadout(sensor, fbg, fidelity)
+        tip = sensor.tip_grating
+        thermal = true_coefficients(sensor, fbg, fidelity).tip
+        self.tip = None if tip is None else TipReadout(tip, fidelity, thermal)
+
+    def read(
+        self, strains: tuple[float, ...], load: float, t: float, rng: np.random.Generator
+    ) -> tuple[tuple[float, ...], float | None, float | None]:
+        """The peaks (m), the reference's and the tip grating's (m, None without one) at fiber
+        strains ``strains``, an axial tip load ``load`` (N) and virtual time ``t`` (s)."""
+        drift = self.history.change(t)
+        wavelengths, reference = self.gratings.read(strains, drift, rng)
+        tip = None if self.tip is None else self.tip.read(load, drift, rng)
+        return wavelengths, reference, tip
 
 
 class GratingReadout:
@@ -25,7 +49,9 @@ class GratingReadout:
         # peak noises, then the reference's, drawn in one call (the same stream as separate ones)
         self._draws = (len(self._base) + (ref_nm is not None)) if self._noise > 0 else 0
         self._strain_coefficient = fbg.strain_coefficient
-        self._temperature_coefficient = fbg.temperature_coefficient
+        thermal = true_coefficients(sensor, fbg, fidelity)
+        self._thermal = thermal.gratings
+        self._reference_thermal = thermal.reference
 
     def read(
         self, strains: tuple[float, ...], drift: float, rng: np.random.Generator
@@ -36,7 +62,7 @@ class GratingReadout:
         reference = None
         if self._reference is not None:
             reference = self._reference
-            reference += self._temperature_coefficient * drift
+            reference += self._reference_thermal * drift
             if noise:
                 reference += noise[-1]
         return self._peaks(strains, drift, noise), reference
@@ -44,12 +70,11 @@ class GratingReadout:
     def _peaks(
         self, strains: tuple[float, ...], drift: float, noise: list[float]
     ) -> tuple[float, ...]:
-        """Peak wavelengths (m): base + S_eps eps (+ S_T dT) (+ noise)."""
+        """Peak wavelengths (m): base + S_eps eps (+ S_T,i dT) (+ noise)."""
         k = self._strain_coefficient
         shift = [k * x for x in strains]
         if drift:
-            offset = self._temperature_coefficient * drift
-            shift = [x + offset for x in shift]
+            shift = [x + c * drift for x, c in zip(shift, self._thermal, strict=True)]
         wl = [b + x for b, x in zip(self._base, shift, strict=True)]
         if noise:
             wl = [w + n for w, n in zip(wl, noise[: len(wl)], strict=True)]
@@ -61,17 +86,15 @@ class TipReadout:
     axial load (clipped at the element's range: past it the element has bottomed out and the
     grating reads no more), its own thermal shift, and the interrogator's noise."""
 
-    def __init__(self, tip: TipGratingConfig, fidelity: FidelityConfig) -> None:
+    def __init__(
+        self, tip: TipGratingConfig, fidelity: FidelityConfig, thermal: float | None = None
+    ) -> None:
+        """``thermal``: its true shift per kelvin (m/K; default: the configured one)."""
         self._base = tip.base_wavelength
         self._sensitivity = tip.sensitivity
         self._range = tip.range
-        self._thermal = tip.temperature_coefficient
+        self._thermal = tip.temperature_coefficient if thermal is None else thermal
         self._noise = fidelity.fbg_noise
-
-    @classmethod
-    def of(cls, tip: TipGratingConfig | None, fidelity: FidelityConfig) -> TipReadout | None:
-        """The readout of a sensor's tip grating, None for a sensor without one."""
-        return None if tip is None else cls(tip, fidelity)
 
     def read(self, load: float, drift: float, rng: np.random.Generator) -> float:
         """The peak (m) at an axial tip load ``load`` (N) and a temperature change ``drift``

@@ -41,7 +41,7 @@ from .contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_gri
 from .equilibrium import ContactEffects, TissueLaw
 from .gravity import BeamWeight, offset_to_mode, sensing_axis
 from .oblique import ObliqueContact
-from .readout import GratingReadout, TipReadout, grating_ends
+from .readout import BoardReadout, grating_ends
 from .viscoelastic import Relaxation
 
 # (roll rad, translation m) -> (tube tip point, unit tangent, exposed length m)
@@ -159,8 +159,7 @@ class World:
         self.has_force = has_force
         self.effects, self.contact_offset = _contact_effects(fidelity, rng, sensor)
         self._centres = tuple(sensor.grating_centres_from_tip())
-        self.readout = GratingReadout(sensor, fbg, fidelity)
-        self.tip_readout = TipReadout.of(sensor.tip_grating, fidelity)
+        self.readout = BoardReadout(sensor, fbg, fidelity)
         self._tip_radius = sensor.tip_radius
         self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
@@ -361,16 +360,12 @@ class World:
     # -- what the board sends ----------------------------------------------------------------
     def sample(self, t: float) -> BoardSample:
         st = self.state(t)
-        drift = self.fidelity.temperature_drift_degc_per_s * t
-        wavelengths, reference = self.readout.read(st.strains, drift, self.rng)
+        wavelengths, reference, tip = self.readout.read(st.strains, st.P, t, self.rng)
         flags = _CONTACT_FLAG if st.contact_event else 0
         force = None
         if self.has_force:
             force = st.P
             flags |= _FORCE_FLAG
-        tip = None
-        if self.tip_readout is not None:
-            tip = self.tip_readout.read(st.P, drift, self.rng)
         return BoardSample(
             wavelengths=wavelengths,
             encoder=st.encoder,

@@ -6,6 +6,9 @@ One command, by what it is given:
   measured shifts (``sensor/calibration.py``), as the paper's Fig. 1d;
 - a CSV with ``force_mn`` and ``shift_pm`` columns, or a frame stream with ``--tip``: the tip
   force grating's sensitivity against a force scale (``sensor/tipcal.py``);
+- a frame stream with ``--thermal``, the sensor free through a temperature change (the
+  insertion into the body, a bath): each grating's thermal shift per the reference grating's,
+  and the residual the configured and the fitted ratios leave (``sensor/thermalcal.py``);
 - a recorded stream of raw board frames (any other file, e.g. ``cat /dev/ttyACM0 > frames.bin``
   while the sensor buckles on a rigid reference on the bench-top stage): k'_eps against the
   elastica's strains (``sensor/framecal.py``; ``--exposed-length-mm``, ``--config``);
@@ -25,7 +28,7 @@ from pathlib import Path
 from palpate.calibration import calibrate, config_lines
 from palpate.config import load_stack
 from palpate.config.loader import InputError
-from palpate.config.schema import MM
+from palpate.config.schema import MM, StackConfig
 from palpate.config.stage import rig_key
 from palpate.estimation.compliance import ComplianceFit
 from palpate.reports.replay import replay
@@ -37,6 +40,7 @@ from palpate.sensor.calibration import (
     load_pairs_csv,
 )
 from palpate.sensor.framecal import calibrate_frames, read_frames
+from palpate.sensor.thermalcal import ThermalFit, fit_thermal_frames
 from palpate.sensor.tipcal import fit_tip_csv, fit_tip_frames, is_tip_csv
 
 
@@ -69,6 +73,12 @@ def register(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="frames: calibrate the tip force grating against the board's force scale reading",
     )
+    parser.add_argument(
+        "--thermal",
+        action="store_true",
+        help="frames: each grating's thermal ratio to the reference grating (a free sensor "
+        "through a temperature change)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -78,6 +88,8 @@ def run(args: argparse.Namespace) -> int:
     if len(files) != 1:
         raise InputError("give one CSV or one frame stream, or trial logs (.jsonl) only")
     path = files[0]
+    if args.thermal:
+        return _thermal(path, args)
     if args.tip or is_tip_csv(path, csv_columns(path)):
         return _tip(path, args)
     if path.suffix.lower() == ".csv":
@@ -138,6 +150,47 @@ def _tip(path: Path, args: argparse.Namespace) -> int:
     print(f"  residual    = {fit.line.residual_std * 1e12:.3f} pm (std)")
     print(f"  config: {fit.config_line()}")
     return 0
+
+
+def _thermal(path: Path, args: argparse.Namespace) -> int:
+    """The gratings' thermal ratios from a free sensor's frame stream."""
+    stack = load_stack(args.config)
+    try:
+        fit = fit_thermal_frames(read_frames(path, stack), stack, confidence=args.confidence)
+    except ValueError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    if getattr(args, "json", False):
+        lines = fit.config_lines(stack)
+        print(json.dumps({"file": str(path), **fit.as_dict(), "config": lines}, indent=2))
+        return 0
+    for line in thermal_lines(path, fit, stack):
+        print(line)
+    return 0
+
+
+def thermal_lines(path: Path, fit: ThermalFit, stack: StackConfig) -> list[str]:
+    """The thermal calibration's table: each grating's ratio, its interval, the residuals."""
+    pct = round(100 * fit.lines[0].confidence)
+    out = [
+        f"thermal calibration of {path} ({fit.frames} frames over {fit.duration:.1f} s; "
+        f"the reference grating moved {fit.span * 1e12:.1f} pm)",
+        f"  grating  ratio   ({pct}% CI)          residual: configured  calibrated",
+    ]
+    for label, line, c, rc, rf in zip(
+        fit.labels,
+        fit.lines,
+        fit.configured,
+        fit.residual_configured,
+        fit.residual_calibrated,
+        strict=True,
+    ):
+        lo, hi = line.ci
+        out.append(
+            f"  {label:<7}  {line.k_eps:.5f} ({lo:.5f} .. {hi:.5f})  "
+            f"{rc * 1e12:8.2f} pm ({c:.4f})  {rf * 1e12:6.2f} pm"
+        )
+    out += [f"  config: {line}" for line in fit.config_lines(stack)]
+    return out
 
 
 def _compliance(files: list[Path], args: argparse.Namespace) -> int:

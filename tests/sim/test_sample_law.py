@@ -150,6 +150,7 @@ SCENES = [
         "inclusions/*.yaml",
         "layers/*.yaml",
         "lung/*.yaml",
+        "invivo/*.yaml",
         "maps/*.yaml",
         "oblique/*.yaml",
         "viscoelastic/*.yaml",

@@ -1,0 +1,38 @@
+"""A free sensor's record through a scene's temperature change, as raw board frames: what a lab
+records with ``cat /dev/ttyACM0 > insertion.bin`` while the sensor enters the body (or with
+``palpate emulate --scene ...`` on the printed board port), for ``palpate calibrate --thermal``.
+
+The emulated bench (:class:`palpate.simulation.twin.SimulatedBench`) at its power-up pose (the
+sensor retracted, touching nothing) sampled on the virtual clock: the scene's
+``fidelity.temperature`` and drift, each grating's true thermal shift, the interrogator's noise.
+
+Usage::
+
+    data = insertion_frames(load_stack("robot-lung-invivo.yaml"),
+                            load_scene("scenes/invivo/temperature.yaml"), seconds=30)
+    Path("insertion.bin").write_bytes(data)
+"""
+
+from __future__ import annotations
+
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.simulation.twin import SimulatedBench
+from palpate.wire.frame import encode, frame_from_si
+
+
+def insertion_frames(
+    stack: StackConfig, scene: SceneConfig, *, seconds: float, rate_hz: float = 250.0, seed: int = 0
+) -> bytes:
+    """``seconds`` of frames at ``rate_hz`` from the free sensor of ``stack`` in ``scene``."""
+    bench = SimulatedBench(stack, scene, wire=False, seed=seed)
+    world = bench.world
+    out = bytearray()
+    for k in range(round(seconds * rate_hz)):
+        t = k / rate_hz
+        s = world.sample(t)
+        frame = frame_from_si(
+            k, t, s.encoder, list(s.wavelengths), reference=s.reference, force=s.force, tip=s.tip
+        )
+        out += encode(frame)
+    return bytes(out)
