@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
+from .breathing import BreathingConfig
 from .faults import FaultsConfig
 from .loader import limits
 from .optics import MM, PM, UE
@@ -43,6 +44,9 @@ class FidelityConfig:
     # An insertion's temperature step and each grating's own thermal shift (config/thermal.py);
     # null: one coefficient for every grating, the drift alone.
     temperature: TemperatureConfig | None = None
+    # The surface's motion with the breath, the ventilator's holds and the heart
+    # (config/breathing.py); null: the tissue stands still.
+    breathing: BreathingConfig | None = None
     # The tissue's force law (sim/sample_law.py): "fe", each sample's own finite-element table
     # (sim/fem; independent of the estimator, so the default: a world that shares the
     # estimator's model measures self-consistency, not accuracy; tables of the shipped scenes
@@ -129,6 +133,13 @@ class CampaignConfig:
     # bench stage. "measure": touch, fit and log the misalignment, but indent as planned.
     probe: bool | Literal["measure"] | None = None
     misalignment_tolerance_deg: float = field(default=2.0, metadata=limits(gt=0, le=45))
+    # The surface's motion along the axis a trial tolerates between the first touch and the
+    # release, measured from the tip grating (estimation/motion.py: breathing, the heart); a
+    # trial that moved more is not ok. null: not checked.
+    motion_tolerance_mm: float | None = field(default=None, metadata=limits(gt=0, le=50))
+    # "board": wait at the stand-off for the ventilator's breath hold (frame status bit 6, the
+    # world's fidelity.breathing.gate), indent within it (robot/indentation.py); "none": go.
+    gate: Literal["none", "board"] = "none"
     # The orthogonal contact must lie this close to where the plan aimed (on the sample).
     miss_tolerance_mm: float = field(default=30.0, metadata=limits(gt=0, le=500))
     probe_points: int = field(default=4, metadata=limits(ge=3, le=9))  # touches; >= 5: spheres
@@ -176,6 +187,7 @@ class CampaignConfig:
     detector_threshold = SI("detector_threshold_ue", UE)  # strain
     outlier_above = SI("outlier_above_kpa", 1e3)  # Pa
     misalignment_tolerance = SI("misalignment_tolerance_deg", math.pi / 180)  # rad
+    motion_tolerance = SIOptional("motion_tolerance_mm", MM)  # m
     miss_tolerance = SI("miss_tolerance_mm", MM)
     probe_sagitta = SI("probe_sagitta_mm", MM)
     probe_touch = SI("probe_touch_ue", UE)

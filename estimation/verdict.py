@@ -96,6 +96,9 @@ class TrialFacts:
         bow: the beam's bow w0/L fitted against the tip grating's load (Southwell), None
             without one (a bow fitted against the strains' own load is not independent).
         probe_reason: what probing said when it measured no normal, None if not known.
+        motion: the surface's displacement along the axis between the first touch and the
+            release (m, ``estimation.motion``), None if not measured.
+        motion_tolerance: the campaign's tolerance on it (m), None: not checked.
     """
 
     state: str = "done"
@@ -113,8 +116,13 @@ class TrialFacts:
     buckling_tip_load: float | None = None
     bow: float | None = None
     probe_reason: str | None = None
+    motion: float | None = None
+    motion_tolerance: float | None = None
 
 
+MOTION_SHARE = 0.04
+"""The surface's motion during a contact, as a share of the fitted indentation, past which the
+trial is not ok (with ``motion_tolerance`` set): about 6 % of the modulus (docs/breathing.md)."""
 EARLY_BUCKLING = 0.5
 """A buckling mark at a tip load below this share of P_cr was not the tissue's buckling."""
 BOW_LIMIT = 0.01
@@ -144,6 +152,9 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
     if imprecise is not None:
         reasons.append(imprecise)
     reasons += _trial_reasons(facts)
+    moved = _moved(fit, facts)
+    if moved is not None:
+        reasons.append(moved)
     if facts.relaxation is not None and facts.relaxation.relaxes:
         reasons += [w for w in facts.relaxation.warnings if w.startswith(CONTRADICTED)]
         reasons.append(
@@ -218,6 +229,26 @@ def _trial_reasons(facts: TrialFacts) -> list[str]:
     if facts.state != "done":
         reasons.append(f"the trial ended in {facts.state}: {facts.reason}")
     return reasons
+
+
+def _moved(fit: JointFit, facts: TrialFacts) -> str | None:
+    """Why the surface's motion during the contact (``facts.motion``) is too much, None if it
+    is not (or is not checked): past the campaign's tolerance, or past MOTION_SHARE of the
+    fitted indentation (the modulus moves by about 1.5 times that share)."""
+    moved, tol = facts.motion, facts.motion_tolerance
+    if moved is None or tol is None:
+        return None
+    limit, what = tol, f"the campaign's {tol * 1e3:g} mm tolerance"
+    if fit.max_depth is not None and MOTION_SHARE * fit.max_depth < limit:
+        limit = MOTION_SHARE * fit.max_depth
+        what = f"{MOTION_SHARE:.0%} of the {fit.max_depth * 1e3:.2f} mm indentation"
+    if abs(moved) <= limit:
+        return None
+    toward = "toward" if moved > 0 else "away from"
+    return (
+        f"moved: the surface moved {abs(moved) * 1e3:.2f} mm {toward} the sensor between the "
+        f"first touch and the release, over {what} (breathing, the heart?)"
+    )
 
 
 def _orientation(facts: TrialFacts) -> list[str]:

@@ -10,7 +10,7 @@ time (the simulator runs faster than real time; a person watches at the screen's
 only while a client listens:
 
 - ``/joint_states`` and ``/fbg/strains`` (JSON): the stage translation and roll, the state, the
-  used gratings' strains, the contact event;
+  used gratings' strains, the contact event, the ventilator's breath hold (frame status bit 6);
 - ``/tip/force`` (JSON): the axial load and the beam's end shortening from the strains (the
   estimator's beam state of that tick, ``estimation.beamstate``); the load is the tip force
   grating's where the sensor has one;
@@ -96,6 +96,7 @@ def _schema(properties: dict[str, str]) -> dict[str, Any]:
         "string": {"type": "string"},
         "boolean": {"type": "boolean"},
         "numbers": {"type": "array", "items": {"type": "number"}},
+        "gate": {"type": ["boolean", "null"]},  # null: no frame yet
     }
     return {"type": "object", "properties": {k: kinds[v] for k, v in properties.items()}}
 
@@ -129,7 +130,14 @@ class LiveView:
         )
         self.strains = foxglove.Channel(
             "/fbg/strains",
-            schema=_schema({"state": "string", "strain": "numbers", "contact": "boolean"}),
+            schema=_schema(
+                {
+                    "state": "string",
+                    "strain": "numbers",
+                    "contact": "boolean",
+                    "breath_hold": "gate",
+                }
+            ),
             context=ctx,
         )
         self.force = foxglove.Channel(
@@ -215,7 +223,12 @@ class _Feed:
         if v.joints.has_sinks():
             v.joints.log({"stage_translation": obs.advance, "outer_roll": obs.roll}, log_time=stamp)
         if v.strains.has_sinks():
-            message = {"state": state.value, "strain": list(obs.strains), "contact": obs.contact}
+            message = {
+                "state": state.value,
+                "strain": list(obs.strains),
+                "contact": obs.contact,
+                "breath_hold": obs.gate,
+            }
             v.strains.log(message, log_time=stamp)
         wanted = v.force.has_sinks() or v.tf.has_sinks() or v.scene.has_sinks()
         if not wanted or not all(math.isfinite(x) for x in (obs.advance, obs.roll)):

@@ -39,6 +39,8 @@ class Observation:
     # s since the servos last answered: > 0 on a tick whose read was missed (the joints are
     # then the last ones read; the rig holds the motion until the bus answers again)
     joints_age: float = 0.0
+    # the ventilator's breath-hold gate in the newest frame (status bit 6); None: no frame yet
+    gate: bool | None = None
 
     @property
     def measured_advance(self) -> float:

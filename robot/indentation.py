@@ -7,8 +7,13 @@ touches hardware, so the same machine runs on the bench, on the emulators and in
 
 States and the normal path::
 
-    IDLE -> HOMING -> POSITIONING -> APPROACH -> CONTACT -> INDENTING -> BUCKLED
+    IDLE -> HOMING -> POSITIONING [-> WAITING] -> APPROACH -> CONTACT -> INDENTING -> BUCKLED
          [-> HOLDING] -> RETRACTING -> DONE
+
+With ``TrialPlan.gated`` the machine waits at the stand-off (WAITING) for a breath hold: the
+ventilator's gate (``Observation.gate``) rising no more than ``gate_fresh`` before (a hold
+already under way has an end nobody knows), then approaches and indents within it; the gate
+falling before the indentation is over retracts, ending in FAULT (the tissue moves again).
 
 With ``TrialPlan.hold_time`` > 0 the stage then stands still that long: the buckled beam is
 nearly a constant-force spring, so the hold is a creep test the gratings record
@@ -65,7 +70,9 @@ __all__ = [
 
 
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
-AT_REST = frozenset({State.HOMING, State.POSITIONING})  # no tissue can be near: a RestCheck
+WAIT_CONFIRM = 3  # ticks a contact holds while WAITING before the rest check takes it
+AT_REST = frozenset({State.HOMING, State.POSITIONING, State.WAITING})  # no tissue: a RestCheck
+GATED = frozenset({State.APPROACH, State.CONTACT, State.INDENTING, State.BUCKLED, State.HOLDING})
 
 
 @dataclass
@@ -87,6 +94,8 @@ class IndentationMachine:
     _first_touch: float | None = None  # advance at the first contact event, planned or not
     _lost_since: float | None = None  # time the servo replies were lost while retracting
     _rest: RestCheck = field(default_factory=lambda: RestCheck(REZERO_SETTLE_TICKS))
+    _gate: tuple[bool, float | None] = (True, None)  # the gate last seen, the time it rose
+    _contact_ticks: int = 0  # successive ticks with a contact
     # how the trial will end once retracted: set with the reason, never read back from its text
     ending: State = State.FAULT
 
@@ -110,6 +119,9 @@ class IndentationMachine:
         """Advance the machine by one tick and return the goal to send to the drive."""
         if self.state is State.IDLE:
             self.start(obs.t)
+        if obs.gate is not None:
+            open_, rose = self._gate
+            self._gate = (obs.gate, obs.t if obs.gate and not open_ else rose)
         if not self.finished:
             self._check_guards(obs)
         cmd = self._held(obs) or _HANDLERS[self.state](self, obs)
@@ -161,12 +173,23 @@ class IndentationMachine:
         if in_contact_phase and obs.stream_age > self.guards.stream_timeout:
             self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
             return
+        if self.plan.gated and self.state in GATED and not obs.gate:
+            self._fault(obs, f"the breath hold ended during {self.state.value}")
+            return
         violation = limit_violation(self.guards, obs, self.marks.x_contact)
         if violation is not None:
             self._fault(obs, violation)
             return
-        if obs.contact and self.state in AT_REST and not self._rest.seen():  # after a re-zero
+        if self._waited_contact(obs) and self.state in AT_REST and not self._rest.seen():
             self._fault(obs, f"unexpected contact during {self.state.value} ({self._rest})")
+
+    def _waited_contact(self, obs: Observation) -> bool:
+        """A contact at rest; while WAITING (a breath cycle at most: thousands of frames, where
+        a zero's noise crosses the threshold on a frame or two) one held WAIT_CONFIRM ticks."""
+        self._contact_ticks = self._contact_ticks + 1 if obs.contact else 0
+        if self.state is not State.WAITING:
+            return obs.contact
+        return self._contact_ticks >= WAIT_CONFIRM
 
     def _fault(self, obs: Observation, reason: str, *, retract: bool = True) -> None:
         self.marks.reason, self.ending = reason, State.FAULT
@@ -222,11 +245,24 @@ class IndentationMachine:
                 rezero = self._settle > REZERO_SETTLE_TICKS
                 self._settle = -1 if rezero else self._settle
                 return Command(target, p.roll, 0.0, rezero=rezero)
+            if p.gated:
+                self._go(State.WAITING, obs.t, "at stand-off", obs.advance, obs.strains)
+                return self._waiting(obs)
             self._go(State.APPROACH, obs.t, "at stand-off", obs.advance, obs.strains)
             return Command(target, p.roll, p.approach_speed)
         # Roll first with the sensor back, then advance: never sweep the tip sideways near tissue.
         goal = target if at_roll else min(obs.advance, target)
         return Command(goal, p.roll, p.fast_speed)
+
+    def _waiting(self, obs: Observation) -> Command:
+        """Hold at the stand-off until a breath hold begins (its gate rose just now)."""
+        p = self.plan
+        target = p.contact_advance - p.standoff
+        rose = self._gate[1]
+        if obs.gate and rose is not None and obs.t - rose <= p.gate_fresh:
+            self._go(State.APPROACH, obs.t, "breath hold", obs.advance, obs.strains)
+            return Command(target, p.roll, p.approach_speed)
+        return Command(target, p.roll, 0.0)
 
     def _approach(self, obs: Observation) -> Command:
         p, g = self.plan, self.guards
@@ -333,6 +369,7 @@ class IndentationMachine:
 _HANDLERS: dict[State, Callable[[IndentationMachine, Observation], Command]] = {
     State.HOMING: IndentationMachine._homing,
     State.POSITIONING: IndentationMachine._positioning,
+    State.WAITING: IndentationMachine._waiting,
     State.PROBING: IndentationMachine._probe_step,
     State.APPROACH: IndentationMachine._approach,
     State.CONTACT: IndentationMachine._contact,

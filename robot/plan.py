@@ -16,6 +16,7 @@ class State(enum.Enum):
     IDLE = "idle"
     HOMING = "homing"
     POSITIONING = "positioning"
+    WAITING = "waiting"
     PROBING = "probing"
     APPROACH = "approach"
     CONTACT = "contact"
@@ -49,6 +50,10 @@ class TrialPlan:
     roll_tolerance: float = 2e-3
     position_tolerance: float = 5e-6
     hold_time: float = 0.0  # s at rest after the post-buckling travel (a creep test); 0: none
+    # wait at the stand-off for a breath hold (the ventilator's gate, Observation.gate) that
+    # began at most ``gate_fresh`` s before, indent within it; the hold's end ends the trial
+    gated: bool = False
+    gate_fresh: float = 1.0
 
 
 @dataclass(frozen=True)

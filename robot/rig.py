@@ -197,6 +197,7 @@ class ServoFbgRig:
             twist=self._twist,
             tip_force=tip_force,
             joints_age=age,
+            gate=None if self._frame is None else bool(self._frame.flags & Status.BREATH_HOLD),
         )
 
     def _tip_force(self, f: Frame) -> float | None:

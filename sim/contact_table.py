@@ -102,6 +102,16 @@ def equilibrium_on_grid(
     return out
 
 
+class ContactGrid(NamedTuple):
+    """The grid solver of one contact's physics (a :class:`GridSolver`)."""
+
+    physics: GridPhysics
+
+    def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
+        grid = tuple(np.asarray(u, dtype=np.float64).tolist())
+        return equilibrium_on_grid(self.physics, grid, length)
+
+
 def grating_strains(
     physics: GridPhysics, beam: Beam, P: NDArray[np.float64], R: NDArray[np.float64]
 ) -> NDArray[np.float64]:

@@ -6,8 +6,10 @@ sensor with the injected forward kinematics, and solves the quasi-static contact
 axis (:mod:`sim.equilibrium`) with the tissue's own force law (:mod:`sim.tissue`), which is not the
 estimator's Hertz model, tabulated along the trial's path (:mod:`sim.contact_table`, which
 also turns the beam state into grating strains). From the beam state it makes what the hardware
-would send: peak wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and temperature drift),
-the force scale reading and the contact event. Gratings still inside the tube read 0.
+would send: peak wavelengths (Eq. 1 with Eq. 3 and Eq. 12, plus noise and the temperature:
+:mod:`sim.readout`), the force scale reading, the contact event, the ventilator's breath-hold
+gate. Gratings still inside the tube read 0. With ``breathing`` the surface moves along its
+normal on the clock (:mod:`sim.breathing`), so the contact is looked up at every sample.
 
 Only what the scene switches on is computed (:class:`config.scene.FidelityConfig`). The tissue's
 force law is the sample's own (:mod:`sim.sample_law`: its finite-element table, or the closed
@@ -36,8 +38,9 @@ from ..estimation.section import Section
 from ..estimation.surface import SurfaceGeometry
 from ..wire.frame import Status
 from .board import BoardSample
+from .breathing import Breath
 from .contact_history import ViscoelasticContact
-from .contact_table import ContactTable, GridPhysics, Vector, equilibrium_on_grid
+from .contact_table import ContactGrid, ContactTable, GridPhysics, Vector, equilibrium_on_grid
 from .equilibrium import ContactEffects, TissueLaw
 from .gravity import BeamWeight, offset_to_mode, sensing_axis
 from .oblique import ObliqueContact
@@ -51,6 +54,7 @@ JointsFn = Callable[[], tuple[float, float, int]]  # -> (roll rad, translation m
 CONTACT_EVENT = Status.CONTACT_EVENT
 _CONTACT_FLAG = int(Status.CONTACT_EVENT)  # int() of an IntFlag costs ~0.3 us per sample
 _FORCE_FLAG = int(Status.FORCE_VALID)
+_HOLD_FLAG = int(Status.BREATH_HOLD)
 
 
 COARSE_BIN_STEPS = 50  # grid steps in a bin of a coarse contact grid at a fixed length
@@ -77,16 +81,6 @@ class Contact:
     misalignment: float
     sticks: bool
     imperfection: float
-
-
-class _ContactGrid(NamedTuple):
-    """The grid solver of one contact's physics (a :class:`sim.contact_table.GridSolver`)."""
-
-    physics: GridPhysics
-
-    def solve_on_grid(self, u: Vector, length: float) -> tuple[Vector, ...]:
-        grid = tuple(np.asarray(u, dtype=np.float64).tolist())
-        return equilibrium_on_grid(self.physics, grid, length)
 
 
 class WorldState(NamedTuple):
@@ -170,6 +164,9 @@ class World:
         self._from_tip = grating_ends(self._centres, sensor.grating_length)  # gravity's sag
         self._tables: dict[float, ContactTable] = {}
         self.relaxation = relaxation
+        self.breath = Breath.of(fidelity.breathing, rng)  # None: the tissue stands still
+        self._moving, self._lift = relaxation is not None or self.breath is not None, 0.0
+        self.moved: tuple[float, float] | None = None  # the surface's lift range in contact (m)
         self._histories: dict[float, ViscoelasticContact] = {}
         self._now = 0.0  # the time of the sample being computed
         self._contact_at: dict[float, Contact] = {}
@@ -193,8 +190,9 @@ class World:
     # -- physics ------------------------------------------------------------------------------
     def state(self, t: float) -> WorldState:
         joints = self.joints()
-        if joints != self._joints or self.relaxation is not None:  # a history moves with time
+        if joints != self._joints or self._moving:  # a history or the breath moves with time
             self._now = t
+            self._lift = 0.0 if self.breath is None else self.breath.lift(t)
             self._physics = self._physics_at(joints[0], joints[1])
             self._joints = joints
         roll, translation, encoder = joints
@@ -210,6 +208,8 @@ class World:
         strains = self._free if self.weight is None else self._sag(roll, tangent, length)
         delta = e = P = R = 0.0
         if past > 0.0 and length > 0.0:
+            lo, hi = self.moved or (self._lift, self._lift)
+            self.moved = (min(lo, self._lift), max(hi, self._lift))
             table = self._tables.get(roll)
             if table is None:
                 table = self._new_table(roll, tangent, length, past, normal)
@@ -237,11 +237,11 @@ class World:
         n = self._surface.normal
         if self._surface.radius is None:
             cos_a = -float(tangent @ n)  # 1 when the sensor points straight into the surface
-            centre_height = float((tip - self._surface.point) @ n) - length * cos_a
+            centre_height = float((tip - self._surface.point) @ n) - self._lift - length * cos_a
             past = (self._tip_radius - centre_height) / cos_a if cos_a > 0.05 else -math.inf
             return past, n
         s = self._surface
-        offset = SurfaceGeometry(s.point, n, s.radius).offset(self._tip_radius)
+        offset = SurfaceGeometry(s.point + self._lift * n, n, s.radius).offset(self._tip_radius)
         centre = tip + length * tangent
         ahead = offset.ray_hit(centre, tangent)
         if not math.isfinite(ahead):
@@ -295,7 +295,7 @@ class World:
         # 20 um ones
         wide = 1e-3 if lattice is None else max(1e-3, COARSE_BIN_STEPS * lattice[0])
         table = ContactTable(
-            _ContactGrid(physics),
+            ContactGrid(physics),
             contact_length,
             self.length_grows,
             lattice=lattice,
@@ -362,6 +362,8 @@ class World:
         st = self.state(t)
         wavelengths, reference, tip = self.readout.read(st.strains, st.P, t, self.rng)
         flags = _CONTACT_FLAG if st.contact_event else 0
+        if self.breath is not None and self.breath.config.gate and self.breath.holding(t):
+            flags |= _HOLD_FLAG
         force = None
         if self.has_force:
             force = st.P

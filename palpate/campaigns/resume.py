@@ -121,6 +121,7 @@ def _restore_probe(outcome: TrialOutcome, log: TrialLog) -> None:
     world = next(log.of_kind("world"), None)
     if world is not None:
         outcome.true_misalignment = world["true_misalignment"]
+        outcome.true_motion = world.get("true_motion")
 
 
 OPTIONAL = frozenset({"normal", "radius"})  # ProbeResult's fields that may be None

@@ -68,6 +68,7 @@ def render(
         f"norm       {view.strain_norm * 1e6:8.1f} ue   limit {view.strain_limit * 1e6:.0f} ue"
         f"   FBG stream {stream}",
         *([] if view.tip_force is None else [f"tip load   {view.tip_force * 1e3:8.3f} mN"]),
+        *([] if view.gate is None else [f"breath     {'HELD' if view.gate else 'moving'}"]),
         f"contact    {_flag(view.contact)} buckled {_flag(view.buckled)}"
         f" past contact {_mm(past, 6)} / {view.travel_limit * 1e3:.2f} mm",
         f"fault      {view.fault or '-'}",

@@ -28,6 +28,7 @@ from palpate.robot.trial.estimate import (
     estimate_from_marks,
     exposed_length_at,
     fit_rows,
+    record_motion,
     tip_load_at_buckling,
     verdict_for,
 )
@@ -159,6 +160,7 @@ def _replay_joint(
             fitted.relaxation,
             tip_load_at_buckling(rows, tips),
             fitted.tip_bow,
+            record_motion(rows, tips),
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

@@ -37,6 +37,7 @@ class TrialOutcome(Outcome):
     series: dict[str, list[float]] = field(default_factory=dict)
     misalignment: float = 0.0  # rad, what the estimator was told (probing's, or the IK's)
     true_misalignment: float | None = None  # rad, the world's at the indentation (sim truth)
+    true_motion: float | None = None  # m, the surface's breathing range in contact (sim truth)
     probe: ProbeResult | None = None
     probing_time: float = 0.0  # simulated s in the probing step
 
@@ -64,6 +65,7 @@ class TrialOutcome(Outcome):
             "ik_residual_deg": math.degrees(self.ik_residual),
             "misalignment_deg": math.degrees(self.misalignment),
             "true_misalignment_deg": _deg(self.true_misalignment),
+            "true_motion_mm": None if self.true_motion is None else self.true_motion * 1e3,
             "probe": None if self.probe is None else self.probe.summary(),
             "strain_lean": None if self.lean is None else self.lean.as_dict(),
             "probing_s": self.probing_time,
@@ -165,6 +167,7 @@ def estimator_inputs(
         compliance=compliance,
         compliance_calibrated=calibrated,
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
+        motion_tolerance=c.motion_tolerance,
         travel_window=c.max_travel_past_contact,
         designed_range=stack.sensor.designed_range,
         rigid=sample.rigid,

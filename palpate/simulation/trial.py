@@ -209,12 +209,27 @@ def run_sim_trial(
                 on_tick=on_tick,
                 on_log=None if hook is None else hook.log_opened,
                 # the world's truth the controller never sees, for the report (and --resume)
-                before_estimate=lambda _: [{"kind": "world", "true_misalignment": _truth(world)}],
+                before_estimate=lambda _: [
+                    {
+                        "kind": "world",
+                        "true_misalignment": _truth(world),
+                        "true_motion": _moved(world),
+                    }
+                ],
             )
             done = run_session_trial(rig, clock, setup)
     outcome = outcome_of(spec, geo, done.result, done.estimate, done.log_path, series)
     outcome.true_misalignment = _truth(world)
+    outcome.true_motion = _moved(world)
     return outcome
+
+
+def _moved(world: World) -> float | None:
+    """How far the surface moved while the tip touched it (m; the range of its breathing
+    displacement), None for a world that does not breathe or a trial without contact."""
+    if world.breath is None or world.moved is None:
+        return None
+    return world.moved[1] - world.moved[0]
 
 
 def _truth(world: World) -> float | None:

@@ -195,6 +195,7 @@ ESTIMATOR = {  # robot.trial.estimate.EstimatorInputs
     "compliance": opt(numbers()),
     "compliance_calibrated": opt(boolean),
     "misalignment_tolerance": opt(number(null=True, ge=0, le=math.pi)),
+    "motion_tolerance": opt(number(null=True, gt=0)),
     "travel_window": opt(number(null=True, gt=0)),
     "rigid": opt(boolean),
     "orientation_verified": opt(boolean),  # absent before issue 25: verified
@@ -263,7 +264,10 @@ RECORDS: dict[str, dict[str, Field]] = {
     },
     "probe": PROBE,
     # a simulated trial's world truth, which the controller never sees (for reports, --resume)
-    "world": {"true_misalignment": opt(number(null=True, ge=0, le=math.pi))},
+    "world": {
+        "true_misalignment": opt(number(null=True, ge=0, le=math.pi)),
+        "true_motion": opt(number(null=True, ge=0)),
+    },
     "end": {
         "state": req(string()),
         "reason": req(string()),

@@ -120,3 +120,4 @@ class TeleopView:
     message: str
     prompt: str | None
     tip_force: float | None = None  # N, the tip force grating's load (None: no tip grating)
+    gate: bool | None = None  # the ventilator's breath hold now (None: no gate seen this session)

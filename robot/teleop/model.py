@@ -66,6 +66,7 @@ class Teleop:
     obs: Observation | None = None
     x_contact: float | None = None
     buckled: bool = False
+    gated: bool = False  # a breath-hold gate was seen open this session (the screen shows it)
     fault: str | None = None
     message: str = "ready"
     prompt: str | None = None
@@ -273,6 +274,7 @@ class Teleop:
     def step(self, obs: Observation) -> Command:
         """One control tick: track contact and buckling, apply the guards, return the goal."""
         self.obs = obs
+        self.gated = self.gated or bool(obs.gate)
         if self.goal is None:
             self.goal = JointState(obs.roll, obs.advance)
         if obs.contact:
@@ -383,6 +385,7 @@ class Teleop:
             message=self.message,
             prompt=self.prompt,
             tip_force=None if obs is None else obs.tip_force,
+            gate=None if obs is None or not self.gated else bool(obs.gate),
         )
 
 

@@ -42,6 +42,7 @@ from ...estimation.detect_contact import baseline_deviation
 from ...estimation.elastica.constants import P_CRIT
 from ...estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from ...estimation.misalignment import Lean
+from ...estimation.motion import Motion, surface_motion
 from ...estimation.relaxation import RelaxationFit
 from ...estimation.section import Section
 from ...estimation.southwell import SouthwellFit, southwell
@@ -66,6 +67,7 @@ __all__ = [
     "fit_record",
     "fit_rows",
     "loading_rows",
+    "record_motion",
     "tip_load_at_buckling",
     "verdict_for",
 ]
@@ -178,6 +180,8 @@ def fit_rows(
     each row's time (s) and a hold in the rows, the relaxation (``robot.trial.relaxed``). With
     each row's tip-grating load (N), the joint fit reads the load from it."""
     rows = list(rows)
+    if inputs.motion_tolerance is not None and times is not None:
+        rows = _still(rows, record_motion(rows, tip_forces, times), times)
     gratings = len(stack.sensor.used_gratings)
     advance, strains = loading_rows(rows, gratings)
     tip = _loading_tip(rows, tip_forces, gratings)
@@ -193,6 +197,19 @@ def fit_rows(
     return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
 
 
+def _still(
+    rows: list[tuple[str, float, Sequence[float]]],
+    motion: Motion | None,
+    times: Sequence[float],
+) -> list[tuple[str, float, Sequence[float]]]:
+    """The rows with the stage's advance taken against the surface, as if it stood where it
+    was at the first touch: the measured motion as an even drift (``Motion.velocity``)."""
+    if motion is None or motion.velocity == 0.0:
+        return rows
+    v, t0 = motion.velocity, motion.touch
+    return [(s, u + v * (t - t0), e) for (s, u, e), t in zip(rows, times, strict=True)]
+
+
 def tip_load_at_buckling(
     rows: Sequence[tuple[str, float, Sequence[float]]],
     tip_forces: Sequence[float | None] | None,
@@ -204,6 +221,18 @@ def tip_load_at_buckling(
         if state == "buckled":
             return None if f is None or not math.isfinite(f) else float(f)
     return None
+
+
+def record_motion(
+    rows: Sequence[tuple[str, float, Sequence[float]]],
+    tip_forces: Sequence[float | None] | None,
+    times: Sequence[float] | None = None,
+) -> Motion | None:
+    """The surface's motion along the axis over a record (``estimation.motion``), None without
+    a tip grating."""
+    if not tip_forces or len(tip_forces) != len(rows):
+        return None
+    return surface_motion([r[0] for r in rows], [r[1] for r in rows], tip_forces, times)
 
 
 def _loading_tip(
@@ -234,11 +263,13 @@ def verdict_for(
     relaxation: RelaxationFit | None = None,
     buckling_tip_load: float | None = None,
     bow: float | None = None,
+    motion: Motion | None = None,
 ) -> tuple[Verdict, Verdict | None]:
     """The trial's verdicts (``estimation.verdict``) from its fit, its inputs and how it ended:
     on the elastic estimate, and on the relaxed modulus when the trial held (else None).
     ``buckling_tip_load``: the tip grating's load at the buckling mark (N), None without one;
-    ``bow``: w0/L fitted against the tip grating's load (``RecordEstimate.tip_bow``)."""
+    ``bow``: w0/L fitted against the tip grating's load (``RecordEstimate.tip_bow``);
+    ``motion``: the surface's motion along the axis (m, :func:`record_motion`)."""
     length = inputs.exposed_length
     if joint is not None and joint.contact is not None:
         length = inputs.stage.exposed_length(joint.contact)
@@ -258,6 +289,8 @@ def verdict_for(
         probe_reason=inputs.probe_reason,
         buckling_tip_load=buckling_tip_load,
         bow=bow,
+        motion=None if motion is None else motion.moved,
+        motion_tolerance=inputs.motion_tolerance,
     )
     elastic = judge(joint, facts, inputs.contact_radius)
     return elastic, relaxed_verdict(relaxation, elastic, facts)
@@ -309,6 +342,8 @@ class TrialEstimate:
         relaxed_verdict: the verdict on the relaxed modulus, when the trial held.
         beam_loads: the axial load the joint fit's beam states gave each loading row, by row
             (``robot.trial.states.RowLoads``): the recording's tip force reuses them.
+        motion: the surface's motion along the axis between the first touch and the release
+            (m, :func:`record_motion`), None without a tip grating.
     """
 
     paper: StiffnessEstimate | None
@@ -322,6 +357,7 @@ class TrialEstimate:
     relaxation: RelaxationFit | None = None
     relaxed_verdict: Verdict | None = None
     beam_loads: RowLoads = dataclasses.field(default_factory=dict)
+    motion: float | None = None
 
 
 def estimate_trial(
@@ -352,6 +388,7 @@ def estimate_trial(
     fitted = fit_rows(result.record, inputs, stack, section, result.times, result.tip_forces)
     seconds = time.perf_counter() - start
     verdict, relaxed = None, None
+    motion = record_motion(result.record, result.tip_forces, result.times)
     if not inputs.rigid:
         state = result.state.value
         verdict, relaxed = verdict_for(
@@ -364,6 +401,7 @@ def estimate_trial(
             fitted.relaxation,
             tip_load_at_buckling(result.record, result.tip_forces),
             fitted.tip_bow,
+            motion,
         )
     return TrialEstimate(
         paper,
@@ -377,4 +415,5 @@ def estimate_trial(
         fitted.relaxation,
         relaxed,
         fitted.loads,
+        None if motion is None else motion.moved,
     )

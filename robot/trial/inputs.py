@@ -46,6 +46,8 @@ class EstimatorInputs:
         compliance: (min, max) compliance of the tube tip or stage (m/N).
         compliance_calibrated: False when ``compliance`` is the uncalibrated prior range.
         misalignment_tolerance: the campaign's tolerance (rad), None: not checked.
+        motion_tolerance: the surface's motion along the axis the campaign tolerates between
+            the first touch and the release (m, ``estimation.motion``), None: not checked.
         travel_window: the travel past contact allowed (m), None: unknown.
         orientation_verified: False when probing ran and could not measure a normal (a
             straight tube): the misalignment told is then not known.
@@ -82,6 +84,7 @@ class EstimatorInputs:
     designed_range: Range | None = None
     probe_reason: str | None = None
     surface_radius: float | None = None
+    motion_tolerance: float | None = None
     version: int = VERSION
 
     @property

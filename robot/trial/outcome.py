@@ -59,6 +59,7 @@ class Outcome:
     lean: Lean | None = None
     relaxation: RelaxationFit | None = None
     relaxed_verdict: Verdict | None = None
+    motion: float | None = None  # m, the surface's along the axis (estimation.motion)
 
     @property
     def status(self) -> str:
@@ -100,6 +101,7 @@ def outcome_fields(
         "lean": estimate.lean,
         "relaxation": estimate.relaxation,
         "relaxed_verdict": estimate.relaxed_verdict,
+        "motion": estimate.motion,
     }
 
 

@@ -141,6 +141,7 @@ class Estimated(Protocol):
     calibration: ComplianceFit | None
     relaxation: RelaxationFit | None
     relaxed_verdict: Verdict | None
+    motion: float | None
 
 
 def estimate_row(o: Estimated) -> dict[str, Any]:
@@ -161,6 +162,7 @@ def estimate_row(o: Estimated) -> dict[str, Any]:
         "paper_force_n": None if est is None else est.force,
         "calibration": None if o.calibration is None else o.calibration.as_dict(),
         **relaxed_row(o.relaxation, o.relaxed_verdict),
+        **({} if o.motion is None else {"motion_mm": o.motion * 1e3}),
     }
 
 

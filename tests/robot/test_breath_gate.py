@@ -1,0 +1,71 @@
+"""The breath-hold gate in the indentation machine (issue 42): a gated trial waits at the
+stand-off for a breath hold that has just begun, indents within it, and a hold that ends before
+the indentation does retracts it (a fault: the tissue moves again)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import pytest
+
+from palpate.robot.indentation import Guards, Observation, State, TrialPlan
+from palpate.robot.trial.run import run_trial
+from palpate.sim.clock import VirtualClock
+from tests.robot.test_indentation import ScriptedRig, ThresholdDetector, plan, states
+
+
+@dataclass
+class GatedRig(ScriptedRig):
+    """The scripted rig, with the ventilator's gate open while ``holds(t)``."""
+
+    holds: Callable[[float], bool] = lambda t: False
+
+    def observe(self, t: float) -> Observation:
+        obs = super().observe(t)
+        return Observation(**{**obs.__dict__, "gate": self.holds(t)})
+
+
+def hold_from(start: float, length: float, cycle: float = 100.0) -> Callable[[float], bool]:
+    return lambda t: start <= t % cycle < start + length
+
+
+def gated(rig: GatedRig, **kw: float) -> object:
+    return run_trial(rig, rig.clock, plan(gated=True, **kw), Guards(), ThresholdDetector())
+
+
+def test_the_trial_waits_for_a_hold_and_indents_within_it() -> None:
+    rig = GatedRig(VirtualClock(), holds=hold_from(12.0, 20.0))
+    result = gated(rig)
+    assert result.state is State.DONE, result.reason
+    assert states(result.transitions)[:4] == ["homing", "positioning", "waiting", "approach"]
+    approach = next(tr for tr in result.transitions if tr.target is State.APPROACH)
+    assert approach.t == pytest.approx(12.0, abs=0.01)  # the hold's first tick
+    assert approach.reason == "breath hold"
+    assert result.marks.t_contact is not None
+    assert 12.0 < result.marks.t_contact < 32.0
+
+
+def test_a_hold_under_way_at_the_stand_off_is_waited_out() -> None:
+    """Its end is not known: the machine waits for the next hold to begin."""
+    rig = GatedRig(VirtualClock(), holds=hold_from(0.0, 30.0, cycle=40.0))
+    result = gated(rig)
+    assert result.state is State.DONE, result.reason
+    approach = next(tr for tr in result.transitions if tr.target is State.APPROACH)
+    assert approach.t == pytest.approx(40.0, abs=0.01)
+
+
+def test_a_hold_that_ends_during_the_indentation_retracts_it() -> None:
+    rig = GatedRig(VirtualClock(), holds=hold_from(5.0, 4.0), x_buckle=1.0)  # never buckles
+    result = gated(rig)
+    assert result.state is State.FAULT
+    assert result.reason.startswith("the breath hold ended during ")
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)  # retracted home
+
+
+def test_an_ungated_plan_goes_without_waiting() -> None:
+    rig = GatedRig(VirtualClock(), holds=lambda t: False)
+    result = run_trial(rig, rig.clock, plan(), Guards(), ThresholdDetector())
+    assert result.state is State.DONE, result.reason
+    assert "waiting" not in states(result.transitions)
+    assert TrialPlan.gated is False

@@ -1,0 +1,50 @@
+"""Breathing in the world (issue 42): the surface's displacement along its normal with each
+breath, the ventilator's holds and their residual drift, the heart; the gate bit in the board's
+frames while a hold lasts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from palpate.config.breathing import BreathingConfig
+from palpate.sim.breathing import Breath
+from palpate.wire.frame import Status
+
+HELD = BreathingConfig(
+    amplitude_mm=2.0, period_s=4.0, hold_s=15.0, breaths=2, residual_mm=1.0, phase="start"
+)
+
+
+def test_a_breath_rises_to_its_amplitude_and_rests_at_expiration() -> None:
+    breath = Breath(HELD)
+    assert breath.lift(0.0) == pytest.approx(1e-3)  # the last hold's drift, being taken back
+    assert breath.lift(2.0) == pytest.approx(2e-3 + 0.75e-3)  # inspiration, 2 s into 8
+    assert not breath.holding(7.9)
+    assert breath.holding(8.0)
+    assert breath.lift(8.0) == pytest.approx(0.0, abs=1e-12)  # the hold starts at expiration
+    assert breath.lift(15.5) == pytest.approx(0.5e-3)  # drifting at an even rate
+    assert breath.holding(22.9)
+    assert not breath.holding(23.0)
+
+
+def test_the_motion_is_continuous() -> None:
+    breath = Breath(HELD)
+    t = np.arange(0.0, 3 * HELD.cycle, 1e-3)
+    lift = np.array([breath.lift(x) for x in t])
+    assert np.max(np.abs(np.diff(lift))) < 1e-5  # 10 um a millisecond at most
+
+
+def test_the_heart_beats_on_top_and_free_breathing_never_holds() -> None:
+    free = Breath(BreathingConfig(hold_s=0.0, cardiac_mm=1.0, cardiac_period_s=1.0, phase="start"))
+    assert free.config.cycle == 4.0
+    assert not any(free.holding(x) for x in np.arange(0.0, 20.0, 0.1))
+    assert free.lift(0.25) == pytest.approx(3e-3 * np.sin(np.pi / 16) ** 4 + 0.5e-3)
+
+
+def test_each_trial_starts_somewhere_in_the_cycle() -> None:
+    rng = np.random.default_rng(0)
+    phases = {Breath.of(HELD.__class__(hold_s=15.0), rng).phase for _ in range(5)}  # type: ignore[union-attr]
+    assert len(phases) == 5
+    assert Breath.of(None, rng) is None
+    assert Status.BREATH_HOLD == 1 << 6
