@@ -65,7 +65,8 @@ class TrialOutcome(Outcome):
             "ik_residual_deg": math.degrees(self.ik_residual),
             "misalignment_deg": math.degrees(self.misalignment),
             "true_misalignment_deg": _deg(self.true_misalignment),
-            "true_motion_mm": None if self.true_motion is None else self.true_motion * 1e3,
+            # a breathing world's only (sim truth): the surface's range while the tip touched it
+            **({} if self.true_motion is None else {"true_motion_mm": self.true_motion * 1e3}),
             "probe": None if self.probe is None else self.probe.summary(),
             "strain_lean": None if self.lean is None else self.lean.as_dict(),
             "probing_s": self.probing_time,
