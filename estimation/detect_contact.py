@@ -143,3 +143,15 @@ def ratio_of_variances(
     return ContactGuess(
         True, i, float(x[i]), "variance-ratio", sigma, f"contact at sample {i} (ratio {best:.3g})"
     )
+
+
+def difference_sigma(forces: ArrayLike) -> float:
+    """The noise of a record (a tip-force record's, N), from its successive differences
+    (median absolute deviation, so the load's own rise and a few outliers do not inflate it);
+    never below 1e-9."""
+    f = np.asarray(forces, dtype=np.float64)
+    if f.size < 3:
+        return 1e-9
+    d = np.diff(f)
+    mad = float(np.median(np.abs(d - np.median(d))))
+    return max(MAD_TO_SIGMA * mad / math.sqrt(2.0), 1e-9)

@@ -7,10 +7,11 @@ load. Breathing, the heart or a patient's motion moves the surface in between: t
 the release is then the advance at the first touch less the surface's displacement toward the
 sensor. So the motion is measured, not assumed: through a band of small loads
 (``LEVEL_SIGMAS``: 5 to 15 times the load's noise above its zero, both from the approach's
-records, the sensor free after the last zero) a line of advance against load on the way in
-(the first pass) and one on the way out (the retraction), the two advances at the band's
-middle load apart. A line through the band, not one crossing: one record's noise would move a
-crossing by its share of the band.
+records, the sensor free after the last zero; up to a quarter of the peak load at least, so a
+fast retraction from stiff tissue still leaves records in it) a line of advance against load
+on the way in (the first pass) and one on the way out (the retraction), the two advances at
+the band's middle load apart. A line through the band, not one crossing: one record's noise
+would move a crossing by its share of the band.
 
 It sees the net displacement between the two instants; motion that comes back by the release
 shows in the fit's residuals instead. Tissue that relaxes and recovers slowly releases early,
@@ -31,9 +32,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..sensor.tipforce import force_sigma
+from .detect_contact import difference_sigma
 
 LEVEL_SIGMAS = (5.0, 15.0)  # the band of loads read, in the load's noise above its zero
+PEAK_SHARE = 0.25  # the band reaches this share of the peak load at least (a fast retraction
+# passes a stiff tissue's 15 sigma in a record or two)
 FREE_ROWS = 5  # the approach's records the zero and the noise need at least
 FREE_STATE = "approach"
 OUT_STATE = "retracting"
@@ -49,12 +52,19 @@ class Motion:
     moved: float
     touch: float = math.nan
     release: float = math.nan
+    sigma: float = 0.0  # m, the standard error of ``moved`` from the two lines' scatter
 
     @property
     def velocity(self) -> float:
         """m/s toward the sensor, as an even drift between the two (0 without their times)."""
         span = self.release - self.touch
         return self.moved / span if span > 0 else 0.0
+
+    @property
+    def velocity_sigma(self) -> float:
+        """The standard error of :attr:`velocity` (m/s)."""
+        span = self.release - self.touch
+        return self.sigma / span if span > 0 else 0.0
 
 
 def surface_motion(
@@ -74,8 +84,9 @@ def surface_motion(
     free = f[keep & (s == FREE_STATE)]
     if free.size < FREE_ROWS:
         return None
-    zero, sigma = float(np.median(free)), max(force_sigma(free), float(free.std()))
+    zero, sigma = float(np.median(free)), max(difference_sigma(free), float(free.std()))
     lo, hi = (zero + k * sigma for k in LEVEL_SIGMAS)
+    hi = max(hi, zero + PEAK_SHARE * (float(np.max(f[keep])) - zero))
     band = keep & (f >= lo) & (f <= hi)
     out = s == OUT_STATE
     before_out = np.arange(s.size) < (int(np.argmax(out)) if out.any() else s.size)
@@ -87,17 +98,23 @@ def surface_motion(
     if np.count_nonzero(loading) < MIN_ROWS or np.count_nonzero(unloading) < MIN_ROWS:
         return None
     middle = 0.5 * (lo + hi)
-    moved = _at(u[loading], f[loading], middle) - _at(u[unloading], f[unloading], middle)
+    (u_in, se_in), (u_out, se_out) = (_at(u[b], f[b], middle) for b in (loading, unloading))
+    sigma = math.hypot(se_in, se_out)
     if times is None:
-        return Motion(moved)
-    return Motion(
-        moved, _at(t[loading], f[loading], middle), _at(t[unloading], f[unloading], middle)
-    )
+        return Motion(u_in - u_out, sigma=sigma)
+    touch, release = (_at(t[b], f[b], middle)[0] for b in (loading, unloading))
+    return Motion(u_in - u_out, touch, release, sigma)
 
 
-def _at(x: np.ndarray, f: np.ndarray, load: float) -> float:
-    """x (the advance, or the time) at ``load`` on the line through a branch's (load, x)."""
+def _at(x: np.ndarray, f: np.ndarray, load: float) -> tuple[float, float]:
+    """x (the advance, or the time) at ``load`` on the line through a branch's (load, x),
+    and its standard error from the line's scatter (0 with too few records for one)."""
     if np.ptp(f) <= 0:
-        return float(np.mean(x))
+        return float(np.mean(x)), 0.0
     slope, intercept = np.polyfit(f, x, 1)
-    return float(intercept + slope * load)
+    n = f.size
+    if n <= 2:
+        return float(intercept + slope * load), 0.0
+    scatter = float(np.sum((x - intercept - slope * f) ** 2)) / (n - 2)
+    leverage = 1.0 / n + (load - f.mean()) ** 2 / float(np.sum((f - f.mean()) ** 2))
+    return float(intercept + slope * load), math.sqrt(scatter * leverage)

@@ -13,14 +13,12 @@ reference grating's shift, ``S_T,ref dT``, scaled by ``S_T,tip / S_T,ref``, is t
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..config.schema import FbgConfig, TipGratingConfig
-from ..estimation.detect_contact import MAD_TO_SIGMA
 
 FloatArray = NDArray[np.float64]
 
@@ -96,17 +94,6 @@ class TipForceChain:
         if self.zero is None:
             raise ValueError("tip grating: no zero; call zeroed() on samples at rest first")
         return self.zero
-
-
-def force_sigma(forces: ArrayLike) -> float:
-    """The noise (N) of a tip-force record, from its successive differences (median absolute
-    deviation, so the load's own rise and a few outliers do not inflate it); never below 1e-9."""
-    f = np.asarray(forces, dtype=np.float64)
-    if f.size < 3:
-        return 1e-9
-    d = np.diff(f)
-    mad = float(np.median(np.abs(d - np.median(d))))
-    return max(MAD_TO_SIGMA * mad / math.sqrt(2.0), 1e-9)
 
 
 def tip_chain(tip: TipGratingConfig | None, fbg: FbgConfig) -> TipForceChain | None:

@@ -158,13 +158,10 @@ class World:
         self._free = (0.0,) * len(self._centres)
         self.length_grows = length_grows
         self.encoder_step = encoder_step
-        self.friction = friction
-        self.poisson = poisson
-        self.weight = weight
+        self.friction, self.poisson, self.weight = friction, poisson, weight
         self._from_tip = grating_ends(self._centres, sensor.grating_length)  # gravity's sag
         self._tables: dict[float, ContactTable] = {}
-        self.relaxation = relaxation
-        self.breath = Breath.of(fidelity.breathing, rng)  # None: the tissue stands still
+        self.relaxation, self.breath = relaxation, Breath.of(fidelity.breathing, rng)
         self._moving, self._lift = relaxation is not None or self.breath is not None, 0.0
         self.moved: tuple[float, float] | None = None  # the surface's lift range in contact (m)
         self._histories: dict[float, ViscoelasticContact] = {}

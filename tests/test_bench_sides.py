@@ -9,7 +9,7 @@ import pytest
 
 import palpate.robot.trial.run
 import palpate.robot.trial.session
-import palpate.sim.world
+import palpate.sim.contact_table
 from palpate.benchmarks.sides import (
     BOUNDARIES,
     CONTROL,
@@ -50,7 +50,7 @@ def _hooked() -> tuple[object, ...]:
     return (
         VirtualClock.__dict__["advance"],
         EmulatedBus.__dict__["exchange"],
-        palpate.sim.world.equilibrium_on_grid,
+        palpate.sim.contact_table.equilibrium_on_grid,
         palpate.robot.trial.session.run_trial,
         palpate.robot.trial.run._tick,
     )

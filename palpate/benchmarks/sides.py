@@ -76,7 +76,7 @@ BOUNDARIES = (
         "palpate.sim.dynamixel.bus:EmulatedBus", "exchange", "emulated bus requests", SIMULATOR
     ),
     Boundary("palpate.sim.inprocess:FramePipe", "take_frames", "frame pipe", SIMULATOR),
-    Boundary("palpate.sim.world", "equilibrium_on_grid", "contact tables", SIMULATOR),
+    Boundary("palpate.sim.contact_table", "equilibrium_on_grid", "contact tables", SIMULATOR),
     Boundary("palpate.robot.trial.session", "run_trial", "trial loop", CONTROL),
     Boundary("palpate.robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
     Boundary("palpate.robot.records.recording:McapRecorder", "write", "MCAP recording", CONTROL),

@@ -28,11 +28,11 @@ from palpate.robot.trial.estimate import (
     estimate_from_marks,
     exposed_length_at,
     fit_rows,
-    record_motion,
     tip_load_at_buckling,
     verdict_for,
 )
 from palpate.robot.trial.inputs import VERSION, probe_inputs
+from palpate.robot.trial.motion import record_motion
 from palpate.robot.trial.record import estimator_keys
 
 MAX_PROBLEMS = 5  # bad lines named in the message (all are counted)
@@ -149,12 +149,11 @@ def _replay_joint(
     end = log.end or {}
     verdict, relaxed = None, None
     if not inputs.rigid:
-        state, reason = str(end.get("state")), str(end.get("reason"))
         verdict, relaxed = verdict_for(
             fitted.joint,
             inputs,
-            state,
-            reason,
+            str(end.get("state")),
+            str(end.get("reason")),
             section,
             fitted.lean,
             fitted.relaxation,

@@ -209,19 +209,18 @@ def run_sim_trial(
                 on_tick=on_tick,
                 on_log=None if hook is None else hook.log_opened,
                 # the world's truth the controller never sees, for the report (and --resume)
-                before_estimate=lambda _: [
-                    {
-                        "kind": "world",
-                        "true_misalignment": _truth(world),
-                        "true_motion": _moved(world),
-                    }
-                ],
+                before_estimate=lambda _: [_world_record(world)],
             )
             done = run_session_trial(rig, clock, setup)
     outcome = outcome_of(spec, geo, done.result, done.estimate, done.log_path, series)
     outcome.true_misalignment = _truth(world)
     outcome.true_motion = _moved(world)
     return outcome
+
+
+def _world_record(world: World) -> dict[str, object]:
+    """The log's ``world`` record: the truth the controller never sees."""
+    return {"kind": "world", "true_misalignment": _truth(world), "true_motion": _moved(world)}
 
 
 def _moved(world: World) -> float | None:

@@ -38,11 +38,11 @@ from ...config.stage import Stage
 from ...estimation.beam import Beam
 from ...estimation.beamstate import BeamStates
 from ...estimation.compliance import ComplianceFit, fit_compliance, less
-from ...estimation.detect_contact import baseline_deviation
+from ...estimation.detect_contact import baseline_deviation, difference_sigma
 from ...estimation.elastica.constants import P_CRIT
 from ...estimation.jointfit import MIN_POINTS, JointFit, joint_fit
 from ...estimation.misalignment import Lean
-from ...estimation.motion import Motion, surface_motion
+from ...estimation.motion import Motion
 from ...estimation.relaxation import RelaxationFit
 from ...estimation.section import Section
 from ...estimation.southwell import SouthwellFit, southwell
@@ -50,12 +50,13 @@ from ...estimation.stiffness import StiffnessEstimate, paper_estimate
 from ...estimation.strain_fit import fit_strains
 from ...estimation.verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from ...sensor.strain import grating_intervals
-from ...sensor.tipforce import force_sigma
 from .inputs import EstimatorInputs
 from .lean import lean_of_rows, row_in, rows_in
+from .motion import Row, drift_envelope, record_motion, still_rows
 from .relaxed import relaxation_of
 from .run import TrialResult
 from .states import LOADING_STATES, RowLoads, record_lengths, row_loads, states_at
+from .tipforce import tip_load_at_buckling
 
 __all__ = [
     "EstimatorInputs",
@@ -67,7 +68,6 @@ __all__ = [
     "fit_record",
     "fit_rows",
     "loading_rows",
-    "record_motion",
     "tip_load_at_buckling",
     "verdict_for",
 ]
@@ -117,7 +117,8 @@ def fit_record(
     """The joint fit of one trial's loading record (see the module docstring), and the beam's
     bow from its pre-buckling part (``estimation.southwell``). With ``tip_forces`` (N, one per
     row, from a tip force grating) the fit reads the load from them instead of the beam's axial
-    strain, with their noise measured on the record (``sensor.tipforce.force_sigma``)."""
+    strain, with their noise measured on the record
+    (``estimation.detect_contact.difference_sigma``)."""
     n = strains.shape[0]
     if n < MIN_POINTS:
         msg = f"too few points: {n} loading samples, the fit needs {MIN_POINTS}"
@@ -132,7 +133,7 @@ def fit_record(
         return RecordEstimate(None, calibration=fit, loads=row_loads(advance, strains, states))
     force, sigma_force = states.P, k * states.sigma_P
     if tip_forces is not None:
-        force, sigma_force = tip_forces, np.full(n, force_sigma(tip_forces))
+        force, sigma_force = tip_forces, np.full(n, difference_sigma(tip_forces))
     guess = baseline_deviation(advance, force, baseline_points=min(30, n // 4))
     joint = joint_fit(
         advance,
@@ -180,12 +181,23 @@ def fit_rows(
     each row's time (s) and a hold in the rows, the relaxation (``robot.trial.relaxed``). With
     each row's tip-grating load (N), the joint fit reads the load from it."""
     rows = list(rows)
-    if inputs.motion_tolerance is not None and times is not None:
-        rows = _still(rows, record_motion(rows, tip_forces, times), times)
     gratings = len(stack.sensor.used_gratings)
-    advance, strains = loading_rows(rows, gratings)
-    tip = _loading_tip(rows, tip_forces, gratings)
-    fitted = fit_record(advance, strains, inputs, stack.sensor, section, tip)
+
+    def fit(rows: list[Row]) -> RecordEstimate:
+        advance, strains = loading_rows(rows, gratings)
+        tip = _loading_tip(rows, tip_forces, gratings)
+        return fit_record(advance, strains, inputs, stack.sensor, section, tip)
+
+    motion = None  # measured and taken out where the campaign expects the tissue to move
+    if inputs.motion_tolerance is not None and times is not None:
+        motion = record_motion(rows, tip_forces, times)
+    if motion is None or times is None:
+        fitted = fit(rows)
+    else:
+        raw, rows = rows, still_rows(rows, times, motion.velocity, motion.touch)
+        fitted = fit(rows)
+        joint = drift_envelope(fitted.joint, raw, times, motion, lambda r: fit(r).joint)
+        fitted = dataclasses.replace(fitted, joint=joint)
     if inputs.rigid:
         return fitted
     lean = lean_of_rows(rows, stack.sensor, section, inputs)
@@ -195,44 +207,6 @@ def fit_rows(
             rows, times, inputs, stack.sensor, section, fitted.joint, tip_forces
         )
     return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
-
-
-def _still(
-    rows: list[tuple[str, float, Sequence[float]]],
-    motion: Motion | None,
-    times: Sequence[float],
-) -> list[tuple[str, float, Sequence[float]]]:
-    """The rows with the stage's advance taken against the surface, as if it stood where it
-    was at the first touch: the measured motion as an even drift (``Motion.velocity``)."""
-    if motion is None or motion.velocity == 0.0:
-        return rows
-    v, t0 = motion.velocity, motion.touch
-    return [(s, u + v * (t - t0), e) for (s, u, e), t in zip(rows, times, strict=True)]
-
-
-def tip_load_at_buckling(
-    rows: Sequence[tuple[str, float, Sequence[float]]],
-    tip_forces: Sequence[float | None] | None,
-) -> float | None:
-    """The tip grating's load (N) at the first row past the buckling mark, None without one."""
-    if not tip_forces or len(tip_forces) != len(rows):
-        return None
-    for (state, _, _), f in zip(rows, tip_forces, strict=True):
-        if state == "buckled":
-            return None if f is None or not math.isfinite(f) else float(f)
-    return None
-
-
-def record_motion(
-    rows: Sequence[tuple[str, float, Sequence[float]]],
-    tip_forces: Sequence[float | None] | None,
-    times: Sequence[float] | None = None,
-) -> Motion | None:
-    """The surface's motion along the axis over a record (``estimation.motion``), None without
-    a tip grating."""
-    if not tip_forces or len(tip_forces) != len(rows):
-        return None
-    return surface_motion([r[0] for r in rows], [r[1] for r in rows], tip_forces, times)
 
 
 def _loading_tip(

@@ -5,8 +5,8 @@ The rows from the approach to the end of the hold (state, advance, strains, with
 time) give the beam's load and end shortening (``estimation.beamstate``, the strain noise
 measured on these rows as for the joint fit); with a tip force grating the load is the
 grating's, as the joint fit reads it (its noise measured on the same rows,
-``sensor.tipforce.force_sigma``): a light sensor's strains carry its load at a few noise
-widths, the grating at hundreds. The joint fit (which reads the loading rows only,
+``estimation.detect_contact.difference_sigma``): a light sensor's strains carry its load at a
+few noise widths, the grating at hundreds. The joint fit (which reads the loading rows only,
 so its number is what it is without a hold) gives the contact, the load offset and its
 model-form bound; the relaxation is fitted under every hypothesis of the belief
 (``estimation.relaxation.beliefs``), not at the elastic fit's best, which a relaxing record
@@ -24,10 +24,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...config.schema import SensorConfig
+from ...estimation.detect_contact import difference_sigma
 from ...estimation.jointfit import JointFit
 from ...estimation.relaxation import RelaxationFit, RelaxationRecord, fit_over_beliefs
 from ...estimation.section import Section
-from ...sensor.tipforce import force_sigma
 from .inputs import EstimatorInputs
 from .lean import row_in, rows_in
 from .states import LOADING_STATES, record_states
@@ -74,7 +74,7 @@ def relaxation_of(
     load, sigma_load = states.P, k * thin * states.sigma_P
     if tips is not None:
         load = _means(blocks, lambda i: tips[i])
-        sigma_load = force_sigma(tips[np.isfinite(tips)]) * thin
+        sigma_load = difference_sigma(tips[np.isfinite(tips)]) * thin
     record = RelaxationRecord(
         times=t,
         load=np.asarray(load - (joint.load_offset or 0.0)),

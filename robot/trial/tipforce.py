@@ -1,11 +1,12 @@
 """The tip force a trial's recording derives at its close (``/tip/wrench``): the tip grating's
 load where the sensor has one, else the axial load of the estimator's beam states. Handed to
 ``robot.records`` (the log writer and the export) as a function: the records serialise, this
-module computes."""
+module computes. And the tip grating's load at a record's buckling mark (the verdict's)."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -63,3 +64,16 @@ def _whole(strains: list[Any], gratings: int) -> bool:
     return len(strains) == gratings and all(
         isinstance(v, int | float) and math.isfinite(v) for v in strains
     )
+
+
+def tip_load_at_buckling(
+    rows: Sequence[tuple[str, float, Sequence[float]]],
+    tip_forces: Sequence[float | None] | None,
+) -> float | None:
+    """The tip grating's load (N) at the first row past the buckling mark, None without one."""
+    if not tip_forces or len(tip_forces) != len(rows):
+        return None
+    for (state, _, _), f in zip(rows, tip_forces, strict=True):
+        if state == "buckled":
+            return None if f is None or not math.isfinite(f) else float(f)
+    return None

@@ -12,6 +12,7 @@ import pytest
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
 from palpate.robot.records.log import read_log
 from palpate.simulation.result import TrialOutcome
 from palpate.simulation.trial import run_sim_trial
@@ -20,14 +21,24 @@ SCENE = load(SceneConfig, resolve("scenes/invivo/breath-hold.yaml"))
 STACK = load_stack(SCENE.robot)
 
 
-def trial(scene: SceneConfig, tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
-    """N2: 2 kPa, 40 mm, through the 15 deg tube, downward."""
+def run_one(
+    scene: SceneConfig,
+    stack: StackConfig,
+    sample: str,
+    tmp_path_factory: pytest.TempPathFactory,
+) -> TrialOutcome:
+    """The scene's trial on ``sample`` through the 15 deg tube, downward."""
     spec = next(
         s
-        for s in campaign_trials(scene, STACK, 0)
-        if s.sample == "N2" and s.tube == "bent15" and s.orientation == "downward"
+        for s in campaign_trials(scene, stack, 0)
+        if s.sample == sample and s.tube == "bent15" and s.orientation == "downward"
     )
-    return run_sim_trial(spec, scene, STACK, log_dir=tmp_path_factory.mktemp("logs"))
+    return run_sim_trial(spec, scene, stack, log_dir=tmp_path_factory.mktemp("logs"))
+
+
+def trial(scene: SceneConfig, tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
+    """N2: 2 kPa, 40 mm."""
+    return run_one(scene, STACK, "N2", tmp_path_factory)
 
 
 @pytest.fixture(scope="module")

@@ -8,11 +8,11 @@ import dataclasses
 
 import pytest
 
-from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.simulation.trial import TrialOutcome, run_sim_trial
+from palpate.simulation.trial import TrialOutcome
+from tests.e2e.test_breath_hold import run_one
 
 SCENE = load(SceneConfig, resolve("scenes/invivo/temperature.yaml"))
 STACK = load_stack(SCENE.robot)
@@ -20,12 +20,7 @@ STACK = load_stack(SCENE.robot)
 
 def trial(stack: StackConfig, tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
     """F1: 10 kPa, 10 mm, through the 15 deg tube, downward."""
-    spec = next(
-        s
-        for s in campaign_trials(SCENE, stack, 0)
-        if s.sample == "F1" and s.tube == "bent15" and s.orientation == "downward"
-    )
-    return run_sim_trial(spec, SCENE, stack, log_dir=tmp_path_factory.mktemp("logs"))
+    return run_one(SCENE, stack, "F1", tmp_path_factory)
 
 
 def test_every_grating_compensated_with_its_ratio(

@@ -10,8 +10,9 @@ import pytest
 from palpate.config.loader import ConfigError, from_mapping
 from palpate.config.scene import FidelityConfig
 from palpate.config.schema import FbgConfig, StackConfig, TipGratingConfig
+from palpate.estimation.detect_contact import difference_sigma
 from palpate.sensor.reader import FrameReader
-from palpate.sensor.tipforce import TipForceChain, force_sigma
+from palpate.sensor.tipforce import TipForceChain
 from palpate.sim.board import BoardEmulator, BoardSample
 from palpate.sim.clock import VirtualClock
 from palpate.sim.readout import TipReadout
@@ -77,7 +78,7 @@ def test_the_chain_reads_the_load_and_takes_the_drift_out() -> None:
     assert err.std() < 0.2e-3
     uncompensated = TipForceChain(tip.sensitivity, 0.0, False, chain.zero)
     assert uncompensated.force(readout.read(0.0, drift, rng)) == pytest.approx(3e-3, abs=0.5e-3)
-    assert force_sigma(read) == pytest.approx(0.125e-3, rel=0.3)  # the reference was exact
+    assert difference_sigma(read) == pytest.approx(0.125e-3, rel=0.3)  # the reference was exact
 
 
 def test_past_its_range_the_element_reads_no_more() -> None:
