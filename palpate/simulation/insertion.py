@@ -3,8 +3,9 @@ records with ``cat /dev/ttyACM0 > insertion.bin`` while the sensor enters the bo
 ``palpate emulate --scene ...`` on the printed board port), for ``palpate calibrate --thermal``.
 
 The emulated bench (:class:`palpate.simulation.twin.SimulatedBench`) at its power-up pose (the
-sensor retracted, touching nothing) sampled on the virtual clock: the scene's
-``fidelity.temperature`` and drift, each grating's true thermal shift, the interrogator's noise.
+sensor retracted, touching nothing), its board's frames (``BoardEmulator.frame_of``) taken on
+the virtual clock: the scene's ``fidelity.temperature`` and drift, each grating's true thermal
+shift, the interrogator's noise.
 
 Usage::
 
@@ -18,21 +19,12 @@ from __future__ import annotations
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.simulation.twin import SimulatedBench
-from palpate.wire.frame import encode, frame_from_si
+from palpate.wire.frame import encode
 
 
 def insertion_frames(
     stack: StackConfig, scene: SceneConfig, *, seconds: float, rate_hz: float = 250.0, seed: int = 0
 ) -> bytes:
     """``seconds`` of frames at ``rate_hz`` from the free sensor of ``stack`` in ``scene``."""
-    bench = SimulatedBench(stack, scene, wire=False, seed=seed)
-    world = bench.world
-    out = bytearray()
-    for k in range(round(seconds * rate_hz)):
-        t = k / rate_hz
-        s = world.sample(t)
-        frame = frame_from_si(
-            k, t, s.encoder, list(s.wavelengths), reference=s.reference, force=s.force, tip=s.tip
-        )
-        out += encode(frame)
-    return bytes(out)
+    board = SimulatedBench(stack, scene, wire=False, seed=seed).board
+    return b"".join(encode(board.frame_of(k, k / rate_hz)) for k in range(round(seconds * rate_hz)))

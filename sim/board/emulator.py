@@ -225,7 +225,7 @@ class BoardEmulator:
         self._seq = (seq + 1) % 2**32
         self.stats.samples += 1
         if self._frame_sink is not None:  # no byte faults here (checked in the constructor)
-            frame = self._frame_of(seq, ts)
+            frame = self.frame_of(seq, ts)
             check_ranges(frame)
             self._injector.log(seq, "sent", 0)
             self.stats.frames_sent += 1
@@ -234,10 +234,11 @@ class BoardEmulator:
 
     def _frame(self, seq: int, ts: float) -> bytes:
         """The encoded frame of sample ``seq`` taken at ``ts`` from the source."""
-        return self._encode(self._frame_of(seq, ts))
+        return self._encode(self.frame_of(seq, ts))
 
-    def _frame_of(self, seq: int, ts: float) -> Frame:
-        """The frame of sample ``seq`` taken at ``ts`` from the source."""
+    def frame_of(self, seq: int, ts: float) -> Frame:
+        """The frame of sample ``seq`` taken at ``ts`` from the source, as the board sends it
+        (its layout's fields, the source's flags; what a recording of the stream holds)."""
         s = self.source(ts)
         flags = s.flags | (Status.OVERRUN if self._overrun else 0)
         self._overrun = False
