@@ -46,9 +46,10 @@ class TipForceChain:
 
     @classmethod
     def from_config(cls, tip: TipGratingConfig, fbg: FbgConfig) -> TipForceChain:
-        ratio = 0.0 if tip.thermal_ratio is None else tip.thermal_ratio
-        if tip.thermal_ratio is None and fbg.temperature_coefficient > 0:
-            ratio = tip.temperature_coefficient / fbg.temperature_coefficient
+        ratio = tip.thermal_ratio  # calibrated; else the two coefficients' ratio
+        if ratio is None:
+            s_ref = fbg.temperature_coefficient
+            ratio = tip.temperature_coefficient / s_ref if s_ref > 0 else 0.0
         return cls(tip.sensitivity, ratio, tip.temperature_compensation == "reference")
 
     def zeroed(self, tip: ArrayLike, reference: ArrayLike | None = None) -> TipForceChain:

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from ..config.scene import FidelityConfig
 from ..config.schema import FbgConfig, SensorConfig, TipGratingConfig
-from .thermal import ThermalHistory, true_coefficients
+from .thermal import ThermalCoefficients, ThermalHistory, true_coefficients
 
 
 class BoardReadout:
@@ -22,10 +22,10 @@ class BoardReadout:
 
     def __init__(self, sensor: SensorConfig, fbg: FbgConfig, fidelity: FidelityConfig) -> None:
         self.history = ThermalHistory.of(fidelity)
-        self.gratings = GratingReadout(sensor, fbg, fidelity)
+        thermal = true_coefficients(sensor, fbg, fidelity)
+        self.gratings = GratingReadout(sensor, fbg, fidelity, thermal)
         tip = sensor.tip_grating
-        thermal = true_coefficients(sensor, fbg, fidelity).tip
-        self.tip = None if tip is None else TipReadout(tip, fidelity, thermal)
+        self.tip = None if tip is None else TipReadout(tip, fidelity, thermal.tip)
 
     def read(
         self, strains: tuple[float, ...], load: float, t: float, rng: np.random.Generator
@@ -41,7 +41,14 @@ class BoardReadout:
 class GratingReadout:
     """The peaks of the used gratings and the reference grating, as the board would send them."""
 
-    def __init__(self, sensor: SensorConfig, fbg: FbgConfig, fidelity: FidelityConfig) -> None:
+    def __init__(
+        self,
+        sensor: SensorConfig,
+        fbg: FbgConfig,
+        fidelity: FidelityConfig,
+        thermal: ThermalCoefficients,
+    ) -> None:
+        """``thermal``: the gratings' true shifts per kelvin (``sim.thermal.true_coefficients``)."""
         self._base = tuple(fbg.base_wavelengths_nm[g - 1] * 1e-9 for g in sensor.used_gratings)
         self._noise = fidelity.fbg_noise
         ref_nm = fbg.reference_wavelength_nm
@@ -49,7 +56,6 @@ class GratingReadout:
         # peak noises, then the reference's, drawn in one call (the same stream as separate ones)
         self._draws = (len(self._base) + (ref_nm is not None)) if self._noise > 0 else 0
         self._strain_coefficient = fbg.strain_coefficient
-        thermal = true_coefficients(sensor, fbg, fidelity)
         self._thermal = thermal.gratings
         self._reference_thermal = thermal.reference
 

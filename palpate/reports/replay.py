@@ -32,7 +32,6 @@ from palpate.robot.trial.estimate import (
     verdict_for,
 )
 from palpate.robot.trial.inputs import VERSION, probe_inputs
-from palpate.robot.trial.motion import record_motion
 from palpate.robot.trial.record import estimator_keys
 
 MAX_PROBLEMS = 5  # bad lines named in the message (all are counted)
@@ -159,7 +158,7 @@ def _replay_joint(
             fitted.relaxation,
             tip_load_at_buckling(rows, tips),
             fitted.tip_bow,
-            record_motion(rows, tips),
+            fitted.motion,
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

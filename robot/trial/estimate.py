@@ -86,7 +86,8 @@ def loading_rows(
 class RecordEstimate:
     """What the record gives: the joint fit and the Southwell fit of the beam's bow (None when
     the record is too short for either); on a rigid reference, the compliance instead.
-    ``tip_load``: the fits read the load from a tip grating."""
+    ``tip_load``: the fits read the load from a tip grating; ``motion``: the surface's along
+    the axis, measured from it (``robot.trial.motion``)."""
 
     joint: JointFit | None
     southwell: SouthwellFit | None = None
@@ -95,6 +96,7 @@ class RecordEstimate:
     relaxation: RelaxationFit | None = None
     tip_load: bool = False
     loads: RowLoads = dataclasses.field(default_factory=dict)  # the beam states' P, by row
+    motion: Motion | None = None
 
     @property
     def tip_bow(self) -> float | None:
@@ -188,16 +190,15 @@ def fit_rows(
         tip = _loading_tip(rows, tip_forces, gratings)
         return fit_record(advance, strains, inputs, stack.sensor, section, tip)
 
-    motion = None  # measured and taken out where the campaign expects the tissue to move
-    if inputs.motion_tolerance is not None and times is not None:
-        motion = record_motion(rows, tip_forces, times)
-    if motion is None or times is None:
+    motion = record_motion(rows, tip_forces, times)
+    if motion is None or times is None or inputs.motion_tolerance is None:
         fitted = fit(rows)
-    else:
+    else:  # taken out where the campaign expects the tissue to move
         raw, rows = rows, still_rows(rows, times, motion.velocity, motion.touch)
         fitted = fit(rows)
         joint = drift_envelope(fitted.joint, raw, times, motion, lambda r: fit(r).joint)
         fitted = dataclasses.replace(fitted, joint=joint)
+    fitted = dataclasses.replace(fitted, motion=motion)
     if inputs.rigid:
         return fitted
     lean = lean_of_rows(rows, stack.sensor, section, inputs)
@@ -362,7 +363,7 @@ def estimate_trial(
     fitted = fit_rows(result.record, inputs, stack, section, result.times, result.tip_forces)
     seconds = time.perf_counter() - start
     verdict, relaxed = None, None
-    motion = record_motion(result.record, result.tip_forces, result.times)
+    motion = fitted.motion
     if not inputs.rigid:
         state = result.state.value
         verdict, relaxed = verdict_for(
