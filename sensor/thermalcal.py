@@ -52,6 +52,11 @@ class ThermalRecord:
     reference: FloatArray
     time: FloatArray
 
+    @property
+    def span(self) -> float:
+        """The reference's span over the record (m)."""
+        return float(self.reference.max() - self.reference.min())
+
     def columns(self) -> list[tuple[str, FloatArray]]:
         """(label, shifts) per grating, the tip grating's last."""
         out = [(str(g), self.gratings[:, k]) for k, g in enumerate(self.numbers)]
@@ -129,23 +134,22 @@ def thermal_record(
             "fbg.reference_wavelength_nm): nothing reads the temperature alone"
         )
     t = block.time - block.time[0]
-    first = t < t[0] + window_s
+    first = t < window_s
     if np.count_nonzero(~first) < 10:
         raise ValueError(f"{len(block)} frames over {t[-1]:.2f} s: record longer than {window_s} s")
     wl = block.wavelengths
-    tip = None
-    if stack.sensor.tip_grating is not None and block.tip_fm is not None:
-        tip_wl = block.tip_fm.astype(np.float64) * 1e-15
-        tip = tip_wl - tip_wl[first].mean()
-    reference = ref - ref[first].mean()
-    span = float(reference.max() - reference.min())
-    if span < MIN_SPAN_PM * PM:
-        raise ValueError(
-            f"the reference grating moved {span / PM:.1f} pm over the record: calibrate across a "
-            f"temperature change of {MIN_SPAN_PM:.0f} pm (2 degC) or more (an insertion, a bath)"
-        )
+    tip = None if stack.sensor.tip_grating is None else block.tip
+    if tip is not None:
+        tip = tip - tip[first].mean()
     used = stack.sensor.used_gratings
-    return ThermalRecord(used, wl - wl[first].mean(axis=0), tip, reference, t)
+    record = ThermalRecord(used, wl - wl[first].mean(axis=0), tip, ref - ref[first].mean(), t)
+    if record.span < MIN_SPAN_PM * PM:
+        raise ValueError(
+            f"the reference grating moved {record.span / PM:.1f} pm over the record: calibrate "
+            f"across a temperature change of {MIN_SPAN_PM:.0f} pm (2 degC) or more (an insertion, "
+            "a bath)"
+        )
+    return record
 
 
 def residuals(
@@ -181,12 +185,9 @@ def fit_thermal_frames(
     record = thermal_record(block, stack, window_s=window_s)
     columns = record.columns()
     blocks = np.floor(record.time / block_s).astype(np.int64)
+    reference = _block_means(record.reference, blocks)
     lines = tuple(
-        fit_strain_coefficient(
-            _block_means(record.reference, blocks),
-            _block_means(shift, blocks),
-            confidence=confidence,
-        )
+        fit_strain_coefficient(reference, _block_means(shift, blocks), confidence=confidence)
         for _, shift in columns
     )
     configured = stack.fbg.ratios(record.numbers)
@@ -200,7 +201,7 @@ def fit_thermal_frames(
         configured=configured,
         residual_configured=residuals(record, configured, window_s=window_s),
         residual_calibrated=residuals(record, fitted, window_s=window_s),
-        span=float(record.reference.max() - record.reference.min()),
+        span=record.span,
         duration=float(record.time[-1]),
         frames=len(block),
     )

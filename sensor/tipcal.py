@@ -82,13 +82,13 @@ def fit_tip_frames(
     tip = stack.sensor.tip_grating
     if tip is None:
         raise ValueError("the robot configuration has no sensor.tip_grating to calibrate")
-    if block.tip_fm is None or block.force_un is None:
+    wl = block.tip
+    if wl is None or block.force_un is None:
         raise ValueError(
             "the frames must carry the tip grating and the force scale (board.has_force: true)"
         )
     if len(block) <= rest_frames + 10:
         raise ValueError(f"{len(block)} frames: too few (needs more than {rest_frames + 10})")
-    wl = block.tip_fm.astype(np.float64) * 1e-15
     shift = wl - wl[:rest_frames].mean()
     if tip.temperature_compensation == "reference":
         ref = block.reference

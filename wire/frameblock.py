@@ -66,6 +66,11 @@ class FrameBlock:
     def force(self) -> NDArray[np.float64] | None:
         return None if self.force_un is None else self.force_un.astype(np.float64) * UN
 
+    @property
+    def tip(self) -> NDArray[np.float64] | None:
+        """The tip force grating's peaks in m, shape (n,); None without the tip grating."""
+        return None if self.tip_fm is None else self.tip_fm.astype(np.float64) * FM
+
     def frame(self, i: int) -> Frame:
         """Row ``i`` as a :class:`Frame`."""
         return Frame(
