@@ -73,6 +73,7 @@ REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 WAIT_CONFIRM = 3  # ticks a contact holds while WAITING before the rest check takes it
 AT_REST = frozenset({State.HOMING, State.POSITIONING, State.WAITING})  # no tissue: a RestCheck
 GATED = frozenset({State.APPROACH, State.CONTACT, State.INDENTING, State.BUCKLED, State.HOLDING})
+CONTACT_PHASE = GATED | {State.PROBING}  # the sensor may touch the tissue: the stream must live
 
 
 @dataclass
@@ -162,15 +163,7 @@ class IndentationMachine:
         if obs.t - self._entered > self.guards.state_timeout:
             self._fault(obs, f"timeout in {self.state.value} after {self.guards.state_timeout:g} s")
             return
-        in_contact_phase = self.state in (
-            State.PROBING,
-            State.APPROACH,
-            State.CONTACT,
-            State.INDENTING,
-            State.BUCKLED,
-            State.HOLDING,
-        )
-        if in_contact_phase and obs.stream_age > self.guards.stream_timeout:
+        if self.state in CONTACT_PHASE and obs.stream_age > self.guards.stream_timeout:
             self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
             return
         if self.plan.gated and self.state in GATED and not obs.gate:
