@@ -138,6 +138,8 @@ def assess(
     bias = p_cr * L / EA + e_det + e_imp * L
     checks = _checks(depth_ratio, contact_ratio, d_stiff, detection, floor, bias, peak, c)
     checks["plane"] = (EI_across / EI, np.full_like(EI, c.plane_margin), False)
+    if c.tip_force_resolution is not None:
+        checks["force"] = (p_cr, np.full_like(EI, c.smallest_critical_load), False)
     return Assessment(
         p_cr,
         d_soft,

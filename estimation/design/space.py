@@ -107,6 +107,15 @@ class DesignConstraints:
             that it buckles in the plane the gratings see (a beam buckles about its softest
             axis): 2 keeps a bow across within twice its size at P_cr (1 / (1 - 1/2)); the
             paper's sensor has 3.2.
+        tip_force_resolution: the tip grating's load resolution (N, 1 sigma), or None for a
+            sensor without one (no ``force`` check). With it, P_cr must be large enough that
+            the load at which the contact is seen, ``contact_sigmas`` resolutions, sinks the
+            Hertz sphere at most ``contact_depth_fraction`` of its depth at buckling (the load
+            grows as delta**1.5, whatever E): :attr:`smallest_critical_load`.
+        contact_sigmas: the contact threshold in load resolutions (``campaign.contact: tip``
+            takes the contact at 5 sigma).
+        contact_depth_fraction: the share of the indentation at buckling the contact's
+            threshold may take (the rest is the load curve the fit reads).
     """
 
     poisson: float = 0.45
@@ -126,6 +135,9 @@ class DesignConstraints:
     grating_centres_from_tip: tuple[float, ...] = (10 * MM, 18 * MM, 26 * MM)
     grating_length: float = 3 * MM
     plane_margin: float = 2.0
+    tip_force_resolution: float | None = None
+    contact_sigmas: float = 5.0
+    contact_depth_fraction: float = 0.5
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.poisson < 0.5 + 1e-12:
@@ -144,6 +156,8 @@ class DesignConstraints:
             "max_bias_fraction",
             "grating_length",
             "plane_margin",
+            "contact_sigmas",
+            "contact_depth_fraction",
         )
         for name in positive:
             value = getattr(self, name)
@@ -161,6 +175,20 @@ class DesignConstraints:
             )
         if not self.grating_centres_from_tip or min(self.grating_centres_from_tip) < 0:
             raise ValueError("grating_centres_from_tip must list distances >= 0")
+        res = self.tip_force_resolution
+        if res is not None and not (math.isfinite(res) and res > 0):
+            raise ValueError(f"tip_force_resolution must be > 0 N or None, got {res!r}")
+        if self.contact_depth_fraction > 1:
+            raise ValueError("contact_depth_fraction must be in (0, 1]")
+
+    @property
+    def smallest_critical_load(self) -> float:
+        """The smallest P_cr (N) the tip grating's resolution allows (0 without a grating)."""
+        if self.tip_force_resolution is None:
+            return 0.0
+        return float(
+            self.contact_sigmas * self.tip_force_resolution / self.contact_depth_fraction**1.5
+        )
 
     @property
     def grating_reach(self) -> float:

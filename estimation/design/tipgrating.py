@@ -66,7 +66,40 @@ def choose_tip_grating(
             f"no tip grating sensitivity in {list(sensitivities)} pm/mN carries "
             f"{range_ratio:g} x P_cr = {range_ratio * p_cr_mn:.3g} mN within {window_pm:g} pm"
         )
-    s = max(fitting)
+    return _choice(max(fitting), noise_pm, window_pm, p_cr_mn)
+
+
+def tip_grating_for_resolution(
+    critical_load: float,
+    noise_pm: float,
+    resolution: float,
+    *,
+    window_pm: float = WINDOW_PM,
+    range_ratio: float = RANGE_RATIO,
+) -> TipGratingChoice:
+    """The tip grating that resolves ``resolution`` (N, 1 sigma) at ``noise_pm`` of interrogator
+    noise: its sensitivity is ``noise / resolution`` (a published element's resolution, e.g.
+    0.25 mN (Iordachita et al. 2009), 0.13 mN (2023), about 0.05 mN (2025), taken as given).
+    ValueError if its range does not carry ``range_ratio`` P_cr or an input is not positive.
+
+        >>> round(tip_grating_for_resolution(5e-3, 1.0, 0.05e-3).sensitivity_pm_per_mn, 6)
+        20.0
+    """
+    if not (critical_load > 0 and noise_pm > 0 and resolution > 0 and window_pm > 0):
+        raise ValueError("critical_load, noise_pm, resolution and window_pm must be > 0")
+    p_cr_mn = critical_load * 1e3
+    s = noise_pm / (resolution * 1e3)
+    if window_pm / s < range_ratio * p_cr_mn:
+        raise ValueError(
+            f"a tip grating resolving {resolution * 1e3:.3g} mN ({s:.3g} pm/mN) reaches "
+            f"{window_pm / s:.3g} mN, less than {range_ratio:g} x P_cr = "
+            f"{range_ratio * p_cr_mn:.3g} mN"
+        )
+    return _choice(s, noise_pm, window_pm, p_cr_mn)
+
+
+def _choice(s: float, noise_pm: float, window_pm: float, p_cr_mn: float) -> TipGratingChoice:
+    """The grating of sensitivity ``s`` (pm/mN): its range, compliance and resolution."""
     strain_per_mn = s / BARE_STRAIN_COEFFICIENT * 1e-6  # strain on the element per mN
     compliance_mm_per_n = ELEMENT_LENGTH * strain_per_mn * 1e3 * 1e3  # m/mN -> mm/N
     resolution = noise_pm / s

@@ -20,11 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from palpate.argtypes import non_negative_int, positive_int
-from palpate.campaigns.campaign import campaign_trials, default_workers
+from palpate.campaigns.campaign import campaign_trials
 from palpate.campaigns.designcheck import (
-    DEFAULT_TOLERANCE,
-    UNITS,
     CheckSettings,
     DesignVerdict,
     design_scene,
@@ -32,190 +29,27 @@ from palpate.campaigns.designcheck import (
     designed_stack,
     run_check,
 )
-from palpate.campaigns.executors import add_executor_arguments
+from palpate.commands.design_inputs import inputs, register, search, tip_grating
 from palpate.config import load, load_stack, resolve
 from palpate.config.loader import InputError, write_yaml
-from palpate.config.optics import MM
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.estimation.design import (
     DesignConstraints,
     DesignResult,
-    DesignSpace,
-    design_sensor,
 )
-from palpate.estimation.design.tipgrating import TipGratingChoice, choose_tip_grating
+from palpate.estimation.design.tipgrating import (
+    TipGratingChoice,
+)
 from palpate.estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
 from palpate.estimation.section import composite_section
 from palpate.progress import progress_bar
 from palpate.reports.design import CheckRun, payload, print_report
-from palpate.sensor.strain import strain_noise
+from palpate.reports.lumen import LumenReport
 from palpate.simulation.trial import TrialOutcome
-from palpate.wire.dynamixel import TICKS_PER_REV
 
 EXIT_NO_DESIGN = 2
-
-
-def _floats(text: str, what: str) -> tuple[float, ...]:
-    try:
-        values = tuple(float(v) for v in text.split(",") if v.strip())
-    except ValueError:
-        raise InputError(f"{what}: expected comma-separated numbers, got {text!r}") from None
-    if not values:
-        raise InputError(f"{what}: empty list")
-    return values
-
-
-def _pair(text: str, what: str) -> tuple[float, float]:
-    parts = text.split(":")
-    try:
-        lo, hi = (float(p) for p in parts)
-    except ValueError:
-        raise InputError(f"{what}: expected MIN:MAX, got {text!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
-        raise InputError(f"{what}: need 0 < MIN <= MAX, got {text!r}")
-    return lo, hi
-
-
-def register(parser: argparse.ArgumentParser) -> None:
-    _add_tissue_arguments(parser)
-    _add_space_arguments(parser)
-    _add_check_arguments(parser)
-
-
-def _add_tissue_arguments(parser: argparse.ArgumentParser) -> None:
-    """The tissue to design for and what the design must resolve."""
-    parser.add_argument(
-        "--modulus-range", required=True, metavar="MIN:MAX", help="tissue moduli, e.g. 1:10"
-    )
-    parser.add_argument("--unit", choices=sorted(UNITS), default="kPa", help="of --modulus-range")
-    parser.add_argument("--poisson", type=float, default=0.45, help="tissue Poisson ratio")
-    parser.add_argument(
-        "--thickness-mm", type=float, default=20.0, help="tissue layer thickness (inf: half-space)"
-    )
-    parser.add_argument(
-        "--imperfection",
-        type=float,
-        default=5e-4,
-        help="initial bow w0/L of the sensor (also used by the simulated campaign)",
-    )
-    parser.add_argument(
-        "--resolution-multiple",
-        type=float,
-        default=20.0,
-        help="smallest indentation at buckling, in encoder counts",
-    )
-
-
-def _add_space_arguments(parser: argparse.ArgumentParser) -> None:
-    """The candidates the search considers."""
-    space = DesignSpace()
-    for flag, values, what in (
-        ("--fiber-radii-um", [f"{r * 1e6:g}" for r in space.fiber_radii], "fiber radii"),
-        ("--wire-diameters-um", [f"{d * 1e6:g}" for d in space.wire_diameters], "wire diameters"),
-        ("--wire-counts", [str(n) for n in space.wire_counts], "numbers of NiTi wires"),
-        ("--tip-radii-mm", [f"{r * 1e3:g}" for r in space.tip_radii], "tip sphere radii"),
-    ):
-        parser.add_argument(
-            flag, default=",".join(values), help=f"{what} to consider (comma-separated)"
-        )
-    parser.add_argument(
-        "--length-range-mm",
-        default=":".join(f"{v * 1e3:g}" for v in space.length_range),
-        metavar="MIN:MAX",
-        help="exposed lengths to consider",
-    )
-
-
-def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
-    """The robot the design is for and the simulated check of the chosen design."""
-    parser.add_argument("--config", default="robot.yaml", help="robot/sensor YAML (fiber, drive)")
-    parser.add_argument(
-        "--scene", type=Path, help="scene YAML whose fidelity and campaign settings the check uses"
-    )
-    parser.add_argument("--moduli", type=positive_int, default=4, help="phantoms across the range")
-    parser.add_argument(
-        "--lengths", type=positive_int, default=2, help="exposed lengths per phantom"
-    )
-    parser.add_argument(
-        "--contact-uncertainty-mm",
-        type=float,
-        default=0.0,
-        help="contact-detection error (1 sigma) in the simulated campaign",
-    )
-    parser.add_argument(
-        "--seed", type=non_negative_int, default=0, help="makes the simulated check reproducible"
-    )
-    parser.add_argument(
-        "--workers",
-        type=positive_int,
-        default=default_workers(),
-        help="trials of the check run in parallel (processes, threads or local Dask workers)",
-    )
-    add_executor_arguments(parser)
-    parser.add_argument("--no-sim", action="store_true", help="skip the simulated campaign")
-    parser.add_argument(
-        "--tolerance-pct",
-        type=float,
-        default=100 * DEFAULT_TOLERANCE,
-        help="the largest |relative error| of the joint fit on a phantom of the simulated check "
-        "for the design to be usable (default %(default)g %%)",
-    )
-    parser.add_argument(
-        "--tip-grating",
-        action="store_true",
-        help="give the sensor a tip force grating (its sensitivity and range chosen against the "
-        "noise) and check the design with it",
-    )
-    parser.add_argument(
-        "--tip-mass-g",
-        type=float,
-        default=None,
-        help="the tip's mass for the weight check (default: sensor.tip_mass_g of --config)",
-    )
-    parser.add_argument(
-        "--write",
-        type=Path,
-        metavar="YAML",
-        help="write the robot configuration with the designed sensor here (what `palpate sim`, "
-        "`emulate`, `trial` and `teleop` read: a scene's `robot:`, `--config`)",
-    )
-
-
-def _inputs(
-    args: argparse.Namespace, stack: StackConfig, scene: SceneConfig
-) -> tuple[tuple[float, float], DesignConstraints, DesignSpace]:
-    unit = UNITS[args.unit]
-    lo, hi = _pair(args.modulus_range, "--modulus-range")
-    thickness = None if math.isinf(args.thickness_mm) else args.thickness_mm * MM
-    s = stack.sensor
-    constraints = DesignConstraints(
-        poisson=args.poisson,
-        thickness=thickness,
-        encoder_resolution=stack.drive.lead / TICKS_PER_REV,
-        resolution_multiple=args.resolution_multiple,
-        strain_limit=stack.fbg.strain_limit,
-        strain_noise=strain_noise(
-            scene.fidelity.fbg_noise_pm, stack.fbg.strain_coefficient_pm_per_ue
-        ),
-        imperfection=args.imperfection,
-        post_buckling_travel=scene.campaign.post_buckling,
-        grating_centres_from_tip=s.grating_centres_from_tip(),
-        grating_length=s.grating_length,
-    )
-    lengths = _pair(args.length_range_mm, "--length-range-mm")
-    space = DesignSpace(
-        fiber_radii=tuple(r * 1e-6 for r in _floats(args.fiber_radii_um, "--fiber-radii-um")),
-        fiber_modulus=s.fiber_modulus,
-        wire_modulus=s.wire_modulus,
-        wire_diameters=tuple(
-            d * 1e-6 for d in _floats(args.wire_diameters_um, "--wire-diameters-um")
-        ),
-        wire_counts=tuple(int(n) for n in _floats(args.wire_counts, "--wire-counts")),
-        tip_radii=tuple(r * 1e-3 for r in _floats(args.tip_radii_mm, "--tip-radii-mm")),
-        length_range=(lengths[0] * 1e-3, lengths[1] * 1e-3),
-    )
-    return (lo * unit, hi * unit), constraints, space
+__all__ = ["DesignOutcome", "evaluate", "register", "run"]  # register: the arguments
 
 
 def _settings(args: argparse.Namespace) -> CheckSettings:
@@ -255,6 +89,8 @@ def _run_sim(
 
 def _written_note(args: argparse.Namespace) -> str:
     tip = " --tip-grating" if args.tip_grating else ""
+    if args.lumen_mm is not None:
+        tip += f" --lumen-mm {args.lumen_mm:g} --tip-resolution-mn {args.tip_resolution_mn:g}"
     if args.tip_mass_g is not None:
         tip += f" --tip-mass-g {args.tip_mass_g:g}"
     return (
@@ -322,10 +158,13 @@ class DesignOutcome:
     tip: TipGratingChoice | None
     weight: WeightCheck | None
     verdict: DesignVerdict
+    lumen: LumenReport | None = None
 
     def as_dict(self) -> dict[str, Any]:
         w = self.weight
         extra = {**_tip_payload(self.tip), **({} if w is None else {"weight": w.as_dict()})}
+        if self.lumen is not None:
+            extra["lumen"] = self.lumen.as_dict()
         return {**self.verdict.as_dict(), **payload(self.result, self.constraints, self.check),
                 **extra}  # fmt: skip
 
@@ -340,8 +179,8 @@ def evaluate(args: argparse.Namespace) -> DesignOutcome:
         raise InputError("--moduli and --lengths must be >= 1")
     if args.contact_uncertainty_mm < 0:
         raise InputError("--contact-uncertainty-mm must be >= 0")
-    modulus_range, constraints, space = _inputs(args, stack, base)
-    result = design_sensor(modulus_range, constraints, space)
+    modulus_range, constraints, space = inputs(args, stack, base)
+    result, lumen = search(args, modulus_range, constraints, space)
     outcomes: list[TrialOutcome] = []
     wall = 0.0
     tip: TipGratingChoice | None = None
@@ -352,10 +191,9 @@ def evaluate(args: argparse.Namespace) -> DesignOutcome:
         scene, sim_stack = design_scene(
             result.evaluation, result.length_window, stack, base, _settings(args)
         )
-        if args.tip_grating:
-            noise = base.fidelity.fbg_noise_pm
-            tip = choose_tip_grating(result.evaluation.critical_load, max(noise, 1e-3))
-        sim_stack = designed_stack(sim_stack, modulus_range, tip, args.tip_mass_g)
+        tip = tip_grating(args, result, max(base.fidelity.fbg_noise_pm, 1e-3))
+        sensor_range = result.evaluation.modulus_range
+        sim_stack = designed_stack(sim_stack, sensor_range, tip, args.tip_mass_g)
         s = sim_stack.sensor
         section = composite_section(
             s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
@@ -373,7 +211,7 @@ def evaluate(args: argparse.Namespace) -> DesignOutcome:
         args.tolerance_pct / 100,
     )
     check = CheckRun(outcomes, wall, args.unit, args.executor)
-    return DesignOutcome(result, constraints, check, tip, weight, verdict)
+    return DesignOutcome(result, constraints, check, tip, weight, verdict, lumen)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -382,6 +220,8 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(found.as_dict(), indent=2))
     else:
         print(found.verdict.headline())
+        if found.lumen is not None:
+            print(found.lumen.text())
         print_report(found.result, found.constraints, found.check)
         _print_tip(found.tip, found.weight, args.write)
     if not found.result.success:

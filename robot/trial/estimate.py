@@ -55,7 +55,7 @@ from .lean import lean_of_rows, row_in, rows_in
 from .motion import Row, drift_envelope, record_motion, still_rows
 from .relaxed import relaxation_of
 from .run import TrialResult
-from .states import LOADING_STATES, RowLoads, record_lengths, row_loads, states_at
+from .states import LOADING_STATES, RowLoads, on_beam, record_lengths, row_loads, states_at
 from .tipforce import tip_load_at_buckling
 
 __all__ = [
@@ -120,14 +120,20 @@ def fit_record(
     bow from its pre-buckling part (``estimation.southwell``). With ``tip_forces`` (N, one per
     row, from a tip force grating) the fit reads the load from them instead of the beam's axial
     strain, with their noise measured on the record
-    (``estimation.detect_contact.difference_sigma``)."""
+    (``estimation.detect_contact.difference_sigma``). Rows whose exposed length leaves a
+    grating off the beam (an advance taken against a drift estimated far beyond the record's)
+    have no beam state and are left out."""
+    lengths = record_lengths(advance, inputs)
+    keep = on_beam(lengths, sensor)
+    if not keep.all():
+        advance, strains, lengths = advance[keep], strains[keep], lengths[keep]
+        tip_forces = None if tip_forces is None else tip_forces[keep]
     n = strains.shape[0]
     if n < MIN_POINTS:
         msg = f"too few points: {n} loading samples, the fit needs {MIN_POINTS}"
         if inputs.rigid:
             return RecordEstimate(None, calibration=ComplianceFit(False, msg, n_points=n))
         return RecordEstimate(JointFit(False, msg, n_points=n, law=inputs.law().name))
-    lengths = record_lengths(advance, inputs)
     states, k = states_at(strains, lengths, sensor, section)
     if inputs.rigid:  # the tube's (stage's) compliance: a tip grating's element is the sensor's
         element = 0.0 if sensor.tip_grating is None else sensor.tip_grating.compliance

@@ -117,3 +117,38 @@ def test_the_verdict_names_every_reason_a_design_is_not_usable() -> None:
     assert v.headline().startswith("NOT USABLE: ")
     assert design_verdict(True, None, True).usable is None
     assert design_verdict(False, None, None).usable is False
+
+
+def test_through_a_working_channel_the_widest_range_and_what_binds(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    written = tmp_path / "lumen.yaml"
+    argv = ["design", "--modulus-range", "1:20", "--lumen-mm", "2.8", "--no-sim", "--json"]
+    code = main([*argv, "--wire-diameters-um", "25,50,75", "--write", str(written)])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    lumen = out["lumen"]
+    assert lumen["passage_mm"] == pytest.approx(2.6)
+    assert lumen["max_depth_ratio"] == 1.0  # the law's tables' end, by default through a lumen
+    assert lumen["one_sensor"] is False
+    (lo, hi), *_ = lumen["ranges_kpa"]
+    assert 1.0 < lo < 5.0
+    assert hi <= 20.0
+    assert {b["check"] for b in lumen["lowest_blocked_by"]} >= {"depth"}
+    d = out["design"]
+    assert d["tip_radius_mm"] <= 1.3
+    assert d["modulus_range_kpa"] == pytest.approx([lo, hi])
+    assert out["tip_grating"]["resolution_mn"] == pytest.approx(0.05)
+    assert "force" in {c["name"] for c in d["checks"]}
+    text = written.read_text()
+    assert "tip_radius_mm: 1.3" in text
+    assert "sensitivity_pm_per_mn: 20.0" in text
+
+
+def test_a_channel_nothing_passes_is_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["design", "--modulus-range", "1:20", "--lumen-mm", "0.05", "--clearance-mm", "0"])
+    assert code == 2
+    assert "--lumen-mm: no tip sphere passes" in capsys.readouterr().err
+    code = main(["design", "--modulus-range", "1:20", "--lumen-mm", "2.8", "--clearance-mm", "3"])
+    assert code == 2
+    assert "--clearance-mm" in capsys.readouterr().err

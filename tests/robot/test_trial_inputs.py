@@ -100,3 +100,26 @@ def test_the_robot_configuration_states_each_compliance_or_its_absence() -> None
         from_mapping(StackConfig, {"tubes": [{"name": "a", "compliance_mm_per_n": [0.2, 0.1]}]})
     with pytest.raises(ConfigError, match="temperature_compensation"):
         from_mapping(StackConfig, {"fbg": {"temperature_compensation": "measured"}})
+
+
+def test_rows_whose_gratings_are_off_the_beam_are_left_out_of_the_fit() -> None:
+    """An advance taken against a drift estimated far beyond the record's can leave rows
+    before the sensor left the tube: they have no beam state, the fit says so, never raises."""
+    import numpy as np
+
+    from palpate.config import load_stack, resolve
+    from palpate.robot.trial.estimate import MIN_POINTS, fit_record
+    from palpate.robot.trial.setup import sensor_section
+
+    stack = load_stack(resolve("robot-lung-lumen-2.8.yaml"))
+    inputs = EstimatorInputs(
+        "robot", 0.1, 0.0, 1.3e-3, encoder_resolution=5e-6, misalignment=0.0, **TRUTH
+    )
+    n = 3 * MIN_POINTS
+    strains = np.zeros((n, len(stack.sensor.used_gratings)))
+    advance = np.linspace(-0.12, -0.01, n)  # every row: the gratings still inside the tube
+    forces = np.zeros(n)
+    out = fit_record(advance, strains, inputs, stack.sensor, sensor_section(stack), forces)
+    assert out.joint is not None
+    assert out.joint.success is False
+    assert "too few points: 0 loading samples" in out.joint.message

@@ -1,0 +1,108 @@
+"""What ``palpate design --lumen-mm`` adds to the design's report: what passes the channel, the
+moduli one sensor spans through it, the limits that bind at either end and the second sensor."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from palpate.campaigns.designcheck import UNITS
+from palpate.estimation.design import DesignConstraints
+from palpate.estimation.design.lumen import Lumen, Span
+from palpate.estimation.design.results import CHECKS
+
+LIMIT_NAMES = {
+    "force": "force resolution",
+    "resolution": "depth resolution",
+    "depth": "delta/R",
+    "thickness": "the layer",
+    "plane": "the beam's softness (it must still buckle in the gratings' plane)",
+    "detection": "buckling detection",
+    "delta_bias": "travel that is not indentation",
+    "fiber_strain": "the fiber's strain",
+}
+
+
+@dataclass(frozen=True)
+class LumenReport:
+    """The lumen, the span of the range through it, the constraints and the unit shown."""
+
+    lumen: Lumen
+    span: Span
+    constraints: DesignConstraints
+    unit: str
+
+    def as_dict(self) -> dict[str, Any]:
+        return lumen_payload(self.lumen, self.span, self.constraints, self.unit)
+
+    def text(self) -> str:
+        return lumen_text(self.lumen, self.span, self.constraints, self.unit)
+
+
+def _limits(names: tuple[str, ...]) -> list[dict[str, str]]:
+    return [{"check": n, "limit": LIMIT_NAMES.get(n, n), "description": CHECKS[n]} for n in names]
+
+
+def lumen_payload(
+    lumen: Lumen, span: Span, constraints: DesignConstraints, unit_name: str
+) -> dict[str, Any]:
+    """The ``lumen`` entry of ``palpate design --json``."""
+    unit = UNITS[unit_name]
+    res = constraints.tip_force_resolution
+    return {
+        "diameter_mm": lumen.diameter * 1e3,
+        "clearance_mm": lumen.clearance * 1e3,
+        "passage_mm": lumen.passage * 1e3,
+        "largest_tip_radius_mm": lumen.largest_tip() * 1e3,
+        "tip_force_resolution_mn": None if res is None else res * 1e3,
+        "smallest_critical_load_mn": constraints.smallest_critical_load * 1e3,
+        "max_depth_ratio": constraints.max_depth_ratio,
+        "one_sensor": span.one_sensor,
+        f"requested_{unit_name.lower()}": [e / unit for e in span.requested],
+        f"ranges_{unit_name.lower()}": [[a / unit, b / unit] for a, b in span.ranges],
+        "lowest_blocked_by": _limits(span.lowest_blocked),
+        "top_blocked_by": _limits(span.top_blocked),
+    }
+
+
+def lumen_text(lumen: Lumen, span: Span, constraints: DesignConstraints, unit_name: str) -> str:
+    """The lumen's paragraph of ``palpate design``'s report."""
+    unit = UNITS[unit_name]
+
+    def kpa(e: float) -> str:
+        return f"{e / unit:.3g}"
+
+    lo, hi = span.requested
+    res = constraints.tip_force_resolution
+    head = (
+        f"lumen {lumen.diameter * 1e3:g} mm (passage {lumen.passage * 1e3:.3g} mm: tip R <= "
+        f"{lumen.largest_tip() * 1e3:.3g} mm), tip grating resolution "
+        + ("none" if res is None else f"{res * 1e3:.3g} mN (P_cr >= "
+           f"{constraints.smallest_critical_load * 1e3:.3g} mN)")
+        + f", delta/R <= {constraints.max_depth_ratio:g}"
+    )  # fmt: skip
+    if span.one_sensor:
+        return f"{head}\n  one sensor spans {kpa(lo)}-{kpa(hi)} {unit_name}"
+    lines = [head, f"  one sensor cannot span {kpa(lo)}-{kpa(hi)} {unit_name} through it"]
+    if not span.ranges:
+        lines.append(
+            f"  no sensor through it reaches any of the range: {_named(span.lowest_blocked)}"
+        )
+        return "\n".join(lines)
+    if span.lowest_blocked:
+        lines.append(
+            f"  below {kpa(span.ranges[0][0])} {unit_name} no sensor through it works: "
+            f"{_named(span.lowest_blocked)}"
+        )
+    first = span.ranges[0]
+    lines.append(f"  the widest one sensor spans: {kpa(first[0])}-{kpa(first[1])} {unit_name}")
+    if span.top_blocked:
+        lines.append(f"    past it: {_named(span.top_blocked)}")
+    if len(span.ranges) > 1:
+        second = span.ranges[1]
+        lines.append(f"  a second sensor: {kpa(second[0])}-{kpa(second[1])} {unit_name}")
+    return "\n".join(lines)
+
+
+def _named(names: tuple[str, ...]) -> str:
+    return ", ".join(LIMIT_NAMES.get(n, n) for n in names) or "(no check named)"
