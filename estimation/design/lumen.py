@@ -30,7 +30,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from .results import DesignResult
-from .search import design_sensor
+from .search import binding_checks, design_sensor
 from .space import DesignConstraints, DesignSpace
 
 MM = 1e-3
@@ -113,8 +113,8 @@ class Span:
             it; else the widest from the lowest reachable modulus, then a second sensor's; empty
             when no modulus of the range is reachable.
         designs: each range's design (the search's result).
-        lowest_blocked: the checks that keep any sensor from the requested E_min (empty when it
-            is reached).
+        lowest_blocked: the checks that keep any sensor from the requested E_min
+            (``search.binding_checks``: each alone; empty when it is reached).
         top_blocked: the checks that stop the first sensor's range from reaching further.
     """
 
@@ -157,7 +157,7 @@ def span_range(
     lowest_blocked: tuple[str, ...] = ()
     start = lo
     if not search(lo, lo).success:
-        lowest_blocked = _failed(search(lo, lo))
+        lowest_blocked = binding_checks((lo, lo), constraints, space)
         reachable = _first(lambda e: search(e, e).success, lo, hi, tolerance)
         if reachable is None:
             return Span((lo, hi), (), (), lowest_blocked, ())
@@ -166,17 +166,12 @@ def span_range(
     first = search(start, top)
     if top >= hi:
         return Span((lo, hi), ((start, hi),), (first,), lowest_blocked, ())
-    top_blocked = _failed(search(start, top * (1 + tolerance)))
+    top_blocked = binding_checks((start, top * (1 + tolerance)), constraints, space)
     second_top = _last(lambda e: search(top, e).success, top, hi, tolerance)
     second = search(top, second_top)
     ranges = ((start, top), (top, second_top)) if second.success else ((start, top),)
     designs = (first, second) if second.success else (first,)
     return Span((lo, hi), ranges, designs, lowest_blocked, top_blocked)
-
-
-def _failed(result: DesignResult) -> tuple[str, ...]:
-    """The names of the checks the closest candidate fails."""
-    return () if result.evaluation is None else tuple(c.name for c in result.evaluation.failed)
 
 
 def _first(ok: Callable[[float], bool], lo: float, hi: float, tolerance: float) -> float | None:

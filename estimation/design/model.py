@@ -24,6 +24,7 @@ from ..elastica import fast
 from ..elastica.constants import E_OVER_L_MAX, MODE_SHORTENING, P_CRIT
 from .results import Check, DesignEvaluation
 from .space import DesignConstraints, SensorDesign
+from .weight import sag_share
 
 FloatArray = NDArray[np.float64]
 
@@ -118,10 +119,12 @@ def assess(
     L: FloatArray,
     modulus_range: tuple[float, float],
     c: DesignConstraints,
+    linear_mass: FloatArray | None = None,
 ) -> Assessment:
     """All checks for N candidates: EI in the fiber's plane and across it (N m^2), EA (N),
     fiber offset and radius, tip radius R and exposed length L (m), each (N,); L must reach
-    past the gratings."""
+    past the gratings. ``linear_mass`` (kg/m, (N,)) is the beam's, for the ``weight`` check
+    (``c.held_across``; required then)."""
     e_min, e_max = modulus_range
     p_cr = P_CRIT * EI / L**2
     preload = p_cr / EA  # the axial strain every grating carries at P_cr
@@ -138,6 +141,12 @@ def assess(
     bias = p_cr * L / EA + e_det + e_imp * L
     checks = _checks(depth_ratio, contact_ratio, d_stiff, detection, floor, bias, peak, c)
     checks["plane"] = (EI_across / EI, np.full_like(EI, c.plane_margin), False)
+    if c.held_across:
+        if linear_mass is None:
+            raise ValueError("the weight check (held_across) needs the beam's linear mass")
+        tip_mass = c.tip_density * 4.0 / 3.0 * math.pi * R**3
+        sag = sag_share(tip_mass, linear_mass, EI, L)
+        checks["weight"] = (sag, np.full_like(EI, c.sag_limit), True)
     if c.tip_force_resolution is not None:
         checks["force"] = (p_cr, np.full_like(EI, c.smallest_critical_load), False)
     return Assessment(
@@ -304,5 +313,6 @@ def evaluate_design(
         one(design.exposed_length),
         rng,
         c,
+        one(design.linear_mass()),
     )
     return evaluation(design, arrays, 0, rng)

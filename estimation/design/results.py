@@ -16,6 +16,8 @@ CHECKS: dict[str, str] = {
     "delta_bias": "stage travel that is not indentation <= max_bias_fraction x delta at E_max",
     "fiber_strain": "fiber survives: peak strain after e_det + post-buckling travel <= limit",
     "plane": "buckles in the fiber's plane: EI across it >= plane_margin x EI in it",
+    "weight": "carries its own weight held across: the tip's sag (a solid printed sphere and "
+    "the beam) <= sag_limit x L",
     "force": "the tip grating resolves the load curve: the contact's load (contact_sigmas x "
     "resolution) sinks the tip at most contact_depth_fraction of delta at buckling",
 }

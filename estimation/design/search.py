@@ -12,6 +12,7 @@ from ..section import across_rigidity, composite_section
 from .model import Assessment, assess, checked_range, evaluation
 from .results import Check, DesignEvaluation, DesignResult
 from .space import DesignConstraints, DesignSpace, SensorDesign
+from .weight import linear_mass
 
 FloatArray = NDArray[np.float64]
 
@@ -135,6 +136,7 @@ class _Candidates:
             self.lengths[self.length],
             rng,
             c,
+            np.asarray([linear_mass(*h) for h in self.hardware], dtype=np.float64)[self.hw],
         )
 
     def design(self, k: int) -> SensorDesign:
@@ -225,3 +227,29 @@ def _no_design(
         f"{reason} {closest[0].upper()}{closest[1:]}" if reason else closest
     )
     return DesignResult(False, message, ev, None, candidates, 0, failures)
+
+
+def binding_checks(
+    modulus_range: tuple[float, float], constraints: DesignConstraints, space: DesignSpace
+) -> tuple[str, ...]:
+    """The checks that bind on ``modulus_range`` (Pa): those whose relaxing alone would let a
+    candidate of ``space`` pass (each alone keeps every candidate out); when no single check
+    does, those the closest candidate fails (several bind together). Empty when a candidate
+    passes."""
+    rng = checked_range(modulus_range)
+    lengths = space.lengths()
+    lengths = lengths[lengths >= constraints.grating_reach]
+    if lengths.size == 0:
+        return ()
+    arrays = _Candidates.of(space, lengths).assess(rng, constraints)
+    passes = arrays.log_margins() >= 0.0
+    if np.any(np.all(passes, axis=1)):
+        return ()
+    names = list(arrays.checks)
+    alone = tuple(
+        name for j, name in enumerate(names) if np.any(np.all(np.delete(passes, j, axis=1), axis=1))
+    )
+    if alone:
+        return alone
+    closest = _leximin(arrays.log_margins(), np.arange(passes.shape[0]))
+    return tuple(n for j, n in enumerate(names) if not passes[closest, j])

@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..corrections import LAYER_STRAIN_MAX
 from ..section import Section, across_rigidity, composite_section, euler_load
+from .weight import SAG_LIMIT, TIP_DENSITY, linear_mass
 
 FloatArray = NDArray[np.float64]
 
@@ -116,6 +117,12 @@ class DesignConstraints:
             takes the contact at 5 sigma).
         contact_depth_fraction: the share of the indentation at buckling the contact's
             threshold may take (the rest is the load curve the fit reads).
+        held_across: the sensor must carry its own weight in any pose (``weight`` check: held
+            across, the tip's sag under a solid printed sphere of ``tip_density`` and the beam
+            stays within ``sag_limit`` of L; ``estimation.design.weight``). False: it is only
+            reported after the search (usable pointing vertically).
+        tip_density: the tip sphere's density (kg/m^3) for the ``weight`` check.
+        sag_limit: the sag / L the ``weight`` check allows.
     """
 
     poisson: float = 0.45
@@ -138,6 +145,9 @@ class DesignConstraints:
     tip_force_resolution: float | None = None
     contact_sigmas: float = 5.0
     contact_depth_fraction: float = 0.5
+    held_across: bool = False
+    tip_density: float = TIP_DENSITY
+    sag_limit: float = SAG_LIMIT
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.poisson < 0.5 + 1e-12:
@@ -158,6 +168,8 @@ class DesignConstraints:
             "plane_margin",
             "contact_sigmas",
             "contact_depth_fraction",
+            "tip_density",
+            "sag_limit",
         )
         for name in positive:
             value = getattr(self, name)
@@ -219,6 +231,10 @@ class SensorDesign:
 
     def critical_load(self) -> float:
         return euler_load(self.section().EI, self.exposed_length)
+
+    def linear_mass(self) -> float:
+        """The beam's mass per length (kg/m)."""
+        return linear_mass(self.fiber_radius, self.wire_count, self.wire_radius)
 
     def across_rigidity(self) -> float:
         """EI across the fiber's plane (N m^2), :func:`estimation.section.across_rigidity`."""

@@ -17,9 +17,31 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
 STANDARD_GRAVITY = 9.80665  # m/s^2
 SAG_LIMIT = 0.015
 """sag / L a design may have: about the paper's sensor's (1.1 %), whose estimates carry it."""
+SILICA_DENSITY = 2200.0  # kg/m^3, the fiber
+NITI_DENSITY = 6450.0  # kg/m^3, the wires
+TIP_DENSITY = 1200.0  # kg/m^3, a printed resin sphere
+
+
+def linear_mass(fiber_radius: float, wire_count: int, wire_radius: float) -> float:
+    """The beam's mass per length (kg/m): the fiber and its wires."""
+    return math.pi * (SILICA_DENSITY * fiber_radius**2 + NITI_DENSITY * wire_count * wire_radius**2)
+
+
+def sag_share(
+    tip_mass: ArrayLike, linear_mass: ArrayLike, EI: ArrayLike, length: ArrayLike
+) -> FloatArray:
+    """sag / L of the cantilever held across (see the module docstring), elementwise."""
+    m, q = np.asarray(tip_mass, dtype=float), np.asarray(linear_mass, dtype=float)
+    EI_, L = np.asarray(EI, dtype=float), np.asarray(length, dtype=float)
+    return np.asarray((m + 0.375 * q * L) * STANDARD_GRAVITY * L**2 / (3.0 * EI_))
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig, TipGratingConfig
 from palpate.estimation.design import DesignEvaluation
 from palpate.estimation.design.tipgrating import TipGratingChoice
+from palpate.estimation.design.weight import linear_mass
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}
@@ -103,8 +104,6 @@ def design_scene(
     return scene, dataclasses.replace(stack, sensor=sensor)
 
 
-SILICA_DENSITY = 2200.0  # kg/m^3, the fiber
-NITI_DENSITY = 6450.0  # kg/m^3, the wires
 REFERENCE_WAVELENGTH_NM = (
     1525.0  # the strain-free reference grating a tip grating's compensation uses
 )
@@ -125,9 +124,7 @@ def designed_stack(
         s,
         tip_mass_g=s.tip_mass_g if tip_mass_g is None else tip_mass_g,
         designed_range_kpa=(modulus_range[0] / 1e3, modulus_range[1] / 1e3),
-        linear_mass_g_per_m=1e3
-        * math.pi
-        * (SILICA_DENSITY * s.fiber_radius**2 + NITI_DENSITY * s.wire_count * s.wire_radius**2),
+        linear_mass_g_per_m=1e3 * linear_mass(s.fiber_radius, s.wire_count, s.wire_radius),
     )
     if tip is None:
         return dataclasses.replace(stack, sensor=sensor)

@@ -91,6 +91,8 @@ def _written_note(args: argparse.Namespace) -> str:
     tip = " --tip-grating" if args.tip_grating else ""
     if args.lumen_mm is not None:
         tip += f" --lumen-mm {args.lumen_mm:g} --tip-resolution-mn {args.tip_resolution_mn:g}"
+    if args.pose == "any":
+        tip += " --pose any"
     if args.tip_mass_g is not None:
         tip += f" --tip-mass-g {args.tip_mass_g:g}"
     return (

@@ -112,6 +112,14 @@ def _add_space_arguments(parser: argparse.ArgumentParser) -> None:
         "widest range one sensor spans through it and the second sensor's",
     )
     parser.add_argument(
+        "--pose",
+        choices=("any", "vertical"),
+        default="vertical",
+        help="any: the design must carry its own weight held across (the search's weight check, "
+        "a solid printed tip sphere; in the body the sensor meets tissue at any angle to "
+        "gravity); vertical: the sag is only reported after the search (default)",
+    )
+    parser.add_argument(
         "--clearance-mm", type=float, default=0.2, help="what a tool leaves of the channel"
     )
     parser.add_argument(
@@ -202,6 +210,7 @@ def inputs(
         ),
         imperfection=args.imperfection,
         max_depth_ratio=_depth_ratio(args),
+        held_across=args.pose == "any",
         tip_force_resolution=None if args.lumen_mm is None else args.tip_resolution_mn * 1e-3,
         post_buckling_travel=scene.campaign.post_buckling,
         grating_centres_from_tip=s.grating_centres_from_tip(),

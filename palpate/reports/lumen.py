@@ -20,6 +20,7 @@ LIMIT_NAMES = {
     "detection": "buckling detection",
     "delta_bias": "travel that is not indentation",
     "fiber_strain": "the fiber's strain",
+    "weight": "the beam's own weight held across",
 }
 
 

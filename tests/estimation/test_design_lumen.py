@@ -100,3 +100,41 @@ def test_a_published_resolution_sets_the_tip_gratings_sensitivity() -> None:
     assert tip.resolution_share == pytest.approx(0.05 / 4.0)
     with pytest.raises(ValueError, match="less than"):
         tip_grating_for_resolution(4e-3, 1.0, 0.001e-3)  # 1000 pm/mN reaches 2 mN
+
+
+def test_the_binding_checks_are_those_whose_relaxing_alone_lets_a_candidate_pass() -> None:
+    from palpate.estimation.design.search import binding_checks
+
+    c = DesignConstraints(max_depth_ratio=1.0, tip_force_resolution=0.05e-3)
+    space = Lumen(2.8e-3).space(SPACE)
+    assert binding_checks((8 * KPA, 16 * KPA), c, space) == ()
+    binding = binding_checks((1 * KPA, 1 * KPA), c, space)
+    assert "depth" in binding
+    for name in binding:  # relaxing that one check alone lets a sensor reach 1 kPa
+        relaxed = DesignConstraints(max_depth_ratio=1e6 if name == "depth" else 1.0,
+                                    plane_margin=1e-6 if name == "plane" else 2.0,
+                                    tip_force_resolution=0.05e-3)  # fmt: skip
+        if name in ("depth", "plane"):
+            assert design_sensor((1 * KPA, 1 * KPA), relaxed, space).success
+
+
+def test_held_across_a_sensor_must_carry_its_own_weight() -> None:
+    from palpate.estimation.design import evaluate_design
+    from palpate.estimation.design.weight import SAG_LIMIT, weight_check
+
+    c = DesignConstraints(max_depth_ratio=1.0, held_across=True)
+    space = Lumen(2.8e-3).space(SPACE)
+    found = design_sensor((20 * KPA, 20 * KPA), c, space)
+    assert found.success
+    assert found.evaluation is not None
+    weight = {ch.name: ch for ch in found.evaluation.checks}["weight"]
+    d = found.evaluation.design
+    tip_mass = c.tip_density * 4 / 3 * math.pi * d.tip_radius**3
+    sag = weight_check(tip_mass, d.linear_mass(), d.section().EI, d.exposed_length)
+    assert weight.value == pytest.approx(sag.sag_over_length)
+    assert weight.value <= SAG_LIMIT
+    # the 100 mm beam that reaches 1.42 kPa held vertically sags a quarter of its length
+    soft = span_range((1 * KPA, 20 * KPA), DesignConstraints(max_depth_ratio=1.0), space)
+    ev = evaluate_design(soft.designs[0].evaluation.design, soft.ranges[0], c)  # type: ignore[union-attr]
+    assert not {ch.name: ch for ch in ev.checks}["weight"].ok
+    assert not design_sensor((1 * KPA, 20 * KPA), c, space).success
