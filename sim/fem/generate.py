@@ -67,11 +67,19 @@ for _h in (5e-3, 6e-3, 8e-3, 12e-3, 16e-3, 20e-3, 30e-3):
 SHIPPED["lung-20mm-nu0.45-frictionless"] = LayerProblem.from_dimensions(
     10e-3, 20e-3, 60e-3, poisson=0.45, material="neo-hookean", contact="frictionless"
 )
+# the channel-sized lung sensors' tips (``config/scenes/invivo/lumen-*.yaml``: R = 1.3, 0.9 mm)
+for _r in (1.3e-3, 0.9e-3):
+    for _h in (10e-3, 20e-3, 40e-3):
+        for _nu in (0.45, 0.49):
+            SHIPPED[f"lumen-R{_r * 1e3:g}-{_h * 1e3:g}mm-nu{_nu:g}"] = LayerProblem.from_dimensions(
+                _r, _h, 60e-3, poisson=_nu, material="neo-hookean", contact="stick"
+            )
 """The problems whose tables ship in ``sim/fem/tables``, by name: the paper's and the soft
 designs' phantoms, the half-space stand-in, the thin and deep layers of
 ``config/scenes/layers/`` (R = 3.5 mm, frictionless tip), the mismatch scenes' layers (other nu,
 sliding, 5-30 mm) and the lung scene's neo-Hookean layers
-(R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung/``, its slip scene frictionless)."""
+(R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung/``, its slip scene frictionless),
+and the same layers under the channel-sized sensors' tips (``config/scenes/invivo/lumen-*``)."""
 
 
 def main(argv: list[str] | None = None) -> int:
