@@ -49,8 +49,9 @@ class CheckSettings:
 
 def campaign_lengths(length: float, window: tuple[float, float], count: int) -> tuple[float, ...]:
     """``count`` exposed lengths (m) around the proposed one, in the middle of the window where
-    the hardware passes every check (geometric means of each end with the proposal)."""
-    if count <= 1:
+    the hardware passes every check (geometric means of each end with the proposal); one when
+    the window is the proposal alone (a design on its checks' edge)."""
+    if count <= 1 or window[0] == window[1]:
         return (length,)
     lo, hi = math.sqrt(window[0] * length), math.sqrt(window[1] * length)
     return tuple(float(v) for v in np.linspace(lo, hi, count))

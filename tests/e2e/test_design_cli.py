@@ -152,3 +152,12 @@ def test_a_channel_nothing_passes_is_bad_input(capsys: pytest.CaptureFixture[str
     code = main(["design", "--modulus-range", "1:20", "--lumen-mm", "2.8", "--clearance-mm", "3"])
     assert code == 2
     assert "--clearance-mm" in capsys.readouterr().err
+
+
+def test_a_design_on_its_checks_edge_is_checked_at_its_one_length() -> None:
+    from palpate.campaigns.designcheck import campaign_lengths
+
+    assert campaign_lengths(0.1, (0.1, 0.1), 2) == (0.1,)  # no window: not the same trial twice
+    lengths = campaign_lengths(0.05, (0.04, 0.07), 2)
+    assert len(lengths) == 2
+    assert 0.04 < lengths[0] < 0.05 < lengths[1] < 0.07
