@@ -193,7 +193,10 @@ def measure_lean(
              for g in np.unique(groups)}  # fmt: skip
     m = np.array([modes[g] for g in groups]).reshape(y.shape)
     cap = (0.5 * math.pi) ** 2 * EI / L**2
-    use = np.flatnonzero(np.max(np.abs(y), axis=1) < MAX_BENDING)
+    # a row with every grating still inside the tube has no onset mode (it would normalise to
+    # NaN): it carries nothing of the lean and is left out
+    bows = np.any(m != 0.0, axis=1)
+    use = np.flatnonzero((np.max(np.abs(y), axis=1) < MAX_BENDING) & bows)
     if use.size > MAX_ROWS:
         use = use[np.linspace(0, use.size - 1, MAX_ROWS).round().astype(int)]
     if use.size < MIN_ROWS:

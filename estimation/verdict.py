@@ -234,10 +234,17 @@ def _trial_reasons(facts: TrialFacts) -> list[str]:
 def _moved(fit: JointFit, facts: TrialFacts) -> str | None:
     """Why the surface's motion during the contact (``facts.motion``) is too much, None if it
     is not (or is not checked): past the campaign's tolerance, or past MOTION_SHARE of the
-    fitted indentation (the modulus moves by about 1.5 times that share)."""
+    fitted indentation (the modulus moves by about 1.5 times that share); with a tolerance and
+    no motion measured, that it is not known."""
     moved, tol = facts.motion, facts.motion_tolerance
-    if moved is None or tol is None:
+    if tol is None:
         return None
+    if moved is None:  # a campaign that expects motion cannot vouch for a trial it did not see
+        return (
+            "motion not measured: the first touch and the release could not be matched at one "
+            f"load (a tip grating's record is needed), so whether the surface moved past the "
+            f"campaign's {tol * 1e3:g} mm tolerance is not known"
+        )
     limit, what = tol, f"the campaign's {tol * 1e3:g} mm tolerance"
     if fit.max_depth is not None and MOTION_SHARE * fit.max_depth < limit:
         limit = MOTION_SHARE * fit.max_depth

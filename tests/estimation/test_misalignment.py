@@ -143,3 +143,16 @@ def test_a_measured_misalignment_is_verified_within_the_tolerance_at_two_sigmas(
     beyond = judge(_ok_fit(), facts(2.5, 0.3), 3.5e-3)
     assert any("beyond the campaign's tolerance" in r for r in beyond.reasons)
     assert not any("not verified within" in r for r in beyond.reasons)  # said once
+
+
+def test_rows_with_every_grating_inside_the_tube_are_left_out_not_nan() -> None:
+    """Rows whose gratings are all still inside the tube (an advance taken against a drift
+    estimated far beyond the record's) have no onset mode: left out, never a NaN."""
+    y = pinned(0.002, seed=4)
+    lengths = np.full(y.shape[0], L)
+    lengths[:40] = 5e-3  # every grating (8.5-27.5 mm from the tip) inside the tube
+    with np.errstate(invalid="raise", divide="raise"):
+        lean = measure_lean(y, lengths, FROM_TIP, EA, EI, DY)
+    assert lean.success
+    assert math.isfinite(lean.aligned_chi2)
+    assert not lean.lateral

@@ -80,3 +80,14 @@ def test_the_verdict_says_how_far_the_surface_moved() -> None:
     assert (
         judge(fit(2e-3), TrialFacts(motion=5e-3), 10e-3).status == "ok"
     )  # no tolerance: unchecked
+
+
+def test_a_campaign_expecting_motion_cannot_vouch_for_a_trial_whose_motion_was_not_seen() -> None:
+    # a relaxing lung trial in a breath hold (invivo/lumen-2.8-relaxing.yaml, seed 0): its
+    # surface moved 0.42 mm, its release could not be matched to its touch, and it read `ok`
+    facts = TrialFacts(motion=None, motion_tolerance=0.2e-3)
+    verdict = judge(fit(2e-3), facts, 10e-3)
+    assert verdict.status == "suspect"
+    assert verdict.reasons[-1].startswith("motion not measured")
+    assert "0.2 mm tolerance" in verdict.reasons[-1]
+    assert judge(fit(2e-3), TrialFacts(motion=None), 10e-3).status == "ok"  # nothing expected
