@@ -34,13 +34,8 @@ from palpate.config import load, load_stack, resolve
 from palpate.config.loader import InputError, write_yaml
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.estimation.design import (
-    DesignConstraints,
-    DesignResult,
-)
-from palpate.estimation.design.tipgrating import (
-    TipGratingChoice,
-)
+from palpate.estimation.design import DesignConstraints, DesignResult
+from palpate.estimation.design.tipgrating import TipGratingChoice
 from palpate.estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
 from palpate.estimation.section import composite_section
 from palpate.progress import progress_bar
