@@ -242,8 +242,7 @@ def _moved(fit: JointFit, facts: TrialFacts) -> str | None:
     if moved is None:  # a campaign that expects motion cannot vouch for a trial it did not see
         return (
             "motion not measured: the first touch and the release could not be matched at one "
-            f"load (a tip grating's record is needed), so whether the surface moved past the "
-            f"campaign's {tol * 1e3:g} mm tolerance is not known"
+            f"load, so whether the surface moved past the {tol * 1e3:g} mm tolerance is not known"
         )
     limit, what = tol, f"the campaign's {tol * 1e3:g} mm tolerance"
     if fit.max_depth is not None and MOTION_SHARE * fit.max_depth < limit:

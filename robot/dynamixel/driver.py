@@ -36,12 +36,7 @@ import dynamixel_sdk as sdk
 from ...config.schema import ServoBusConfig, XYStageConfig
 from ...sensor.ports import PORT_ERRORS, open_failure
 from ...wire import dynamixel as tables
-from ..motors import (
-    MotorState,
-    ServoFaultError,
-    ServoIdentityError,
-    ServoTransportError,
-)
+from ..motors import MotorState, ServoFaultError, ServoIdentityError, ServoTransportError
 from . import units
 from .latency import USB_SERIAL_SYSFS, latency_warning
 from .port import PortRecovery, TimedPortHandler
@@ -97,8 +92,8 @@ class DynamixelBus:
         self._ph = sdk.PacketHandler(2.0) if packet_handler is None else packet_handler
         self._baudrate = baudrate
         self._retries = retries
-        # connect pings each servo for CONNECT_PATIENCE_S at least: nothing moves yet, and a
-        # busy host (or an emulator starting beside it) may answer late
+        # every transaction of connect waits CONNECT_PATIENCE_S at least: nothing moves yet,
+        # and a busy host (or an emulator starting beside it) may answer late
         self._connect_retries = max(retries, math.ceil(CONNECT_PATIENCE_S / timeout) - 1)
         self.max_goal_step = max_goal_step
         self._last_goals: dict[str, float] = {}
@@ -167,9 +162,10 @@ class DynamixelBus:
         if warning:
             log.warning("%s", warning)
         self._connected = True
+        retries, self._retries = self._retries, self._connect_retries
         try:
             for m in self._motors.values():
-                model = self.ping(m.name, retries=self._connect_retries)
+                model = self.ping(m.name)
                 if model != tables.MODEL_NUMBERS[m.model]:
                     found = tables.MODEL_NAMES.get(model, f"model number {model}")
                     raise ServoIdentityError(
@@ -181,8 +177,10 @@ class DynamixelBus:
                 if self.read_item(m.name, "Operating_Mode") != tables.MODE_EXTENDED_POSITION:
                     self.write_item(m.name, "Operating_Mode", tables.MODE_EXTENDED_POSITION)
         except BaseException:
+            self._retries = retries
             self.close()
             raise
+        self._retries = retries
 
     def close(self) -> None:
         """Torque off on every servo (best effort, each tried), then close the port."""

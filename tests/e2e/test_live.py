@@ -56,8 +56,11 @@ class Client:
                         new = {c["id"]: c["topic"] for c in op["channels"]}
                         topics.update(new)
                         self.advertised.update(new.values())
-                        subs = [{"id": cid, "channelId": cid} for cid in new]
-                        ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+                        # one request a channel: a trial's channel gone before the request
+                        # arrives ("unknown channel") must not take the others' with it
+                        for cid in new:
+                            sub = [{"id": cid, "channelId": cid}]
+                            ws.send(json.dumps({"op": "subscribe", "subscriptions": sub}))
                         if self.wanted <= self.advertised:
                             self.subscribed.set()
                     continue

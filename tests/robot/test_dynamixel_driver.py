@@ -283,3 +283,35 @@ def test_real_bus_reads_state() -> None:
         pytest.skip("no servo bus: set PALPATE_HW_SERVO_PORT")
     with DynamixelBus.from_config(ServoBusConfig(), port=port) as bus:
         assert set(bus.read_state()) == set(NAMES)
+
+
+class _LateReads:
+    """The SDK's packet handler whose next ``late`` register reads get no reply: a busy host
+    (or an emulator starting beside it) answering past the timeout."""
+
+    def __init__(self, late: int) -> None:
+        self._inner = sdk.PacketHandler(2.0)
+        self.late = late
+
+    def readTxRx(self, port: object, servo_id: int, address: int, size: int) -> object:
+        if self.late > 0:
+            self.late -= 1
+            return [], sdk.COMM_RX_TIMEOUT, 0
+        return self._inner.readTxRx(port, servo_id, address, size)
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._inner, name)
+
+
+def test_connect_waits_its_patience_on_every_transaction_not_only_the_pings(
+    silent: EmulatedBus,
+) -> None:
+    cfg = ServoBusConfig(retries=2, timeout_ms=20.0)  # 3 attempts a transaction; 0.5 s: 25
+    port = InProcessPort(silent)
+    port.reply_timeout_ms = 0.0
+    late = _LateReads(late=6)  # the operating mode's read is late 6 times in a row
+    with DynamixelBus.from_config(cfg, port=port, packet_handler=late) as driver:
+        assert late.late == 0
+        late.late = 6  # after connect the bus's own retries hold: 3 attempts
+        with pytest.raises(ServoTransportError, match="3 attempts"):
+            driver.read_item("translation", "Present_Position")
