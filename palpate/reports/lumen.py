@@ -70,7 +70,7 @@ def lumen_text(lumen: Lumen, span: Span, constraints: DesignConstraints, unit_na
     """The lumen's paragraph of ``palpate design``'s report."""
     unit = UNITS[unit_name]
 
-    def kpa(e: float) -> str:
+    def shown(e: float) -> str:
         return f"{e / unit:.3g}"
 
     lo, hi = span.requested
@@ -83,8 +83,8 @@ def lumen_text(lumen: Lumen, span: Span, constraints: DesignConstraints, unit_na
         + f", delta/R <= {constraints.max_depth_ratio:g}"
     )  # fmt: skip
     if span.one_sensor:
-        return f"{head}\n  one sensor spans {kpa(lo)}-{kpa(hi)} {unit_name}"
-    lines = [head, f"  one sensor cannot span {kpa(lo)}-{kpa(hi)} {unit_name} through it"]
+        return f"{head}\n  one sensor spans {shown(lo)}-{shown(hi)} {unit_name}"
+    lines = [head, f"  one sensor cannot span {shown(lo)}-{shown(hi)} {unit_name} through it"]
     if not span.ranges:
         lines.append(
             f"  no sensor through it reaches any of the range: {_named(span.lowest_blocked)}"
@@ -92,16 +92,16 @@ def lumen_text(lumen: Lumen, span: Span, constraints: DesignConstraints, unit_na
         return "\n".join(lines)
     if span.lowest_blocked:
         lines.append(
-            f"  below {kpa(span.ranges[0][0])} {unit_name} no sensor through it works: "
+            f"  below {shown(span.ranges[0][0])} {unit_name} no sensor through it works: "
             f"{_named(span.lowest_blocked)}"
         )
     first = span.ranges[0]
-    lines.append(f"  the widest one sensor spans: {kpa(first[0])}-{kpa(first[1])} {unit_name}")
+    lines.append(f"  the widest one sensor spans: {shown(first[0])}-{shown(first[1])} {unit_name}")
     if span.top_blocked:
         lines.append(f"    past it: {_named(span.top_blocked)}")
     if len(span.ranges) > 1:
         second = span.ranges[1]
-        lines.append(f"  a second sensor: {kpa(second[0])}-{kpa(second[1])} {unit_name}")
+        lines.append(f"  a second sensor: {shown(second[0])}-{shown(second[1])} {unit_name}")
     return "\n".join(lines)
 
 
