@@ -116,7 +116,9 @@ class CampaignConfig:
     hold_s: float = field(default=0.0, metadata=limits(ge=0, le=50))
     max_travel_past_contact_mm: float = field(default=2.5, metadata=limits(gt=0, le=50))
     contact: Literal["event", "fbg", "tip"] = "event"
-    detector: Literal["paper", "cusum"] = "paper"
+    # paper: the strain norm past detector_threshold_ue; cusum: the first mode's CUSUM; tip: the
+    # tip grating's load stops rising (estimation.detect_plateau; a sagging mN beam, docs/invivo.md)
+    detector: Literal["paper", "cusum", "tip"] = "paper"
     detector_threshold_ue: float = field(default=300.0, metadata=limits(gt=0, le=10000))
     outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))
     # A diagnostic threshold (normal below, diseased above): `palpate sim` counts the trials with

@@ -85,8 +85,12 @@ class BucklingDetector(Protocol):
         """Re-arm: forget every sample seen."""
         ...
 
-    def update(self, strains: tuple[float, ...]) -> bool:
-        """Feed one sample of grating strains (N,); True once buckling is detected."""
+    def update(
+        self, strains: tuple[float, ...], advance: float | None = None, load: float | None = None
+    ) -> bool:
+        """Feed one sample of grating strains (N,), with the stage's ``advance`` (m) and the
+        tip grating's ``load`` (N, None without one) for a detector that reads them
+        (``estimation.detect_plateau``); True once buckling is detected."""
         ...
 
 
@@ -96,7 +100,9 @@ class Detector(BucklingDetector, Protocol):
 
     alarm: bool
 
-    def update(self, strains: ArrayLike) -> bool: ...
+    def update(
+        self, strains: ArrayLike, advance: float | None = None, load: float | None = None
+    ) -> bool: ...
 
     def first_alarm(self, strains: ArrayLike) -> int | None: ...
 
@@ -119,7 +125,9 @@ class NormThreshold:
         if not self.threshold > 0:
             raise ValueError(f"threshold must be > 0, got {self.threshold}")
 
-    def update(self, strains: ArrayLike) -> bool:
+    def update(
+        self, strains: ArrayLike, advance: float | None = None, load: float | None = None
+    ) -> bool:
         if not self.alarm:
             self.alarm = bool(
                 np.linalg.norm(np.asarray(strains, dtype=np.float64)) > self.threshold
@@ -208,7 +216,9 @@ class CusumDetector:
     def two_sided(self) -> bool:
         return self.pattern is not None
 
-    def update(self, strains: ArrayLike) -> bool:
+    def update(
+        self, strains: ArrayLike, advance: float | None = None, load: float | None = None
+    ) -> bool:
         if self.alarm:
             return True
         z = float(self.score(np.asarray(strains, dtype=np.float64)))

@@ -196,8 +196,8 @@ def _early_buckling(facts: TrialFacts) -> str | None:
         return None
     return (
         f"buckling detected at a tip load of {load * 1e3:.3g} mN, {load / p_cr:.0%} of the beam's "
-        f"critical load ({p_cr * 1e3:.3g} mN): the gratings bent under something else than the "
-        "tissue (the beam's own weight across it, a bow), and the record ends before buckling"
+        f"critical load ({p_cr * 1e3:.3g} mN): the beam bent under something else than the "
+        "tissue (its own weight across it, a bow), not the straight beam's buckling"
     )
 
 

@@ -308,7 +308,7 @@ class IndentationMachine:
         return Command(goal, self.plan.roll, self.plan.indent_speed)
 
     def _indenting(self, obs: Observation) -> Command:
-        if self.detector.update(obs.strains):
+        if self.detector.update(obs.strains, obs.advance, obs.tip_force):
             self.marks.x_buckling = obs.advance
             self.marks.t_buckling = obs.t
             self.marks.strains_at_buckling = obs.strains

@@ -20,13 +20,14 @@ def check_campaign(
     scene: SceneConfig, stack: StackConfig, scene_source: str, robot_source: str
 ) -> None:
     """Raise ConfigError if the scene's campaign names a tube the robot configuration lacks, or
-    reads the contact from a tip grating the sensor does not have."""
-    if scene.campaign.contact == "tip" and stack.sensor.tip_grating is None:
-        raise ConfigError(
-            scene_source,
-            "campaign.contact",
-            f"'tip' needs a tip force grating: {robot_source} has no sensor.tip_grating",
-        )
+    reads the contact or the buckling from a tip grating the sensor does not have."""
+    for key in ("contact", "detector"):
+        if getattr(scene.campaign, key) == "tip" and stack.sensor.tip_grating is None:
+            raise ConfigError(
+                scene_source,
+                f"campaign.{key}",
+                f"'tip' needs a tip force grating: {robot_source} has no sensor.tip_grating",
+            )
     known = [t.name for t in stack.tubes]
     if not scene.campaign.on_tubes:
         return

@@ -281,7 +281,7 @@ class Teleop:
             if self.x_contact is None:
                 self.x_contact = obs.advance
                 self.detector.reset()
-            self.buckled = self.detector.update(obs.strains)
+            self.buckled = self.detector.update(obs.strains, obs.advance, obs.tip_force)
         else:
             self.x_contact, self.buckled = None, False
         self._guard(obs)

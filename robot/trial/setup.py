@@ -19,6 +19,7 @@ from ...config.scene import CampaignConfig
 from ...config.schema import MM, StackConfig, TubeConfig
 from ...estimation.beamstate import infer_states, onset_mode
 from ...estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
+from ...estimation.detect_plateau import LoadPlateau
 from ...estimation.elastica.constants import P_CRIT
 from ...estimation.section import Section
 from ...estimation.section import sensor_section as section_of
@@ -211,8 +212,11 @@ def trial_plan(
 
 def detector_for(campaign: CampaignConfig, chain: StrainChain) -> BucklingDetector:
     """The campaign's buckling detector; CUSUM takes its noise from the zeroed baseline (the
-    stream's real noise, not a configured figure)."""
+    stream's real noise, not a configured figure), the tip grating's plateau from the load's
+    own record."""
     if campaign.detector == "paper":
         return NormThreshold(campaign.detector_threshold_ue * 1e-6)
+    if campaign.detector == "tip":
+        return LoadPlateau()
     sigma = float(np.max(chain.strain_noise()))
     return CusumDetector(sigma=max(sigma, 1e-7))

@@ -90,6 +90,9 @@ CASES = [
     ("contact from a tip grating the sensor lacks",
      SCENE.replace("contact: event ", "contact: tip   "), None, "scene",
      "campaign.contact: 'tip' needs a tip force grating"),
+    ("buckling from a tip grating the sensor lacks",
+     SCENE.replace("detector: paper ", "detector: tip   "), None, "scene",
+     "campaign.detector: 'tip' needs a tip force grating"),
 ]  # fmt: skip
 
 

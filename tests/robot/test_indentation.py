@@ -36,7 +36,9 @@ class ThresholdDetector:
     def reset(self) -> None:
         pass
 
-    def update(self, strains: tuple[float, ...]) -> bool:
+    def update(
+        self, strains: tuple[float, ...], advance: float | None = None, load: float | None = None
+    ) -> bool:
         return math.sqrt(sum(s * s for s in strains)) > self.threshold
 
 
