@@ -22,6 +22,7 @@ from palpate.cli import main
 from palpate.commands.trial import run_session
 from palpate.config import load, resolve
 from palpate.config.bench import LoadedBench, load_bench
+from palpate.config.loader import ConfigError
 from palpate.config.scene import SceneConfig
 from palpate.lab.hardware import HardwareError, explain, open_hardware
 from palpate.lab.trial import SKIPPED, BenchOutcome, plan_bench_trials
@@ -385,3 +386,12 @@ def test_the_real_bench_opens_reads_and_releases() -> None:
     assert math.isfinite(joints.translation)
     assert abs(joints.translation - loaded.stack.drive.home_translation) < 1e-4  # homed here
     assert len(frames) >= 20
+
+
+@pytest.mark.parametrize("key", ["contact", "detector"])
+def test_a_bench_file_reading_a_tip_grating_the_sensor_lacks_is_refused(
+    key: str, tmp_path: Path
+) -> None:
+    path = bench_file(tmp_path, ONE, f"campaign: {{{key}: tip}}\n")
+    with pytest.raises(ConfigError, match=f"campaign.{key}: 'tip' needs a tip force grating"):
+        load_bench(path)
