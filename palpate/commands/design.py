@@ -110,14 +110,17 @@ def _print_tip(
             f"({tip.resolution_share:.2%} of P_cr at 1 sigma)"
         )
     if weight is not None:
-        advice = (
-            ""
-            if weight.ok
-            else (
+        advice = ""
+        if not weight.ok:
+            advice = (
                 ": use it pointing vertically or with the fiber bending in a horizontal plane "
                 "(docs/lung.md)"
             )
-        )
+            if tip is not None:  # a tilted beam's sag fools a strain threshold, not the load
+                advice += (
+                    "; tilted, read its buckling from the tip load's plateau "
+                    "(campaign.detector: tip, docs/invivo.md)"
+                )
         print(f"weight: held across, {_sag_text(weight)}{advice}")
     if written is not None:
         print(f"wrote {written}")

@@ -161,3 +161,15 @@ def test_a_design_on_its_checks_edge_is_checked_at_its_one_length() -> None:
     lengths = campaign_lengths(0.05, (0.04, 0.07), 2)
     assert len(lengths) == 2
     assert 0.04 < lengths[0] < 0.05 < lengths[1] < 0.07
+
+
+def test_a_sagging_sensor_with_a_tip_grating_is_pointed_to_the_load_plateau(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    argv = ["design", "--modulus-range", "1:20", "--lumen-mm", "2.8", "--no-sim"]
+    assert main([*argv, "--wire-diameters-um", "25,50,75", "--tip-mass-g", "0.011"]) == 0
+    weight = next(
+        line for line in capsys.readouterr().out.splitlines() if line.startswith("weight")
+    )
+    assert "beyond 1.5%" in weight
+    assert "read its buckling from the tip load's plateau (campaign.detector: tip" in weight
