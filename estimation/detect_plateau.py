@@ -28,6 +28,8 @@ import statistics
 from collections import deque
 from dataclasses import dataclass, field
 
+from .detect_contact import MAD_TO_SIGMA
+
 MAX_SAMPLES = 5000  # a stalled stage adds samples without advance: the window stops growing
 
 
@@ -95,8 +97,9 @@ class LoadPlateau:
 
 def _noise(loads: list[float]) -> float:
     """The load's noise (N, 1 sigma) from its second differences: for white noise their
-    variance is 6 sigma^2; the median absolute deviation (x 1.4826) keeps a step out of it."""
+    variance is 6 sigma^2; the median absolute deviation keeps a step out of it (as
+    ``detect_contact.difference_sigma`` does with first differences)."""
     d2 = [loads[i + 1] - 2.0 * loads[i] + loads[i - 1] for i in range(1, len(loads) - 1)]
     centre = statistics.median(d2)
     mad = statistics.median(abs(x - centre) for x in d2)
-    return max(1.4826 * mad / math.sqrt(6.0), 1e-12)
+    return max(MAD_TO_SIGMA * mad / math.sqrt(6.0), 1e-12)

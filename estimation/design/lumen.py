@@ -25,15 +25,15 @@ found by bisection on log E to ``tolerance`` (2 %: about 20 searches, a few seco
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from .results import DesignResult
 from .search import binding_checks, design_sensor
-from .space import DesignConstraints, DesignSpace
+from .space import MM, DesignConstraints, DesignSpace
 
-MM = 1e-3
 CLEARANCE = 0.2 * MM  # a 2.8 mm channel passes a 2.6 mm tool
 TIP_STEP = 0.05 * MM  # the finest tip radius step a printed sphere is made to
 TOLERANCE = 0.02  # relative, on the modulus range's ends
@@ -151,6 +151,7 @@ def span_range(
     if full.success:
         return Span((lo, hi), ((lo, hi),), (full,), (), ())
 
+    @functools.cache  # the bisections ask some ranges twice (the range's ends again)
     def search(a: float, b: float) -> DesignResult:
         return design_sensor((a, b), constraints, space)
 

@@ -109,6 +109,14 @@ class _Candidates:
         hw, tip, length = (x.ravel() for x in np.indices((n_h, n_t, n_l)))
         return cls(space, hardware, tips, lengths, hw, tip, length)
 
+    @classmethod
+    def reaching(cls, space: DesignSpace, c: DesignConstraints) -> _Candidates | None:
+        """The candidates whose exposed length reaches past the gratings; None when no length
+        of the space does."""
+        lengths = space.lengths()
+        lengths = lengths[lengths >= c.grating_reach]
+        return cls.of(space, lengths) if lengths.size else None
+
     def assess(self, rng: tuple[float, float], c: DesignConstraints) -> Assessment:
         """The model of every candidate (``model.assess``), one composite section per hardware."""
         sp = self.space
@@ -176,9 +184,8 @@ def design_sensor(
     c = constraints or DesignConstraints()
     sp = space or DesignSpace()
     rng = checked_range(modulus_range)
-    lengths = sp.lengths()
-    lengths = lengths[lengths >= c.grating_reach]
-    if lengths.size == 0:
+    candidates = _Candidates.reaching(sp, c)
+    if candidates is None:
         return DesignResult(
             False,
             f"no exposed length in the design space reaches past the gratings "
@@ -188,7 +195,6 @@ def design_sensor(
             0,
             0,
         )
-    candidates = _Candidates.of(sp, lengths)
     arrays = candidates.assess(rng, c)
     logm = arrays.log_margins()
     ok = np.all(logm >= 0.0, axis=1)
@@ -236,13 +242,12 @@ def binding_checks(
     candidate of ``space`` pass (each alone keeps every candidate out); when no single check
     does, those the closest candidate fails (several bind together). Empty when a candidate
     passes."""
-    rng = checked_range(modulus_range)
-    lengths = space.lengths()
-    lengths = lengths[lengths >= constraints.grating_reach]
-    if lengths.size == 0:
+    candidates = _Candidates.reaching(space, constraints)
+    if candidates is None:
         return ()
-    arrays = _Candidates.of(space, lengths).assess(rng, constraints)
-    passes = arrays.log_margins() >= 0.0
+    arrays = candidates.assess(checked_range(modulus_range), constraints)
+    logm = arrays.log_margins()
+    passes = logm >= 0.0
     if np.any(np.all(passes, axis=1)):
         return ()
     names = list(arrays.checks)
@@ -251,5 +256,5 @@ def binding_checks(
     )
     if alone:
         return alone
-    closest = _leximin(arrays.log_margins(), np.arange(passes.shape[0]))
+    closest = _leximin(logm, np.arange(passes.shape[0]))
     return tuple(n for j, n in enumerate(names) if not passes[closest, j])

@@ -34,75 +34,65 @@ class LumenReport:
     unit: str
 
     def as_dict(self) -> dict[str, Any]:
-        return lumen_payload(self.lumen, self.span, self.constraints, self.unit)
+        """The ``lumen`` entry of ``palpate design --json``."""
+        lumen, span, c, unit = self.lumen, self.span, self.constraints, UNITS[self.unit]
+        res = c.tip_force_resolution
+        return {
+            "diameter_mm": lumen.diameter * 1e3,
+            "clearance_mm": lumen.clearance * 1e3,
+            "passage_mm": lumen.passage * 1e3,
+            "largest_tip_radius_mm": lumen.largest_tip() * 1e3,
+            "tip_force_resolution_mn": None if res is None else res * 1e3,
+            "smallest_critical_load_mn": c.smallest_critical_load * 1e3,
+            "max_depth_ratio": c.max_depth_ratio,
+            "one_sensor": span.one_sensor,
+            f"requested_{self.unit.lower()}": [e / unit for e in span.requested],
+            f"ranges_{self.unit.lower()}": [[a / unit, b / unit] for a, b in span.ranges],
+            "lowest_blocked_by": _limits(span.lowest_blocked),
+            "top_blocked_by": _limits(span.top_blocked),
+        }
 
     def text(self) -> str:
-        return lumen_text(self.lumen, self.span, self.constraints, self.unit)
+        """The lumen's paragraph of ``palpate design``'s report."""
+        lumen, span, c, name = self.lumen, self.span, self.constraints, self.unit
+
+        def shown(e: float) -> str:
+            return f"{e / UNITS[name]:.3g}"
+
+        lo, hi = span.requested
+        res = c.tip_force_resolution
+        head = (
+            f"lumen {lumen.diameter * 1e3:g} mm (passage {lumen.passage * 1e3:.3g} mm: tip R <= "
+            f"{lumen.largest_tip() * 1e3:.3g} mm), tip grating resolution "
+            + ("none" if res is None else f"{res * 1e3:.3g} mN (P_cr >= "
+               f"{c.smallest_critical_load * 1e3:.3g} mN)")
+            + f", delta/R <= {c.max_depth_ratio:g}"
+        )  # fmt: skip
+        if span.one_sensor:
+            return f"{head}\n  one sensor spans {shown(lo)}-{shown(hi)} {name}"
+        lines = [head, f"  one sensor cannot span {shown(lo)}-{shown(hi)} {name} through it"]
+        if not span.ranges:
+            lines.append(
+                f"  no sensor through it reaches any of the range: {_named(span.lowest_blocked)}"
+            )
+            return "\n".join(lines)
+        if span.lowest_blocked:
+            lines.append(
+                f"  below {shown(span.ranges[0][0])} {name} no sensor through it works: "
+                f"{_named(span.lowest_blocked)}"
+            )
+        first = span.ranges[0]
+        lines.append(f"  the widest one sensor spans: {shown(first[0])}-{shown(first[1])} {name}")
+        if span.top_blocked:
+            lines.append(f"    past it: {_named(span.top_blocked)}")
+        if len(span.ranges) > 1:
+            second = span.ranges[1]
+            lines.append(f"  a second sensor: {shown(second[0])}-{shown(second[1])} {name}")
+        return "\n".join(lines)
 
 
 def _limits(names: tuple[str, ...]) -> list[dict[str, str]]:
     return [{"check": n, "limit": LIMIT_NAMES.get(n, n), "description": CHECKS[n]} for n in names]
-
-
-def lumen_payload(
-    lumen: Lumen, span: Span, constraints: DesignConstraints, unit_name: str
-) -> dict[str, Any]:
-    """The ``lumen`` entry of ``palpate design --json``."""
-    unit = UNITS[unit_name]
-    res = constraints.tip_force_resolution
-    return {
-        "diameter_mm": lumen.diameter * 1e3,
-        "clearance_mm": lumen.clearance * 1e3,
-        "passage_mm": lumen.passage * 1e3,
-        "largest_tip_radius_mm": lumen.largest_tip() * 1e3,
-        "tip_force_resolution_mn": None if res is None else res * 1e3,
-        "smallest_critical_load_mn": constraints.smallest_critical_load * 1e3,
-        "max_depth_ratio": constraints.max_depth_ratio,
-        "one_sensor": span.one_sensor,
-        f"requested_{unit_name.lower()}": [e / unit for e in span.requested],
-        f"ranges_{unit_name.lower()}": [[a / unit, b / unit] for a, b in span.ranges],
-        "lowest_blocked_by": _limits(span.lowest_blocked),
-        "top_blocked_by": _limits(span.top_blocked),
-    }
-
-
-def lumen_text(lumen: Lumen, span: Span, constraints: DesignConstraints, unit_name: str) -> str:
-    """The lumen's paragraph of ``palpate design``'s report."""
-    unit = UNITS[unit_name]
-
-    def shown(e: float) -> str:
-        return f"{e / unit:.3g}"
-
-    lo, hi = span.requested
-    res = constraints.tip_force_resolution
-    head = (
-        f"lumen {lumen.diameter * 1e3:g} mm (passage {lumen.passage * 1e3:.3g} mm: tip R <= "
-        f"{lumen.largest_tip() * 1e3:.3g} mm), tip grating resolution "
-        + ("none" if res is None else f"{res * 1e3:.3g} mN (P_cr >= "
-           f"{constraints.smallest_critical_load * 1e3:.3g} mN)")
-        + f", delta/R <= {constraints.max_depth_ratio:g}"
-    )  # fmt: skip
-    if span.one_sensor:
-        return f"{head}\n  one sensor spans {shown(lo)}-{shown(hi)} {unit_name}"
-    lines = [head, f"  one sensor cannot span {shown(lo)}-{shown(hi)} {unit_name} through it"]
-    if not span.ranges:
-        lines.append(
-            f"  no sensor through it reaches any of the range: {_named(span.lowest_blocked)}"
-        )
-        return "\n".join(lines)
-    if span.lowest_blocked:
-        lines.append(
-            f"  below {shown(span.ranges[0][0])} {unit_name} no sensor through it works: "
-            f"{_named(span.lowest_blocked)}"
-        )
-    first = span.ranges[0]
-    lines.append(f"  the widest one sensor spans: {shown(first[0])}-{shown(first[1])} {unit_name}")
-    if span.top_blocked:
-        lines.append(f"    past it: {_named(span.top_blocked)}")
-    if len(span.ranges) > 1:
-        second = span.ranges[1]
-        lines.append(f"  a second sensor: {shown(second[0])}-{shown(second[1])} {unit_name}")
-    return "\n".join(lines)
 
 
 def _named(names: tuple[str, ...]) -> str:

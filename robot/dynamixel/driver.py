@@ -177,10 +177,10 @@ class DynamixelBus:
                 if self.read_item(m.name, "Operating_Mode") != tables.MODE_EXTENDED_POSITION:
                     self.write_item(m.name, "Operating_Mode", tables.MODE_EXTENDED_POSITION)
         except BaseException:
-            self._retries = retries
-            self.close()
+            self.close()  # its torque-off names its own retries
             raise
-        self._retries = retries
+        finally:
+            self._retries = retries
 
     def close(self) -> None:
         """Torque off on every servo (best effort, each tried), then close the port."""
