@@ -50,6 +50,15 @@ for _h in (10e-3, 20e-3, 40e-3):
         SHIPPED[f"lung-{_h * 1e3:g}mm-nu{_nu:g}"] = LayerProblem.from_dimensions(
             10e-3, _h, 60e-3, poisson=_nu, material="neo-hookean", contact="stick"
         )
+# thin neo-Hookean layers under the paper's tip, frictionless and sticking
+# (``config/scenes/layers/neo-hookean.yaml``, issue 41's finite strain)
+_NH = {"poisson": 0.45, "material": "neo-hookean"}
+for _h in (1.5e-3, 2e-3, 3e-3):
+    for _base in ("bonded", "sliding"):
+        for _contact in ("frictionless", "stick"):
+            SHIPPED[f"layers-nh-{_h * 1e3:g}mm-{_base}-{_contact}"] = LayerProblem.from_dimensions(
+                3.5e-3, _h, 40e-3, **_NH, base=_base, contact=_contact
+            )
 # the mismatch scenes (``config/scenes/mismatch/``): the paper's layer at other nu, sliding,
 # and at other thicknesses
 for _nu in (0.40, 0.42, 0.47, 0.49):
@@ -76,7 +85,8 @@ for _r in (1.3e-3, 0.9e-3):
             )
 """The problems whose tables ship in ``sim/fem/tables``, by name: the paper's and the soft
 designs' phantoms, the half-space stand-in, the thin and deep layers of
-``config/scenes/layers/`` (R = 3.5 mm, frictionless tip), the mismatch scenes' layers (other nu,
+``config/scenes/layers/`` (R = 3.5 mm, frictionless tip; the neo-Hookean ones with a sticking tip
+too), the mismatch scenes' layers (other nu,
 sliding, 5-30 mm) and the lung scene's neo-Hookean layers
 (R = 10 mm, the 1-20 kPa design's tip; ``config/scenes/lung/``, its slip scene frictionless),
 and the same layers under the channel-sized sensors' tips (``config/scenes/invivo/lumen-*``)."""
