@@ -47,20 +47,38 @@ class Client:
             contextlib.suppress(ConnectionClosed),
             connect(f"ws://{HOST}:{self.port}", subprotocols=[SUBPROTOCOL]) as ws,
         ):
-            topics: dict[int, str] = {}
-            while not self.complete.is_set():
-                frame = ws.recv(timeout=BOUND)
+            channels: dict[str, int] = {}  # topic -> its newest channel id
+            topics: dict[int, str] = {}  # subscription id -> topic
+            deadline = time.monotonic() + BOUND
+            retry = time.monotonic() + 1.0
+
+            def subscribe(topic: str) -> None:
+                sid = len(topics) + 1  # a fresh subscription id each request
+                topics[sid] = topic
+                sub = [{"id": sid, "channelId": channels[topic]}]
+                ws.send(json.dumps({"op": "subscribe", "subscriptions": sub}))
+
+            while not self.complete.is_set() and time.monotonic() < deadline:
+                if time.monotonic() > retry:
+                    # a subscription the server refused ("unknown channel": a request that
+                    # raced the channel's registration, or a trial's channel already gone)
+                    # is asked again, once a second, while its topic has not been heard
+                    for topic in (self.wanted & channels.keys()) - self.received:
+                        subscribe(topic)
+                    retry = time.monotonic() + 1.0
+                try:
+                    frame = ws.recv(timeout=1.0)
+                except TimeoutError:
+                    continue
                 if isinstance(frame, str):
                     op = json.loads(frame)
                     if op.get("op") == "advertise":
-                        new = {c["id"]: c["topic"] for c in op["channels"]}
-                        topics.update(new)
-                        self.advertised.update(new.values())
-                        # one request a channel: a trial's channel gone before the request
-                        # arrives ("unknown channel") must not take the others' with it
-                        for cid in new:
-                            sub = [{"id": cid, "channelId": cid}]
-                            ws.send(json.dumps({"op": "subscribe", "subscriptions": sub}))
+                        new = {c["topic"]: c["id"] for c in op["channels"]}
+                        channels.update(new)
+                        self.advertised.update(new)
+                        # one request a channel: a refused one must not take the others with it
+                        for topic in new:
+                            subscribe(topic)
                         if self.wanted <= self.advertised:
                             self.subscribed.set()
                     continue
