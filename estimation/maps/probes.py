@@ -31,7 +31,8 @@ class Probe:
         ci: its 95 % interval (Pa), None without one.
         status: the verdict's ``ok``, ``suspect`` or ``none``; reasons: its reasons.
         lab_time: simulated or bench seconds it took, the stage's travel to it included.
-        truth: in simulation, the world's apparent modulus there if known (Pa), else None.
+        contact_radius: the tip's contact radius at its deepest (m; sqrt(R delta), Hertz's),
+            None if unknown: how wide the probe reads the tissue (``extent``).
     """
 
     x: float
@@ -41,6 +42,7 @@ class Probe:
     status: str
     reasons: tuple[str, ...] = field(default=())
     lab_time: float = 0.0
+    contact_radius: float | None = None
 
     @property
     def usable(self) -> bool:
@@ -81,6 +83,7 @@ class Probe:
             d["status"],
             tuple(d["reasons"]),
             d["lab_time_s"],
+            None if d.get("contact_radius_mm") is None else d["contact_radius_mm"] * MM,
         )
 
     def as_dict(self) -> dict[str, object]:
@@ -92,4 +95,5 @@ class Probe:
             "status": self.status,
             "reasons": list(self.reasons),
             "lab_time_s": self.lab_time,
+            "contact_radius_mm": None if self.contact_radius is None else self.contact_radius / MM,
         }

@@ -7,12 +7,17 @@ patch has nothing above it. The region is where the process is above it with pro
 one half; an inclusion is **found** when some point of the patch is above it with probability
 at least ``found_probability`` (0.95), else the summary says "no inclusion found" with its
 evidence (the largest probability, the peak's rise). The centre is the region's centroid
-weighted by how far the mean is above the threshold, the radius that of a disc of the
-region's area; their intervals are the 2.5 and 97.5 percentiles over joint posterior draws
-(each draw's own region, centroid and area)::
+weighted by how far the mean is above the threshold, its interval the 2.5 and 97.5
+percentiles over joint posterior draws (each draw's own region and centroid). The region is
+the *apparent* map's: the tip's contact blurs the inclusion, and a level set half-way to the
+peak lies inside a small inclusion's footprint. So the inclusion's extent, the boundary the
+summary reports, is the disc fitted through the tip's contact (``extent``) where the probes
+carry their contact radii; its radius's interval spans the two forms, from the apparent
+region's (the draws' 2.5 percentile, inside) to the disc's (its 97.5 %, outside); without
+contact radii the region and its draws' radius are the answer, as before::
 
     summary = summarise(StiffnessMap.fit(probes), patch)
-    summary.found, summary.centre, summary.centre_ci, summary.radius
+    summary.found, summary.centre, summary.centre_ci, summary.radius, summary.inside(x, y)
 """
 
 from __future__ import annotations
@@ -26,8 +31,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
 
+from .extent import Extent, ExtentError, fit_extent
 from .gp import LENGTH_SCALE_MAX, MIN_PROBES, MM, MapError, Patch, StiffnessMap
-from .probes import Probe
+from .probes import Z95, Probe
 
 FloatArray = NDArray[np.float64]
 MIN_RISE = 0.10  # the smallest rise above the background a threshold from the data takes
@@ -55,10 +61,26 @@ class MapSummary:
     centre_ci: tuple[tuple[float, float], tuple[float, float]] | None = None
     radius: float | None = None
     radius_ci: tuple[float, float] | None = None
+    apparent_radius: float | None = None  # the region's (equal area disc), m
+    extent: Extent | None = None
+
+    def inside(self, x: FloatArray, y: FloatArray) -> NDArray[np.bool_]:
+        """Whether points (m, any shape) lie within the reported boundary: the extent's disc,
+        or the region P(above) > 0.5 on the summary's grid without one (nothing if not
+        found)."""
+        if not self.found:
+            return np.zeros(np.shape(x), dtype=bool)
+        if self.extent is not None:
+            c = self.extent.centre
+            return np.asarray(np.hypot(x - c[0], y - c[1]) <= self.extent.radius)
+        return np.asarray(self.p_above > 0.5)
 
     def as_dict(self) -> dict[str, object]:
         def mm(v: tuple[float, ...] | None) -> list[float] | None:
             return None if v is None else [float(a) / MM for a in v]
+
+        def length(v: float | None) -> float | None:
+            return None if v is None else v / MM
 
         return {
             "inclusion_found": self.found,
@@ -67,8 +89,10 @@ class MapSummary:
             "inclusion_center_ci_mm": (
                 None if self.centre_ci is None else [mm(self.centre_ci[0]), mm(self.centre_ci[1])]
             ),
-            "inclusion_radius_mm": None if self.radius is None else self.radius / MM,
+            "inclusion_radius_mm": length(self.radius),
             "inclusion_radius_ci_mm": mm(self.radius_ci),
+            "apparent_radius_mm": length(self.apparent_radius),
+            "extent": None if self.extent is None else self.extent.as_dict(),
             "threshold_kpa": self.threshold / 1e3,
             "threshold_from_data": self.threshold_from_data,
             "background_kpa": self.background / 1e3,
@@ -118,8 +142,13 @@ def summarise(
         float(points[:, 0] @ weight / weight.sum()),
         float(points[:, 1] @ weight / weight.sum()),
     )
-    radius = math.sqrt(region.sum() * _cell(patch, GRID) / math.pi)
+    apparent = math.sqrt(region.sum() * _cell(patch, GRID) / math.pi)
     centre_ci, radius_ci = _intervals(m, patch, t, np.random.default_rng(seed))
+    extent = _extent(m, centre, apparent)
+    radius = apparent
+    if extent is not None:
+        radius = extent.radius
+        radius_ci = (min(radius_ci[0], radius), extent.radius + Z95 * extent.radius_se)
     evidence = (
         f"inclusion found: above {math.exp(t) / 1e3:.4g} kPa with probability {best:.3f}; the "
         f"map's peak is {100 * rise:+.1f} % of the background"
@@ -132,7 +161,19 @@ def summarise(
         centre_ci=centre_ci,
         radius=radius,
         radius_ci=radius_ci,
+        apparent_radius=apparent,
+        extent=extent,
     )
+
+
+def _extent(m: StiffnessMap, centre: tuple[float, float], radius: float) -> Extent | None:
+    """The disc through the tip's contact (``extent``), None where the probes cannot carry it
+    (no contact radii, too few) or it comes out unbounded."""
+    try:
+        ext = fit_extent(m.used, centre, radius)
+    except ExtentError:
+        return None
+    return ext if math.isfinite(ext.radius_se) else None
 
 
 def above(mean: FloatArray, sd: FloatArray, t: float) -> FloatArray:

@@ -164,4 +164,4 @@ def _probe_at(
     )
     last = (0.0, 0.0) if not probes else (probes[-1].x, probes[-1].y)
     travel = math.hypot(point[0] - last[0], point[1] - last[1]) / scene.campaign.stage_speed
-    return probe_of(o, point, o.sim_time + travel), o
+    return probe_of(o, point, o.sim_time + travel, stack.sensor.tip_radius), o

@@ -137,7 +137,7 @@ class SurveyResult:
         xx, yy = np.meshgrid(s.x, s.y)
         t = self.truth
         inside = np.hypot(xx - t.centre[0], yy - t.centre[1]) <= t.radius
-        said = s.p_above > 0.5 if s.found else np.zeros_like(inside)
+        said = s.inside(xx, yy)
         out["sensitivity"] = float((said & inside).sum() / max(inside.sum(), 1))
         out["specificity"] = float((~said & ~inside).sum() / max((~inside).sum(), 1))
         cell = (s.x[1] - s.x[0]) * (s.y[1] - s.y[0]) / MM**2

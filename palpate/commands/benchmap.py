@@ -89,7 +89,7 @@ def run_bench_map(
         outcome, _ = run_bench_trial(
             hw, trial, loaded, stack, log_dir, sync_to_clock=sync_to_clock, live=live
         )
-        probe = probe_of(outcome, point, hw.clock.now() - t0)
+        probe = probe_of(outcome, point, hw.clock.now() - t0, stack.sensor.tip_radius)
         if progress is not None:
             progress(outcome)
         if outcome.state not in PLANNED:

@@ -3,9 +3,10 @@
 Three panels over the patch (mm): the map's modulus (posterior median, kPa) with every probe
 numbered in the order it was taken and the stage's path between them (a probe without a
 number as a grey cross, a ``suspect`` one in orange); the map's uncertainty (sd of log E, %);
-and the probability of being above the threshold with its one-half contour (the estimated
-boundary), the estimated centre with its 95 % box, and in simulation the inclusion's footprint
-(dashed) and centre (+). A survey that found nothing says so in the title.
+and the probability of being above the threshold with its one-half contour (the apparent
+region), the inclusion's extent (the disc fitted through the tip's contact, solid black on every
+panel: the boundary the map reports), the estimated centre with its 95 % box, and in simulation
+the inclusion's footprint (dashed) and centre (+). A survey that found nothing says so in the title.
 """
 
 from __future__ import annotations
@@ -46,7 +47,11 @@ def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
         fig.colorbar(image, ax=ax, shrink=0.85, label=label)
         _probes(ax, result)
         _truth(ax, result)
-    axes[2].contour(s.x / MM, s.y / MM, s.p_above, levels=[0.5], colors="k", linewidths=1.5)
+    axes[2].contour(s.x / MM, s.y / MM, s.p_above, levels=[0.5], colors="k", linewidths=0.8)
+    if s.extent is not None:
+        (cx, cy), r = s.extent.centre, s.extent.radius
+        for ax in axes:
+            ax.add_patch(Circle((cx / MM, cy / MM), r / MM, fill=False, color="k", lw=1.5))
     if s.centre is not None and s.centre_ci is not None:
         (x0, x1), (y0, y1) = s.centre_ci
         axes[2].add_patch(

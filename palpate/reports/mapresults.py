@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from palpate.campaigns.surveyloop import SurveyResult
+from palpate.estimation.maps import MapSummary
 
 
 def write_map_results(
@@ -55,7 +56,7 @@ def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) ->
             lines.append(
                 f"centre ({s.centre[0] * 1e3:+.2f}, {s.centre[1] * 1e3:+.2f}) mm "
                 f"[x {x0 * 1e3:+.2f}..{x1 * 1e3:+.2f}, y {y0 * 1e3:+.2f}..{y1 * 1e3:+.2f}], "
-                f"radius {s.radius * 1e3:.2f} mm"
+                f"radius {s.radius * 1e3:.2f} mm{_radius_note(s)}"
             )
     if result.truth is not None:
         t = result.truth
@@ -66,3 +67,15 @@ def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) ->
         )
     lines.append(f"run folder: {run_dir}")
     return lines
+
+
+def _radius_note(s: MapSummary) -> str:
+    """The radius's interval and where it comes from (the extent's disc, or the region)."""
+    lo, hi = s.radius_ci if s.radius_ci is not None else (None, None)
+    band = "" if lo is None or hi is None else f" [{lo * 1e3:.2f}..{hi * 1e3:.2f}]"
+    if s.extent is None or s.apparent_radius is None:
+        return f"{band} (the region above the threshold)"
+    return (
+        f"{band} (the disc through the tip's contact; the region above the threshold: "
+        f"{s.apparent_radius * 1e3:.2f} mm)"
+    )

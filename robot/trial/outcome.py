@@ -13,6 +13,7 @@ and the bus counters)::
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -105,10 +106,13 @@ def outcome_fields(
     }
 
 
-def probe_of(o: Outcome, point: tuple[float, float], lab_time: float) -> Probe:
+def probe_of(
+    o: Outcome, point: tuple[float, float], lab_time: float, tip_radius: float | None = None
+) -> Probe:
     """A finished trial as a map's probe at ``point`` (m): the joint fit's modulus and interval
-    when it succeeded, the verdict's status and reasons (the trial's end when it has none), and
-    the lab time it took (s, with the stage's travel to it)."""
+    when it succeeded, the verdict's status and reasons (the trial's end when it has none), the
+    lab time it took (s, with the stage's travel to it) and, given the sensor's ``tip_radius``
+    (m), the contact's radius at the fit's deepest point, sqrt(R delta)."""
     from ...estimation.maps.probes import Probe
 
     jf, v = o.joint, o.verdict
@@ -124,4 +128,11 @@ def probe_of(o: Outcome, point: tuple[float, float], lab_time: float) -> Probe:
         "none" if v is None else v.status,
         () if v is None else tuple(v.reasons) or (() if ok else (o.reason,)),
         lab_time,
+        _contact_radius(jf, tip_radius) if ok else None,
     )
+
+
+def _contact_radius(jf: JointFit | None, tip_radius: float | None) -> float | None:
+    if jf is None or tip_radius is None or not jf.max_depth or jf.max_depth <= 0.0:
+        return None
+    return math.sqrt(tip_radius * jf.max_depth)
