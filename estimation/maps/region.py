@@ -144,7 +144,7 @@ def summarise(
     )
     apparent = math.sqrt(region.sum() * _cell(patch, GRID) / math.pi)
     centre_ci, radius_ci = _intervals(m, patch, t, np.random.default_rng(seed))
-    extent = _extent(m, centre, apparent)
+    extent = _extent(m, patch, centre, apparent)
     radius = apparent
     if extent is not None:
         radius = extent.radius
@@ -166,14 +166,19 @@ def summarise(
     )
 
 
-def _extent(m: StiffnessMap, centre: tuple[float, float], radius: float) -> Extent | None:
+def _extent(
+    m: StiffnessMap, patch: Patch, centre: tuple[float, float], radius: float
+) -> Extent | None:
     """The disc through the tip's contact (``extent``), None where the probes cannot carry it
-    (no contact radii, too few) or it comes out unbounded."""
+    (no contact radii, too few), it is unbounded, or it leaves the patch (its centre outside,
+    its radius past half the patch's diagonal): the region stands then."""
     try:
         ext = fit_extent(m.used, centre, radius)
     except ExtentError:
         return None
-    return ext if math.isfinite(ext.radius_se) else None
+    (cx, cy), r = ext.centre, ext.radius
+    within = patch.x_min <= cx <= patch.x_max and patch.y_min <= cy <= patch.y_max
+    return ext if within and r <= 0.5 * patch.diagonal and math.isfinite(ext.radius_se) else None
 
 
 def above(mean: FloatArray, sd: FloatArray, t: float) -> FloatArray:

@@ -78,6 +78,12 @@ def test_palpate_map_prints_the_map_and_writes_its_run_folder(
         assert key in payload, key
     assert payload["probes_used"] == 4
     assert payload["truth"]["contrast"] == pytest.approx(5.0)
+    assert "apparent_radius_mm" in payload
+    assert "extent" in payload  # None here: four probes cannot carry the disc's fit
+    # each probe carries how wide its tip read the tissue: sqrt(R delta), R = 3.5 mm
+    radii = [p["contact_radius_mm"] for p in payload["probes"] if p["modulus_kpa"] is not None]
+    assert radii
+    assert all(1.0 < a < 3.5 for a in radii), radii
     run_dir = Path(payload["run_dir"])
     assert (run_dir / "map.png").stat().st_size > 0
     assert json.loads((run_dir / "map.json").read_text())["probes_used"] == 4
