@@ -16,11 +16,12 @@ radius (``Probe.contact_radius``; the probes' median where one lacks it). b and 
 (Nelder-Mead from the map's region), and their 95 % intervals come from the Gauss-Newton
 curvature of the weighted misfit scaled by its own residual variance.
 
-What it leaves out: the tip's stress spreads with depth, so an inclusion under the surface is
-felt from further away than its footprint, and the disc comes out wider than the footprint of a
-buried sphere (+0.6 mm for the shipped 2.5 mm sphere 1 mm under the surface, the same at 3, 5
-and 10x: docs/maps.md). The extent errs outward, the side a margin around a tumour wants; the
-map's half-peak region errs inward; ``region`` reports the radius's interval over both::
+What it leaves out: the inclusion's shape below the surface. The tip's stress spreads with
+depth, so a small buried sphere is felt from further away than its footprint and the disc comes
+out wider (+0.6 mm for the shipped 2.5 mm sphere 1 mm under the surface, the same at 3, 5 and
+10x; +1.0 mm for the lung map's 5 mm nodule under a 10 mm tip), while a large sphere is felt by
+its cap, narrower than its equator (-0.3 mm at 4 mm): docs/maps.md. The map's half-peak region
+errs inward on the small ones; ``region`` reports the radius's interval over both::
 
     ext = fit_extent(probes, start=(x, y), radius=r0)
     ext.centre, ext.radius, ext.radius_se
