@@ -133,6 +133,8 @@ def probe_of(
 
 
 def _contact_radius(jf: JointFit | None, tip_radius: float | None) -> float | None:
-    if jf is None or tip_radius is None or not jf.max_depth or jf.max_depth <= 0.0:
+    """sqrt(R delta) at the fit's deepest point (m), None without a tip radius or a depth."""
+    depth = None if jf is None else jf.max_depth
+    if tip_radius is None or depth is None or depth <= 0.0:
         return None
-    return math.sqrt(tip_radius * jf.max_depth)
+    return math.sqrt(tip_radius * depth)
