@@ -144,11 +144,6 @@ def summarise(
     )
     apparent = math.sqrt(region.sum() * _cell(patch, GRID) / math.pi)
     centre_ci, radius_ci = _intervals(m, patch, t, np.random.default_rng(seed))
-    extent = _extent(m, patch, centre, apparent)
-    radius = apparent
-    if extent is not None:
-        radius = extent.radius
-        radius_ci = (min(radius_ci[0], radius), extent.radius + Z95 * extent.radius_se)
     evidence = (
         f"inclusion found: above {math.exp(t) / 1e3:.4g} kPa with probability {best:.3f}; the "
         f"map's peak is {100 * rise:+.1f} % of the background"
@@ -159,11 +154,18 @@ def summarise(
         evidence=evidence,
         centre=centre,
         centre_ci=centre_ci,
-        radius=radius,
-        radius_ci=radius_ci,
-        apparent_radius=apparent,
-        extent=extent,
+        **_radii(apparent, radius_ci, _extent(m, patch, centre, apparent)),
     )
+
+
+def _radii(apparent: float, drawn: tuple[float, float], extent: Extent | None) -> dict[str, Any]:
+    """The summary's radius fields: the extent's disc where there is one, its interval from
+    the region's draws' low end to the disc's high one; else the region's, as drawn."""
+    if extent is None:
+        return {"radius": apparent, "radius_ci": drawn, "apparent_radius": apparent}
+    r = extent.radius
+    spans = (min(drawn[0], r), r + Z95 * extent.radius_se)
+    return {"radius": r, "radius_ci": spans, "apparent_radius": apparent, "extent": extent}
 
 
 def _extent(

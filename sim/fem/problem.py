@@ -26,6 +26,8 @@ FloatArray = NDArray[np.float64]
 MATERIALS = ("linear", "neo-hookean")
 BASES = ("bonded", "sliding")
 CONTACTS = ("frictionless", "stick")
+THIN_STRAIN_MAX = 0.5
+"""delta/h to which a neo-Hookean layer thinner than the tip is tabulated (``from_dimensions``)."""
 
 
 @dataclass(frozen=True)
@@ -118,11 +120,17 @@ class LayerProblem:
     ) -> LayerProblem:
         """The problem of a sample in SI units (tip radius R, layer thickness h and lateral
         radius, m); the ratios are rounded to 9 significant digits so that the same sample
-        written two ways (10 mm / 3.5 mm or 0.01 / 0.0035) names the same table."""
+        written two ways (10 mm / 3.5 mm or 0.01 / 0.0035) names the same table. A
+        neo-Hookean layer thinner than the tip is solved to delta/h = THIN_STRAIN_MAX unless
+        ``depth_max`` is given (delta/R = 1 would press through it; its elements invert near
+        delta/h = 0.6)."""
         if not (math.isfinite(tip_radius) and tip_radius > 0):
             raise ValueError(f"tip_radius must be finite and > 0, got {tip_radius}")
+        ratio = significant(thickness / tip_radius)
+        if options.get("material") == "neo-hookean" and ratio < 1.0:
+            options.setdefault("depth_max", round(THIN_STRAIN_MAX * ratio, 6))
         return cls(
-            thickness_ratio=significant(thickness / tip_radius),
+            thickness_ratio=ratio,
             radius_ratio=significant(radius / tip_radius),
             **options,
         )
