@@ -20,7 +20,7 @@ from typing import Literal
 
 from .loader import ConfigError, limits, load, resolve
 from .sample import AssumedConfig
-from .scene import CampaignConfig, check_patch
+from .scene import CampaignConfig, check_patch, require_tip_grating
 from .schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
 
 SIMULATION_ONLY = ("samples", "exposed_lengths_mm", "exposed_length_mm", "tubes", "orientations")
@@ -168,7 +168,7 @@ def load_bench(path: str | Path) -> LoadedBench:
         ),
     )
     _check_stage(p, bench, stack, robot)
-    _check_tip(p, bench, stack, robot)
+    require_tip_grating(bench.campaign, stack, str(p), str(robot))
     targets = Path(bench.targets)
     if not targets.exists():
         try:
@@ -195,15 +195,3 @@ def _check_stage(path: Path, bench: BenchConfig, stack: StackConfig, robot: Path
             f"{list(bench.map.patch_mm)} reaches beyond the stage's travel "
             f"(x {[xl, xh]}, y {[yl, yh]} mm in {robot})",
         )
-
-
-def _check_tip(path: Path, bench: BenchConfig, stack: StackConfig, robot: Path) -> None:
-    """The contact or the buckling read from a tip grating needs the sensor to have one (as
-    ``palpate sim``'s preflight refuses it)."""
-    for key in ("contact", "detector"):
-        if getattr(bench.campaign, key) == "tip" and stack.sensor.tip_grating is None:
-            raise ConfigError(
-                str(path),
-                f"campaign.{key}",
-                f"'tip' needs a tip force grating: {robot} has no sensor.tip_grating",
-            )

@@ -14,10 +14,10 @@ from typing import Literal
 
 from .breathing import BreathingConfig
 from .faults import FaultsConfig
-from .loader import limits
+from .loader import ConfigError, limits
 from .optics import MM, PM, UE
 from .sample import PAPER_SAMPLES, SampleConfig
-from .schema import DEFAULT_CONTROL_RATE_HZ
+from .schema import DEFAULT_CONTROL_RATE_HZ, StackConfig
 from .thermal import TemperatureConfig
 from .units import SI, SIOptional, SITuple
 
@@ -247,6 +247,23 @@ class SceneConfig:
     def campaign_samples(self) -> tuple[SampleConfig, ...]:
         wanted = self.campaign.samples
         return tuple(s for s in self.samples if not wanted or s.name in wanted)
+
+
+def require_tip_grating(
+    campaign: CampaignConfig, stack: StackConfig, source: str, robot: str
+) -> None:
+    """ConfigError naming ``source`` and the key where ``campaign`` reads its contact or its
+    buckling from a tip grating (``'tip'``) that the sensor of ``stack`` (from ``robot``) lacks:
+    ``palpate sim``'s preflight and ``palpate trial``'s bench file alike."""
+    if stack.sensor.tip_grating is not None:
+        return
+    for key in ("contact", "detector"):
+        if getattr(campaign, key) == "tip":
+            raise ConfigError(
+                source,
+                f"campaign.{key}",
+                f"'tip' needs a tip force grating: {robot} has no sensor.tip_grating",
+            )
 
 
 def check_patch(patch_mm: tuple[float, ...], key: str) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from palpate.config.loader import ConfigError
-from palpate.config.scene import SceneConfig
+from palpate.config.scene import SceneConfig, require_tip_grating
 from palpate.config.schema import StackConfig
 from palpate.simulation.world import TrialSpec, trial_geometry
 
@@ -21,13 +21,7 @@ def check_campaign(
 ) -> None:
     """Raise ConfigError if the scene's campaign names a tube the robot configuration lacks, or
     reads the contact or the buckling from a tip grating the sensor does not have."""
-    for key in ("contact", "detector"):
-        if getattr(scene.campaign, key) == "tip" and stack.sensor.tip_grating is None:
-            raise ConfigError(
-                scene_source,
-                f"campaign.{key}",
-                f"'tip' needs a tip force grating: {robot_source} has no sensor.tip_grating",
-            )
+    require_tip_grating(scene.campaign, stack, scene_source, robot_source)
     known = [t.name for t in stack.tubes]
     if not scene.campaign.on_tubes:
         return
