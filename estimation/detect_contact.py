@@ -145,13 +145,14 @@ def ratio_of_variances(
     )
 
 
-def difference_sigma(forces: ArrayLike) -> float:
-    """The noise of a record (a tip-force record's, N), from its successive differences
-    (median absolute deviation, so the load's own rise and a few outliers do not inflate it);
-    never below 1e-9."""
+def difference_sigma(forces: ArrayLike, order: int = 1) -> float:
+    """The noise of a record (a tip-force record's, N), from its differences of ``order`` (1:
+    successive, of variance 2 sigma^2; 2: second, of variance 6 sigma^2, out of which a linear
+    rise drops too; C(2n, n) for order n), by their median absolute deviation, so the load's
+    own rise and a few outliers do not inflate it; never below 1e-9."""
     f = np.asarray(forces, dtype=np.float64)
-    if f.size < 3:
+    if f.size < order + 2:
         return 1e-9
-    d = np.diff(f)
+    d = np.diff(f, n=order)
     mad = float(np.median(np.abs(d - np.median(d))))
-    return max(MAD_TO_SIGMA * mad / math.sqrt(2.0), 1e-9)
+    return max(MAD_TO_SIGMA * mad / math.sqrt(math.comb(2 * order, order)), 1e-9)

@@ -12,7 +12,7 @@ first third: the rise. It alarms when the rise falls under ``plateau_share`` of 
 seen so far, once that largest rise stands ``sigmas`` standard errors above the noise and the
 load ``floor_sigmas`` noise above zero. The noise is the record's own, from the second
 differences of the first ``noise_samples`` loads (a linear rise drops out of them), robustly
-(the median absolute deviation).
+(``detect_contact.difference_sigma``, the median absolute deviation).
 
     >>> d = LoadPlateau(window=0.1e-3)
     >>> u = [i * 2e-6 for i in range(600)]  # 2 um a sample: 0.5 mm/s at 250 Hz
@@ -24,11 +24,10 @@ differences of the first ``noise_samples`` loads (a linear rise drops out of the
 from __future__ import annotations
 
 import math
-import statistics
 from collections import deque
 from dataclasses import dataclass, field
 
-from .detect_contact import MAD_TO_SIGMA
+from .detect_contact import difference_sigma
 
 MAX_SAMPLES = 5000  # a stalled stage adds samples without advance: the window stops growing
 
@@ -74,7 +73,7 @@ class LoadPlateau:
             self._first.append(load)
             if len(self._first) < self.noise_samples:
                 return False
-            self.sigma = _noise(self._first)
+            self.sigma = difference_sigma(self._first, order=2)
         while advance - self._advance[0] > self.window:
             self._advance.popleft()
             self._load.popleft()
@@ -93,13 +92,3 @@ class LoadPlateau:
             and rise < self.plateau_share * self.largest_rise
         )
         return self.alarm
-
-
-def _noise(loads: list[float]) -> float:
-    """The load's noise (N, 1 sigma) from its second differences: for white noise their
-    variance is 6 sigma^2; the median absolute deviation keeps a step out of it (as
-    ``detect_contact.difference_sigma`` does with first differences)."""
-    d2 = [loads[i + 1] - 2.0 * loads[i] + loads[i - 1] for i in range(1, len(loads) - 1)]
-    centre = statistics.median(d2)
-    mad = statistics.median(abs(x - centre) for x in d2)
-    return max(MAD_TO_SIGMA * mad / math.sqrt(6.0), 1e-12)
