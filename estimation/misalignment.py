@@ -241,10 +241,9 @@ class _Model:
         base = y.T[:, :, None] + loads[None, :, :] / EA  # (G, N, J): the part without c
         # the candidates' squared residual, quadratic in c: |b - c h|^2 = A - 2 c B + c^2 C
         # with b and h the base and the lateral shape with the onset mode taken out per row
-        b = _without_mode(list(base), [g[:, None] for g in unit])
-        hp = _without_mode(list(h.reshape(-1, n, j)), [g[:, None] for g in unit])
-        cross = _in_order([g * w for g, w in zip(b, hp, strict=True)])
-        quadratic = (_in_order([g * g for g in b]), cross, _in_order([w * w for w in hp]))
+        b = _without_mode(base, unit[:, :, None])
+        hp = _without_mode(h.reshape(-1, n, j), unit[:, :, None])
+        quadratic = (_in_order(list(b * b)), _in_order(list(b * hp)), _in_order(list(hp * hp)))
         return cls(y.T, unit, cap, loads, quadratic, L, from_tip, EA, EI, dy)
 
     @property
@@ -277,7 +276,8 @@ class _Model:
         both = np.concatenate([cs, cs])
         for _ in range(_GOLDEN):
             a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-            ss_a, ss_b = np.split(self._row_ss(both, np.concatenate([a, b])), 2)
+            ss = self._row_ss(both, np.concatenate([a, b]))
+            ss_a, ss_b = ss[: cs.size], ss[cs.size :]
             left = ss_a < ss_b
             lo, hi = np.where(left, lo, a), np.where(left, b, hi)
         P = 0.5 * (lo + hi)
@@ -286,15 +286,26 @@ class _Model:
     def _row_ss(self, cs: FloatArray, P: FloatArray) -> FloatArray:
         """(C, N): each row's residual at its load P (C, N) and the lean c of its line (the
         lateral shape as :func:`lateral_shape_by_grating` computes it, element for element,
-        with the rows' grating spans taken once)."""
+        with the rows' grating spans taken once). The gratings are stacked (G, C, N): each
+        element sees the arithmetic of a grating at a time, in the same order."""
         k = np.sqrt(np.maximum(np.minimum(P, self._saturation), 0.0) / self.EI)
         half_k = 0.5 * k
         d_sum, d_diff, span = self._spans
         integral = 2.0 * np.sin(half_k * d_sum) * np.sin(half_k * d_diff)
         shape = -self.dy * integral / (span * np.cos(k * self.L))
         axial = P / self.EA
-        c2 = cs[:, None]
-        return self._ss([y + axial - c2 * g for y, g in zip(self.y, shape, strict=True)])
+        resid = (self._y3 + axial) - cs[:, None] * shape
+        return _in_order(list(_without_mode(resid, self._unit3) ** 2))
+
+    @functools.cached_property
+    def _y3(self) -> FloatArray:
+        """(G, 1, N): the strains, to broadcast over the leans."""
+        return self.y[:, None, :]
+
+    @functools.cached_property
+    def _unit3(self) -> FloatArray:
+        """(G, 1, N): the unit onset mode, to broadcast over the leans."""
+        return self.unit[:, None, :]
 
     @functools.cached_property
     def _saturation(self) -> FloatArray:
@@ -310,16 +321,13 @@ class _Model:
         span = (self.from_tip[:, 1] - self.from_tip[:, 0])[:, None, None]
         return (d0 + d1)[:, None, :], (d1 - d0)[:, None, :], span
 
-    def _ss(self, v: list[FloatArray]) -> FloatArray:
-        """Squared norm over the gratings of v (one (C, N) array per grating) with the onset
-        mode taken out per row."""
-        return _in_order([g**2 for g in _without_mode(v, list(self.unit))])
 
-
-def _without_mode(v: list[FloatArray], u: list[FloatArray]) -> list[FloatArray]:
-    """v (one array per grating) with its component along the unit onset mode u taken out."""
-    along = _in_order([vg * ug for vg, ug in zip(v, u, strict=True)])
-    return [vg - along * ug for vg, ug in zip(v, u, strict=True)]
+def _without_mode(v: FloatArray, u: FloatArray) -> FloatArray:
+    """v (gratings first) with its component along the unit onset mode u taken out, the
+    gratings' products summed in order."""
+    along = _in_order(list(v * u))
+    out: FloatArray = v - along * u
+    return out
 
 
 def _in_order(terms: list[FloatArray]) -> FloatArray:
