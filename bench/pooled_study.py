@@ -4,6 +4,7 @@ verdict, its relative error and whether its interval holds the truth. Prints one
 and a summary: wrong beliefs flagged (of samples), false alarms on true beliefs, coverage.
 
     python bench/pooled_study.py --seeds 0 1          # the scenes below
+    python bench/pooled_study.py --set depth-span --seeds 5 6   # pressed at 30-50 mm
     python bench/pooled_study.py --seeds 0 --scene config/scenes/layers/bonded.yaml:true
 """
 
@@ -26,6 +27,12 @@ SCENES = {
     "config/scenes/mismatch/nominal.yaml": "none",
     "config/scenes/bench.yaml": "none",
 }
+# the same wrong and true beliefs pressed on the bench-top stage at 30-50 mm (loads 2.8x apart)
+DEPTH_SPAN = {
+    "config/scenes/mismatch/depth-span.yaml": "all",
+    "config/scenes/mismatch/depth-span-true.yaml": "none",
+}
+SETS = {"campaigns": SCENES, "depth-span": DEPTH_SPAN}
 
 
 def run(scene: str, seed: int) -> list[dict[str, object]]:
@@ -57,9 +64,10 @@ def _pct(v: object) -> str:
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, nargs="+", default=[0])
-    ap.add_argument("--scene", action="append", help="PATH:all|none|NAMES (default: the list)")
+    ap.add_argument("--set", choices=sorted(SETS), default="campaigns", help="which scenes")
+    ap.add_argument("--scene", action="append", help="PATH:all|none|NAMES (instead of a set)")
     args = ap.parse_args()
-    scenes = dict(s.rsplit(":", 1) for s in args.scene) if args.scene else SCENES
+    scenes = dict(s.rsplit(":", 1) for s in args.scene) if args.scene else SETS[args.set]
     flagged = wrong = alarms = right = covered = numbers = 0
     errors: list[float] = []
     for scene, which in scenes.items():

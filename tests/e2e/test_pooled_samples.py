@@ -54,3 +54,22 @@ def test_a_bench_sample_without_a_stated_modulus_gets_its_pooled_answer(tmp_path
     assert row["pooled_trials"] == 2
     assert row["pooled_kpa"] == pytest.approx(314.53, rel=0.05)  # S8 in the twin's world
     assert row["pooled_ci_low_kpa"] <= row["pooled_kpa"] <= row["pooled_ci_high_kpa"]
+
+
+def test_a_wrong_thickness_is_caught_when_the_trials_span_depths(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The depth-span protocol (docs/estimation.md): a 5 mm layer believed 10 mm thick, pressed
+    at 30-50 mm, is flagged by its pooled record with the truth's modulus under the alternative."""
+    from palpate.config import resolve
+
+    scene = str(resolve("scenes/mismatch/depth-span.yaml"))
+    args = ["sim", "--scene", scene, "--workers", "1", "--no-plots", "--json", "--limit", "5"]
+    assert main([*args, "--out", str(tmp_path), "--seed", "5"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    (sample,) = payload["samples"]
+    assert sample["sample"] == "T5as10-E150"
+    assert sample["pooled_verdict"] == "suspect"
+    assert "prefers a 5 mm layer to the stated 10 mm" in sample["pooled_reasons"]
+    assert sample["pooled_delta_chi2"] > 30
+    assert {t["exposed_length_mm"] for t in payload["trials"]} == {30.0, 35.0, 40.0, 45.0, 50.0}

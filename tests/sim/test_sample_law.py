@@ -152,6 +152,7 @@ SCENES = [
         "lung/*.yaml",
         "invivo/*.yaml",
         "maps/*.yaml",
+        "mismatch/*.yaml",
         "oblique/*.yaml",
         "viscoelastic/*.yaml",
     )
