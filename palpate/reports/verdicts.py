@@ -5,6 +5,7 @@ silently counted as good, and its interval is still held to account."""
 
 from __future__ import annotations
 
+import re
 import statistics
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -132,21 +133,33 @@ def by_sample(outcomes: Iterable[TrialOutcome]) -> dict[str, Tally]:
 
 
 def reason_lines(outcomes: Iterable[TrialOutcome], limit: int = 8) -> list[str]:
-    """``suspect``/``none`` reasons with how many trials give each (the most frequent first)."""
-    seen: dict[tuple[str, str], int] = {}
+    """``suspect``/``none`` reasons with how many trials give each (the most frequent first);
+    reasons that differ only in their figures count as one, shown by their first ("e.g.")."""
+    seen: dict[tuple[str, str], list[str]] = {}
     for o in estimating(outcomes):
         if o.verdict is None or o.verdict.status == "ok":
             continue
         for r in o.verdict.reasons:
-            key = (o.verdict.status, _generic(r))
-            seen[key] = seen.get(key, 0) + 1
-    ranked = sorted(seen.items(), key=lambda kv: -kv[1])[:limit]
-    return [f"{n:>4} x {status}: {reason}" for (status, reason), n in ranked]
+            text = _headline(r)
+            seen.setdefault((o.verdict.status, _FIGURE.sub("#", text)), []).append(text)
+    ranked = sorted(seen.items(), key=lambda kv: -len(kv[1]))[:limit]
+    return [
+        f"{len(texts):>4} x {status}: {'' if len(set(texts)) == 1 else 'e.g. '}{texts[0]}"
+        for (status, _), texts in ranked
+    ]
 
 
-def _generic(reason: str) -> str:
-    """A reason without its numbers after the first colon (so trials group by kind)."""
+_FIGURE = re.compile(r"[-+]?\d+(?:\.\d+)?")
+
+
+def _headline(reason: str) -> str:
+    """A reason without its parenthesis and a belief check's ": delta chi^2 = ...".
+
+    >>> _headline("the record prefers a 5 mm layer to the stated 10 mm: delta chi^2 = 125")
+    'the record prefers a 5 mm layer to the stated 10 mm'
+    """
     head, _, _ = reason.partition(" (")
+    head, _, _ = head.partition(": delta chi^2 =")
     return head
 
 
