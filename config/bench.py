@@ -20,7 +20,7 @@ from typing import Literal
 
 from .loader import ConfigError, limits, load, resolve
 from .sample import AssumedConfig
-from .scene import CampaignConfig, check_patch, require_tip_grating
+from .scene import CampaignConfig, check_patch, require_exposed_gratings, require_tip_grating
 from .schema import DEFAULT_CONTROL_RATE_HZ, MM, StackConfig
 
 SIMULATION_ONLY = ("samples", "exposed_lengths_mm", "exposed_length_mm", "tubes", "orientations")
@@ -169,6 +169,13 @@ def load_bench(path: str | Path) -> LoadedBench:
     )
     _check_stage(p, bench, stack, robot)
     require_tip_grating(bench.campaign, stack, str(p), str(robot))
+    if not bench.campaign.on_tubes:  # the bench-top column: each trial's fixed length
+        lengths = [
+            (f"trials[{i}].exposed_length_mm", t.exposed_length_mm * MM)
+            for i, t in enumerate(bench.trials)
+            if t.exposed_length_mm is not None
+        ]
+        require_exposed_gratings(lengths, stack, str(p), str(robot))
     targets = Path(bench.targets)
     if not targets.exists():
         try:

@@ -9,6 +9,7 @@ samples for the robot campaign.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -264,6 +265,36 @@ def require_tip_grating(
                 f"campaign.{key}",
                 f"'tip' needs a tip force grating: {robot} has no sensor.tip_grating",
             )
+
+
+def require_exposed_gratings(
+    lengths: Sequence[tuple[str, float]], stack: StackConfig, source: str, robot: str
+) -> None:
+    """ConfigError naming ``source`` and the key of the first exposed length (key, m) that
+    leaves a grating the estimator reads inside the tube: its strains would be the tube's, and
+    every trial would end with no estimate (``palpate sim``'s campaign and the bench file's
+    trials alike)."""
+    sensor = stack.sensor
+    reach = max(sensor.grating_centres_from_tip()) + 0.5 * sensor.grating_length
+    for key, length in lengths:
+        if length < reach - 1e-12:
+            raise ConfigError(
+                source,
+                key,
+                f"{length * 1e3:g} mm leaves a grating inside the tube: the estimator reads "
+                f"gratings {list(sensor.used_gratings)} of {robot}, the farthest ending "
+                f"{reach * 1e3:g} mm from the tip; expose at least {reach * 1e3:g} mm",
+            )
+
+
+def campaign_lengths(campaign: CampaignConfig) -> list[tuple[str, float]]:
+    """(key, m) of the exposed lengths a simulated ``campaign`` presses at (at contact)."""
+    if campaign.on_tubes:
+        return [("campaign.exposed_length_mm", campaign.exposed_length)]
+    return [
+        (f"campaign.exposed_lengths_mm[{i}]", length)
+        for i, length in enumerate(campaign.exposed_lengths)
+    ]
 
 
 def check_patch(patch_mm: tuple[float, ...], key: str) -> None:

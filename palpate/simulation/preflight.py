@@ -11,7 +11,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from palpate.config.loader import ConfigError
-from palpate.config.scene import SceneConfig, require_tip_grating
+from palpate.config.scene import (
+    SceneConfig,
+    campaign_lengths,
+    require_exposed_gratings,
+    require_tip_grating,
+)
 from palpate.config.schema import StackConfig
 from palpate.simulation.world import TrialSpec, trial_geometry
 
@@ -19,9 +24,12 @@ from palpate.simulation.world import TrialSpec, trial_geometry
 def check_campaign(
     scene: SceneConfig, stack: StackConfig, scene_source: str, robot_source: str
 ) -> None:
-    """Raise ConfigError if the scene's campaign names a tube the robot configuration lacks, or
-    reads the contact or the buckling from a tip grating the sensor does not have."""
+    """Raise ConfigError if the scene's campaign names a tube the robot configuration lacks,
+    reads the contact or the buckling from a tip grating the sensor does not have, or presses at
+    an exposed length that leaves a grating it reads inside the tube."""
     require_tip_grating(scene.campaign, stack, scene_source, robot_source)
+    lengths = campaign_lengths(scene.campaign)
+    require_exposed_gratings(lengths, stack, scene_source, robot_source)
     known = [t.name for t in stack.tubes]
     if not scene.campaign.on_tubes:
         return

@@ -93,6 +93,9 @@ CASES = [
     ("buckling from a tip grating the sensor lacks",
      SCENE.replace("detector: paper ", "detector: tip   "), None, "scene",
      "campaign.detector: 'tip' needs a tip force grating"),
+    ("an exposed length that leaves a grating in the tube",
+     SCENE.replace("exposed_length_mm: 42", "exposed_length_mm: 25"), None, "scene",
+     "campaign.exposed_length_mm: 25 mm leaves a grating inside the tube"),
 ]  # fmt: skip
 
 

@@ -306,6 +306,11 @@ def test_the_shipped_bench_file_fails_cleanly_on_a_machine_without_the_bench() -
         ("", "  - {target: down, modulus_kpa: -3}\n", "trials[0].modulus_kpa: must be > 0"),
         ("campaign: {max_travel_past_contact_mm: 40}\n", ONE, "may reach 84.00 mm"),
         ("after_trial: limp\n", ONE, "after_trial: must be one of ['hold', 'release']"),
+        (
+            "campaign: {kind: bench}\n",
+            "  - {target: down, exposed_length_mm: 25}\n",
+            "trials[0].exposed_length_mm: 25 mm leaves a grating inside the tube",
+        ),
     ],
 )
 def test_bad_bench_files_exit_2_naming_file_and_key(
