@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from ..belief import Belief
 from ..corrections import ContactLaw
 from .envelope import other_forms
-from .grid import grid_fits
+from .grid import GridFit, grid_fits, grouped_grid_fits
 from .pooling import FORM, STATED, Curve
 
 FloatArray = NDArray[np.float64]
@@ -81,9 +81,10 @@ def law_curves(
     depth_base, w = base
     grid = np.linspace(window[0], window[1], CHECK_POINTS)
     laws = [(STATED, law), *((FORM, f) for f in other_forms(law)), *alternatives(belief, law)]
+    coarse = grouped_grid_fits([c for _, c in laws], depth_base, P, w, grid, offset)
     curves = {}
-    for key, candidate in laws:
-        E, rss, S = _grid(candidate, depth_base, P, w, grid, offset)
+    for (key, candidate), fit in zip(laws, coarse, strict=True):
+        E, rss, S = _refined(candidate, fit, (depth_base, P, w), grid, offset)
         curves[key] = Curve(E, rss / scale2, S / scale2)
     return curves
 
@@ -109,17 +110,18 @@ def contradiction(
     return (f"{CONTRADICTED} belief: {record} prefers {worst}: delta chi^2 = {gains[worst]:.0f}",)
 
 
-def _grid(
+def _refined(
     law: ContactLaw,
-    depth_base: FloatArray,
-    P: FloatArray,
-    w: FloatArray,
+    coarse: GridFit,
+    record: tuple[FloatArray, FloatArray, FloatArray],
     grid: FloatArray,
     offset: bool,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """E, the weighted RSS (inf where E <= 0) and S at every contact position of ``grid``
-    (E, P0 in closed form), and on a finer grid around the RSS's minimum."""
-    ((E, _, rss, S),) = grid_fits([law], depth_base, P, w, grid, offset)
+    (``coarse``: the law's grid fit there, E and P0 in closed form), and on a finer grid around
+    the RSS's minimum; ``record`` is (depth base, P, weights)."""
+    depth_base, P, w = record
+    E, _, rss, S = coarse
     rss = np.where(E > 0.0, rss, np.inf)
     i = int(np.argmin(rss))
     step = grid[1] - grid[0] if grid.size > 1 else 0.0

@@ -92,6 +92,29 @@ def grid_fits(
     return [_concatenate(law_parts) for law_parts in parts]
 
 
+def grouped_grid_fits(
+    laws: Sequence[ContactLaw],
+    depth_base: FloatArray,
+    P: FloatArray,
+    w: FloatArray,
+    grid: FloatArray,
+    offset: bool,
+) -> list[GridFit]:
+    """:func:`grid_fits` of each of ``laws``, in their order, those that share the half-space
+    part (tip, Poisson ratio, half-space law) in one call: each law's numbers are those of a
+    call of its own, the half-space evaluated once per group."""
+    groups: dict[tuple[float, float, bool], list[int]] = {}
+    for i, law in enumerate(laws):
+        key = (law.tip_radius, law.poisson, law.large_indentation)
+        groups.setdefault(key, []).append(i)
+    fits: list[GridFit | None] = [None] * len(laws)
+    for idx in groups.values():
+        group = [laws[i] for i in idx]
+        for i, fit in zip(idx, grid_fits(group, depth_base, P, w, grid, offset), strict=True):
+            fits[i] = fit
+    return [fit for fit in fits if fit is not None]
+
+
 def _concatenate(blocks: list[GridFit]) -> GridFit:
     E, P0, rss, S = (np.concatenate(column) for column in zip(*blocks, strict=True))
     return E, P0, rss, S

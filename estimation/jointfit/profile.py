@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..corrections import ContactLaw
-from .grid import GridFit, grid_fits
+from .grid import GridFit, grouped_grid_fits
 
 FloatArray = NDArray[np.float64]
 
@@ -141,14 +141,16 @@ def _candidate_fits(
 ) -> list[GridFit]:
     """Every candidate's grid fit; candidates on one depth base with one Poisson ratio go in
     one :func:`grid_fits` call (they share the half-space part)."""
-    groups: dict[tuple[int, float], list[int]] = {}
+    groups: dict[int, list[int]] = {}
     for i, c in enumerate(candidates):
-        groups.setdefault((c.base, c.law.poisson), []).append(i)
+        groups.setdefault(c.base, []).append(i)
     fits: list[GridFit | None] = [None] * len(candidates)
-    for (base, _), idx in groups.items():
+    for base, idx in groups.items():
         laws = [candidates[i].law for i in idx]
         depth_base, w = bases[base]
-        for i, fit in zip(idx, grid_fits(laws, depth_base, P, w, grid, offset), strict=True):
+        for i, fit in zip(
+            idx, grouped_grid_fits(laws, depth_base, P, w, grid, offset), strict=True
+        ):
             fits[i] = fit
     return [fit for fit in fits if fit is not None]
 
