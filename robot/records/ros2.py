@@ -26,6 +26,7 @@ the end) takes the last time seen, so every channel's times never decrease.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -169,15 +170,23 @@ def wrench(stamp_ns: int, load: float) -> tuple[str, bytes]:
     )
 
 
+@functools.lru_cache(maxsize=64)
+def _tip_in_bend_plane(tube: TubeConfig) -> tuple[float, float, float]:
+    """The tube tip's position at roll 0 (``robot.kinematics.tube_tip_in_bend_plane``), once a
+    tube: a recording's ``/tf`` asks for it at every sample."""
+    p0, _ = tube_tip_in_bend_plane(tube)
+    return float(p0[0]), float(p0[1]), float(p0[2])
+
+
 def tip_transforms(tube: TubeConfig, roll: float, advance: float) -> list[cdr.Transform] | None:
     """A robot sample's ``/tf`` transforms: ``base`` -> ``tube_tip`` -> ``sensor_tip`` (None
     where the encoders gave no number); as ``robot.kinematics.forward``, the rotation composed as
     quaternions (roll about x, then the tube's tip angle about y)."""
     if not (math.isfinite(roll) and math.isfinite(advance)):
         return None
-    p0, _ = tube_tip_in_bend_plane(tube)
+    x0, y0, z0 = _tip_in_bend_plane(tube)
     c, s = math.cos(roll), math.sin(roll)
-    tip = (float(p0[0]), c * float(p0[1]) - s * float(p0[2]), s * float(p0[1]) + c * float(p0[2]))
+    tip = (x0, c * y0 - s * z0, s * y0 + c * z0)
     w1, x1 = math.cos(roll / 2), math.sin(roll / 2)
     w2, y2 = math.cos(tube.tip_angle / 2), math.sin(tube.tip_angle / 2)
     quaternion = (x1 * w2, w1 * y2, x1 * y2, w1 * w2)  # (x, y, z, w) of q_x(roll) q_y(angle)
