@@ -176,6 +176,9 @@ def load_bench(path: str | Path) -> LoadedBench:
             if t.exposed_length_mm is not None
         ]
         require_exposed_gratings(lengths, stack, str(p), str(robot))
+        if any(t.exposed_length_mm is None for t in bench.trials):  # the sensor's own length
+            default = [("sensor.exposed_length_mm", stack.sensor.exposed_length)]
+            require_exposed_gratings(default, stack, str(robot), str(robot))
     targets = Path(bench.targets)
     if not targets.exists():
         try:

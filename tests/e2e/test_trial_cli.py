@@ -323,6 +323,16 @@ def test_bad_bench_files_exit_2_naming_file_and_key(
     assert str(tmp_path) in err
 
 
+def test_a_sensor_length_that_hides_a_grating_is_refused_naming_the_robot_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    robot = ROBOT_YAML + "sensor: {exposed_length_mm: 25}\n"
+    path = bench_file(tmp_path, "  - {target: down}\n", "campaign: {kind: bench}\n", robot=robot)
+    assert main(["trial", "--config", str(path), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path}/robot.yaml: sensor.exposed_length_mm: 25 mm leaves a grating" in err
+
+
 def test_the_simulator_port_is_refused_on_the_bench(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
