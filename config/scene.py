@@ -281,9 +281,9 @@ def require_exposed_gratings(
             raise ConfigError(
                 source,
                 key,
-                f"{length * 1e3:g} mm leaves a grating inside the tube: the estimator reads "
+                f"{length / MM:g} mm leaves a grating inside the tube: the estimator reads "
                 f"gratings {list(sensor.used_gratings)} of {robot}, the farthest ending "
-                f"{reach * 1e3:g} mm from the tip; expose at least {reach * 1e3:g} mm",
+                f"{reach / MM:g} mm from the tip; expose at least {reach / MM:g} mm",
             )
 
 
