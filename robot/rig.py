@@ -62,6 +62,10 @@ class RigSettings:
     # line) for this long (s, the rig's clock) before the rig reports it lost; meanwhile the
     # motion holds (no new goal) and the ticks keep the last joints read, marked stale.
     bus_silence: float = 0.25
+    # ... and for at least this many reads in a row (each its own retries): the silence is the
+    # bus's, not a host that did not run the rig for a while (a dead bus misses three reads of
+    # four 20 ms attempts in about bus_silence anyway).
+    bus_missed_reads: int = 3
 
 
 class ServoFbgRig:
@@ -91,6 +95,7 @@ class ServoFbgRig:
         self._first_t: float | None = None  # the first tick's time: silence counts from it
         self._stale = False  # the last read was missed: hold the motion
         self.missed_reads = 0  # ticks whose servo read was missed and tolerated
+        self._missed_in_row = 0  # reads missed since the servos last answered
         self.frames: list[Frame] = []  # every frame received, for the trial log and plots
 
     @classmethod
@@ -156,15 +161,19 @@ class ServoFbgRig:
         try:
             joints, motors = self.drive.read()
             self._joints, self._read_t, self._stale = joints, t, False
+            self._missed_in_row = 0
             self._twist = self.drive.drive.twist({n: m.position for n, m in motors.items()})
         except ServoFaultError as exc:
             fault = str(exc)
         except ServoTransportError as exc:
             # A missed reply: tolerated (the motion holds, the joints are the last read, none
             # before the first) while the bus has been silent, since its last answer or the
-            # trial's first tick, for less than ``bus_silence``; then it is lost.
+            # trial's first tick, for less than ``bus_silence`` or fewer than
+            # ``bus_missed_reads`` reads in a row; then it is lost.
             since = self._first_t if self._read_t is None else self._read_t
-            if t - since >= self.settings.bus_silence:
+            self._missed_in_row += 1
+            silent = t - since >= self.settings.bus_silence
+            if silent and self._missed_in_row >= self.settings.bus_missed_reads:
                 fault, lost = f"bus transport: {exc} (silent {1e3 * (t - since):.0f} ms)", True
             else:
                 age, self._stale = max(t - since, 1e-9), True

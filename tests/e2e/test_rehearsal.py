@@ -23,7 +23,10 @@ from palpate.robot.records.log import read_log
 def test_the_rehearsal_completes_with_a_joint_fit_beside_a_cpu_load(tmp_path: Path) -> None:
     with cpu_load(busy=2):
         session = rehearse(tmp_path)
-    assert session.exit_code == 0, session.stderr[-2000:] + session.emulator_stderr[-1000:]
+    ended = [(t.get("state"), t.get("reason"), t.get("bus")) for t in session.trials]
+    assert session.exit_code == 0, (
+        f"{ended}\n{session.stderr[-2000:]}{session.emulator_stderr[-1000:]}"
+    )
     assert session.trials
     for trial in session.trials:
         assert trial["state"] == "done", trial["reason"]
