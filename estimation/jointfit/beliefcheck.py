@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from ..belief import Belief
 from ..corrections import ContactLaw
 from .envelope import other_forms
-from .grid import GridFit, grid_fits, grouped_grid_fits
+from .grid import GridFit, grid_fits
 from .pooling import FORM, STATED, Curve
 
 FloatArray = NDArray[np.float64]
@@ -81,7 +81,7 @@ def law_curves(
     depth_base, w = base
     grid = np.linspace(window[0], window[1], CHECK_POINTS)
     laws = [(STATED, law), *((FORM, f) for f in other_forms(law)), *alternatives(belief, law)]
-    coarse = grouped_grid_fits([c for _, c in laws], depth_base, P, w, grid, offset)
+    coarse = grid_fits([c for _, c in laws], depth_base, P, w, grid, offset)
     curves = {}
     for (key, candidate), fit in zip(laws, coarse, strict=True):
         E, rss, S = _refined(candidate, fit, (depth_base, P, w), grid, offset)

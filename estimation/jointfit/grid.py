@@ -74,7 +74,18 @@ def grid_fits(
     - the laws share one evaluation of the half-space part
       (``estimation.corrections.shape_values``).
     The sums run in depth order instead of record order: the same fit up to rounding.
+
+    Laws that differ in tip, Poisson ratio or half-space law go in one call per group: each
+    law's numbers are those of a call of its own.
     """
+    groups = _half_space_groups(laws)
+    if len(groups) > 1:
+        fits: list[GridFit | None] = [None] * len(laws)
+        for idx in groups:
+            group = [laws[i] for i in idx]
+            for i, fit in zip(idx, grid_fits(group, depth_base, P, w, grid, offset), strict=True):
+                fits[i] = fit
+        return [fit for fit in fits if fit is not None]
     order = np.argsort(depth_base, kind="stable")
     depth_sorted, P_sorted, w_sorted = depth_base[order], P[order], w[order]
     first = np.searchsorted(depth_sorted, grid, side="right")  # first touching sample per row
@@ -92,27 +103,12 @@ def grid_fits(
     return [_concatenate(law_parts) for law_parts in parts]
 
 
-def grouped_grid_fits(
-    laws: Sequence[ContactLaw],
-    depth_base: FloatArray,
-    P: FloatArray,
-    w: FloatArray,
-    grid: FloatArray,
-    offset: bool,
-) -> list[GridFit]:
-    """:func:`grid_fits` of each of ``laws``, in their order, those that share the half-space
-    part (tip, Poisson ratio, half-space law) in one call: each law's numbers are those of a
-    call of its own, the half-space evaluated once per group."""
+def _half_space_groups(laws: Sequence[ContactLaw]) -> list[list[int]]:
+    """The indices of ``laws`` by the half-space part they share (tip, Poisson ratio, law)."""
     groups: dict[tuple[float, float, bool], list[int]] = {}
     for i, law in enumerate(laws):
-        key = (law.tip_radius, law.poisson, law.large_indentation)
-        groups.setdefault(key, []).append(i)
-    fits: list[GridFit | None] = [None] * len(laws)
-    for idx in groups.values():
-        group = [laws[i] for i in idx]
-        for i, fit in zip(idx, grid_fits(group, depth_base, P, w, grid, offset), strict=True):
-            fits[i] = fit
-    return [fit for fit in fits if fit is not None]
+        groups.setdefault((law.tip_radius, law.poisson, law.large_indentation), []).append(i)
+    return list(groups.values())
 
 
 def _concatenate(blocks: list[GridFit]) -> GridFit:

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..corrections import ContactLaw
-from .grid import GridFit, grouped_grid_fits
+from .grid import GridFit, grid_fits
 
 FloatArray = NDArray[np.float64]
 
@@ -148,9 +148,7 @@ def _candidate_fits(
     for base, idx in groups.items():
         laws = [candidates[i].law for i in idx]
         depth_base, w = bases[base]
-        for i, fit in zip(
-            idx, grouped_grid_fits(laws, depth_base, P, w, grid, offset), strict=True
-        ):
+        for i, fit in zip(idx, grid_fits(laws, depth_base, P, w, grid, offset), strict=True):
             fits[i] = fit
     return [fit for fit in fits if fit is not None]
 
