@@ -169,16 +169,7 @@ def load_bench(path: str | Path) -> LoadedBench:
     )
     _check_stage(p, bench, stack, robot)
     require_tip_grating(bench.campaign, stack, str(p), str(robot))
-    if not bench.campaign.on_tubes:  # the bench-top column: each trial's fixed length
-        lengths = [
-            (f"trials[{i}].exposed_length_mm", t.exposed_length_mm * MM)
-            for i, t in enumerate(bench.trials)
-            if t.exposed_length_mm is not None
-        ]
-        require_exposed_gratings(lengths, stack, str(p), str(robot))
-        if any(t.exposed_length_mm is None for t in bench.trials):  # the sensor's own length
-            default = [("sensor.exposed_length_mm", stack.sensor.exposed_length)]
-            require_exposed_gratings(default, stack, str(robot), str(robot))
+    _check_lengths(p, bench, stack, robot)
     targets = Path(bench.targets)
     if not targets.exists():
         try:
@@ -205,3 +196,19 @@ def _check_stage(path: Path, bench: BenchConfig, stack: StackConfig, robot: Path
             f"{list(bench.map.patch_mm)} reaches beyond the stage's travel "
             f"(x {[xl, xh]}, y {[yl, yh]} mm in {robot})",
         )
+
+
+def _check_lengths(path: Path, bench: BenchConfig, stack: StackConfig, robot: Path) -> None:
+    """On the bench-top column, each trial's fixed exposed length (or the sensor's own, in the
+    robot file, where a trial gives none) must expose every grating the estimator reads."""
+    if bench.campaign.on_tubes:
+        return
+    given = [
+        (f"trials[{i}].exposed_length_mm", t.exposed_length_mm * MM)
+        for i, t in enumerate(bench.trials)
+        if t.exposed_length_mm is not None
+    ]
+    require_exposed_gratings(given, stack, str(path), str(robot))
+    if len(given) < len(bench.trials):
+        own = [("sensor.exposed_length_mm", stack.sensor.exposed_length)]
+        require_exposed_gratings(own, stack, str(robot), str(robot))
