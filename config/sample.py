@@ -58,6 +58,8 @@ class AssumedConfig:
     curvature_radius_mm: float | Range | Literal["unknown"] | None = field(
         default=None, metadata=limits(gt=0, le=1e4)
     )
+    material: Literal["linear", "neo-hookean"] | None = None
+    friction: Literal["frictionless", "sticking", "unknown"] | None = None
 
     def validate(self) -> None:
         _check_range("thickness_mm", self.thickness_mm, 0.0, 1000.0)

@@ -39,7 +39,8 @@ from typing import Literal
 
 import numpy as np
 
-from .corrections import CHI_MAX, ContactLaw, LayerLaw
+from .corrections import CHI_MAX, ContactLaw, LayerLaw, Material
+from .finite_strain.table import Tip
 
 E_STEP = 0.02
 CHI_STEP = 0.02
@@ -65,13 +66,18 @@ class Hypothesis:
     compliance: float = 0.0
 
     def describe(self) -> dict[str, object]:
-        """JSON-ready: thickness (m, None = half-space), bonded, poisson, compliance (m/N)."""
-        return {
+        """JSON-ready: thickness (m, None = half-space), bonded, poisson, compliance (m/N), and
+        for a neo-Hookean law its material and tip."""
+        out: dict[str, object] = {
             "thickness": self.law.thickness,
             "bonded": self.law.bonded,
             "poisson": self.law.poisson,
             "compliance": self.compliance,
         }
+        if self.law.material != "linear":
+            out["material"] = self.law.material
+            out["tip"] = self.law.tip
+        return out
 
     @classmethod
     def described(
@@ -86,6 +92,8 @@ class Hypothesis:
             None if thickness is None else float(thickness),  # type: ignore[arg-type]
             bool(best.get("bonded", True)),
             layer_law=layer_law,
+            material=str(best.get("material", "linear")),  # type: ignore[arg-type]
+            tip=str(best.get("tip", "frictionless")),  # type: ignore[arg-type]
         )
         return cls(law, float(best.get("compliance") or 0.0))  # type: ignore[arg-type]
 
@@ -106,6 +114,9 @@ class Belief:
         large_indentation: Sneddon's sphere (else Hertz).
         layer_ratio_from: the thin-layer ratio of the laws (``ContactLaw.layer_ratio_from``).
         layer_law: the laws' layer law (``ContactLaw.layer_law``): exact, or the series.
+        material: the laws' material (``ContactLaw.material``): linear, or neo-Hookean.
+        tips: the tip contacts allowed (``ContactLaw.tip``): ("frictionless",),
+            ("sticking",) or both (friction unknown: profiled over, as the bonding is).
     """
 
     tip_radius: float
@@ -116,6 +127,8 @@ class Belief:
     large_indentation: bool = True
     layer_ratio_from: Literal["published", "sphere"] = "published"
     layer_law: LayerLaw = "exact"
+    material: Material = "linear"
+    tips: tuple[Tip, ...] = ("frictionless",)
 
     def __post_init__(self) -> None:
         _checked_range("poisson", self.poisson, 0.0, 0.5)
@@ -123,6 +136,10 @@ class Belief:
         _checked_range("compliance", self.compliance, 0.0, math.inf)
         if not self.bonded or len(set(self.bonded)) != len(self.bonded):
             raise ValueError(f"bonded must list True and/or False once each, got {self.bonded!r}")
+        if not self.tips or len(set(self.tips)) != len(self.tips):
+            raise ValueError(
+                f"tips must list frictionless and/or sticking once each, got {self.tips!r}"
+            )
         if self.thickness[1] == 0.0:
             raise ValueError("thickness must allow a layer thicker than 0 m")
         ContactLaw(self.tip_radius, self.poisson[0])  # validates the tip radius
@@ -140,6 +157,8 @@ class Belief:
             law.large_indentation,
             law.layer_ratio_from,
             law.layer_law,
+            law.material,
+            (law.tip,),
         )
 
     @property
@@ -150,6 +169,8 @@ class Belief:
             out.append("thickness")
         if len(self.bonded) > 1:
             out.append("bonded")
+        if len(self.tips) > 1 and self.material != "linear":
+            out.append("tip")
         if self.poisson[0] != self.poisson[1]:
             out.append("poisson")
         if self.compliance[0] != self.compliance[1]:
@@ -165,6 +186,7 @@ class Belief:
             self.bonded[0],
             0.5 * (self.poisson[0] + self.poisson[1]),
             0.5 * (self.compliance[0] + self.compliance[1]),
+            self.tips[0],
         )
 
     def hypotheses(
@@ -178,11 +200,19 @@ class Belief:
         n_c = RANGE_POINTS
         if max_force is not None and max_depth > 0:
             n_c = _count(1.5 * (c[1] - c[0]) * max_force / max_depth / E_STEP)
-        grid = itertools.product(inv, self.bonded, _poisson_points(self.poisson), _points(c, n_c))
+        tips = self.tips if self.material != "linear" else self.tips[:1]
+        grid = itertools.product(
+            inv, self.bonded, _poisson_points(self.poisson), _points(c, n_c), tips
+        )
         return tuple(self._hypothesis(*point) for point in grid)
 
     def _hypothesis(
-        self, inverse_thickness: float, bonded: bool, poisson: float, compliance: float
+        self,
+        inverse_thickness: float,
+        bonded: bool,
+        poisson: float,
+        compliance: float,
+        tip: Tip = "frictionless",
     ) -> Hypothesis:
         h = None if inverse_thickness <= 0.0 else 1.0 / inverse_thickness
         law = ContactLaw(
@@ -193,6 +223,8 @@ class Belief:
             self.large_indentation,
             self.layer_ratio_from,
             self.layer_law,
+            self.material,
+            tip,
         )
         return Hypothesis(law, compliance)
 

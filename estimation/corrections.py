@@ -35,6 +35,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .finite_strain.table import DepartureCurve, Tip, departure_curve
 from .hertz import MAX_DEPTH_RATIO as MAX_DEPTH_RATIO_HERTZ
 from .hertz import hertz_validity
 from .layer import dimitriadis_bracket, layer_coefficients
@@ -47,6 +48,7 @@ CHI_MAX = 1.0
 """Layer ratio up to which the Dimitriadis series is trusted (its small-chi expansion)."""
 
 LayerLaw = Literal["exact", "dimitriadis"]
+Material = Literal["linear", "neo-hookean"]
 
 MAX_MISALIGNMENT = math.radians(5.0)
 """Angle between the sensor axis and the surface normal above which a warning is given: the
@@ -94,6 +96,10 @@ class ContactLaw:
         layer_law: ``"exact"``: the layer's exact linear-elastic law for the sphere (or the
             paraboloid) at depth (``estimation.layer_table``), trusted to chi = 3 and
             delta/R = 1; ``"dimitriadis"``: the published series, kept as a reference.
+        material: ``"linear"`` elasticity, or a ``"neo-hookean"`` solid: the linear law times
+            ``1 + D``, its second-order departure (``estimation.finite_strain``).
+        tip: the tip's contact, ``"frictionless"`` or ``"sticking"`` (full stick): it moves a
+            neo-Hookean solid's departure (the linear law does not tell them apart: <= 0.3 %).
     """
 
     tip_radius: float
@@ -103,6 +109,8 @@ class ContactLaw:
     large_indentation: bool = True
     layer_ratio_from: Literal["published", "sphere"] = "published"
     layer_law: LayerLaw = "exact"
+    material: Material = "linear"
+    tip: Tip = "frictionless"
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tip_radius) and self.tip_radius > 0):
@@ -118,6 +126,10 @@ class ContactLaw:
             )
         if self.layer_law not in ("exact", "dimitriadis"):
             raise ValueError(f"layer_law must be 'exact' or 'dimitriadis', got {self.layer_law!r}")
+        if self.material not in ("linear", "neo-hookean"):
+            raise ValueError(f"material must be 'linear' or 'neo-hookean', got {self.material!r}")
+        if self.tip not in ("frictionless", "sticking"):
+            raise ValueError(f"tip must be 'frictionless' or 'sticking', got {self.tip!r}")
 
     @property
     def name(self) -> str:
@@ -128,6 +140,14 @@ class ContactLaw:
         if self.layer_law == "exact":
             return f"{base} on an exact {kind} layer (h = {self.thickness * 1e3:g} mm)"
         return f"{base} x Dimitriadis {kind} (h = {self.thickness * 1e3:g} mm)"
+
+    @property
+    def finite_strain(self) -> DepartureCurve | None:
+        """The neo-Hookean departure's curve (None: a linear material)."""
+        if self.material == "linear":
+            return None
+        inverse = 0.0 if self.thickness is None else self.tip_radius / self.thickness
+        return departure_curve(self.poisson, self.bonded, inverse, self.tip)
 
     @property
     def exact_layer(self) -> LayerFactor | None:
@@ -161,16 +181,26 @@ class ContactLaw:
         df0 = 2.0 * a  # dF/ddelta = 2 E* a for any axisymmetric frictionless indenter
         scale = 1.0 / (1.0 - self.poisson**2)
         if self.thickness is None:
-            return np.asarray(scale * f0), np.asarray(scale * df0)
+            return self._strained(dp, scale * f0, scale * df0)
         exact = self.exact_layer
         if exact is not None:
             g, dg = exact.at(root / self.thickness)
             dchi = da / self.thickness
-            return np.asarray(scale * f0 * g), np.asarray(scale * (df0 * g + f0 * dg * dchi))
+            return self._strained(dp, scale * f0 * g, scale * (df0 * g + f0 * dg * dchi))
         chi = root / self.thickness
         b, db = dimitriadis_bracket(chi, layer_coefficients(self.poisson, self.bonded))
         dchi = da / self.thickness
-        return np.asarray(scale * f0 * b), np.asarray(scale * (df0 * b + f0 * db * dchi))
+        return self._strained(dp, scale * f0 * b, scale * (df0 * b + f0 * db * dchi))
+
+    def _strained(
+        self, dp: FloatArray, f: FloatArray, df: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """The linear law's (f, df) at depths ``dp`` >= 0, times the material's ``1 + D``."""
+        curve = self.finite_strain
+        if curve is None:
+            return np.asarray(f), np.asarray(df)
+        d, dd = curve.at(dp / self.tip_radius)
+        return np.asarray(f * (1.0 + d)), np.asarray(df * (1.0 + d) + f * dd / self.tip_radius)
 
     def force(self, modulus: float, delta: ArrayLike) -> FloatArray:
         """F (N) at depths ``delta`` for modulus E (Pa)."""
@@ -217,22 +247,26 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
     out: list[FloatArray] = []
     for law in laws:
         if law.thickness is None:
-            out.append(np.asarray(scale * f0))
-            continue
-        exact = law.exact_layer
-        if exact is not None:
-            out.append(np.asarray(scale * f0 * exact.at(half.root / law.thickness)[0]))
-            continue
-        radius = half.a if law.layer_ratio_from == "sphere" else half.root
-        k = layer_coefficients(law.poisson, law.bonded)
-        b, _ = dimitriadis_bracket(radius / law.thickness, k)
-        out.append(np.asarray(scale * f0 * b))
+            value = scale * f0
+        elif (exact := law.exact_layer) is not None:
+            value = scale * f0 * exact.at(half.root / law.thickness)[0]
+        else:
+            radius = half.a if law.layer_ratio_from == "sphere" else half.root
+            k = layer_coefficients(law.poisson, law.bonded)
+            value = scale * f0 * dimitriadis_bracket(radius / law.thickness, k)[0]
+        curve = law.finite_strain
+        if curve is not None:
+            value = value * (1.0 + curve.at(np.maximum(delta, 0.0) / law.tip_radius)[0])
+        out.append(np.asarray(value))
     return out
 
 
 LAYER_STRAIN_MAX = 0.2
 """Trusted compression of a layer, delta/h: past it a thin layer's finite strain (not in any
 linear law) moves the force by several % (docs/estimation.md)."""
+LAYER_STRAIN_MAX_NEO_HOOKEAN = 0.3
+"""The same for a neo-Hookean law, which carries the departure to second order: checked
+against the world's finite elements to delta/h = 0.3 (docs/layer-law.md)."""
 
 
 def validity_warnings(
@@ -280,6 +314,8 @@ def exact_domain_warnings(law: ContactLaw, delta_max: float) -> list[str]:
         note = "the paraboloid departs from the sphere"
         if law.large_indentation:
             note = "corrected with Sneddon's sphere (linear elasticity still assumed)"
+            if law.material != "linear":
+                note = "corrected with Sneddon's sphere and the neo-Hookean departure"
         out.append(
             f"indentation beyond Hertz's small-strain range: delta/R up to {depth_ratio:.3g}; "
             f"{note}"
@@ -294,7 +330,13 @@ def exact_domain_warnings(law: ContactLaw, delta_max: float) -> list[str]:
             f"domain (chi <= {exact.reach:.3g}): the thickness correction is extrapolated"
         )
     strain = delta_max / law.thickness
-    if strain > LAYER_STRAIN_MAX:
+    if law.material != "linear":
+        if strain > LAYER_STRAIN_MAX_NEO_HOOKEAN:
+            out.append(
+                f"the layer is compressed by delta/h = {strain:.3g} > "
+                f"{LAYER_STRAIN_MAX_NEO_HOOKEAN:g}: beyond the second-order neo-Hookean law"
+            )
+    elif strain > LAYER_STRAIN_MAX:
         out.append(
             f"the layer is compressed by delta/h = {strain:.3g} > {LAYER_STRAIN_MAX:g}: "
             f"finite strain, outside every linear law, moves the force by several %"

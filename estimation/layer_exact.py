@@ -111,20 +111,11 @@ def _profile(tau: FloatArray, rho: float) -> FloatArray:
     return np.asarray(tau * rho * np.arctanh(tau / rho))
 
 
-def solve_contact(
-    alpha: FloatArray, rho: float, kernel: LayerKernel, nodes: int = NODES
-) -> LayerContact:
-    """The layer's contact at each contact radius ``alpha`` = a/h (> 0), for a sphere of radius
-    ``rho`` = R/h (``math.inf``: Hertz's paraboloid). All radii are solved as one batch.
-
-    Raises:
-        LayerSolveError: alpha outside (0, min(rho, KERNEL_X_MAX/2)), or a radius with no
-            admissible solution (g1(a) <= 0 or a non-finite load).
-    """
-    a = np.atleast_1d(np.asarray(alpha, dtype=np.float64))
-    top = min(rho, 0.5 * KERNEL_X_MAX)
-    if not np.all(np.isfinite(a) & (a > 0.0) & (a < top)):
-        raise LayerSolveError(f"contact radius a/h must be in (0, {top:.4g}), got {a.min():.4g}")
+def _nystrom(
+    a: FloatArray, rho: float, kernel: LayerKernel, nodes: int
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Nodes tau, weights, g1, g2 (each (n_a, nodes)) and the depth D of the contact at each
+    radius in ``a`` (already checked)."""
     g, w = np.polynomial.legendre.leggauss(nodes)
     tau = a[:, None] * (0.5 * (g + 1.0))
     wt = a[:, None] * (0.5 * w)
@@ -140,8 +131,46 @@ def solve_contact(
     g2a = _profile(a, rho) - np.sum(edge * wt * g2, axis=1)
     if not np.all(np.isfinite(g1a) & (g1a > 0.0)):
         raise LayerSolveError("the layer's contact equation has no positive edge solution")
-    depth = g2a / g1a
+    return tau, wt, np.asarray(g1), np.asarray(g2), np.asarray(g2a / g1a)
+
+
+def _checked_radii(alpha: FloatArray, rho: float) -> FloatArray:
+    a = np.atleast_1d(np.asarray(alpha, dtype=np.float64))
+    top = min(rho, 0.5 * KERNEL_X_MAX)
+    if not np.all(np.isfinite(a) & (a > 0.0) & (a < top)):
+        raise LayerSolveError(f"contact radius a/h must be in (0, {top:.4g}), got {a.min():.4g}")
+    return a
+
+
+def solve_contact(
+    alpha: FloatArray, rho: float, kernel: LayerKernel, nodes: int = NODES
+) -> LayerContact:
+    """The layer's contact at each contact radius ``alpha`` = a/h (> 0), for a sphere of radius
+    ``rho`` = R/h (``math.inf``: Hertz's paraboloid). All radii are solved as one batch.
+
+    Raises:
+        LayerSolveError: alpha outside (0, min(rho, KERNEL_X_MAX/2)), or a radius with no
+            admissible solution (g1(a) <= 0 or a non-finite load).
+    """
+    a = _checked_radii(alpha, rho)
+    _, wt, g1, g2, depth = _nystrom(a, rho, kernel, nodes)
     force = 2.0 * (depth * np.sum(wt * g1, axis=1) - np.sum(wt * g2, axis=1))
     if not np.all(np.isfinite(force) & (force > 0.0)):
         raise LayerSolveError("the layer's contact load is not finite and positive")
     return LayerContact(a, np.asarray(depth), np.asarray(force))
+
+
+def contact_density(
+    alpha: float, rho: float, kernel: LayerKernel, nodes: int = NODES
+) -> tuple[FloatArray, FloatArray, float]:
+    """The contact's Copson density at radius ``alpha`` = a/h: Gauss-Legendre nodes ``tau`` of
+    [0, alpha], ``g(tau) pi R / (E* h^2)`` there (the pressure's Hankel transform is
+    ``int g cos(xi t) dt``), and the depth D = delta R / h^2 (``estimation.finite_strain`` builds
+    the layer's interior fields from it).
+
+    Raises:
+        LayerSolveError: as :func:`solve_contact`.
+    """
+    a = _checked_radii(np.asarray([alpha]), rho)
+    tau, _, g1, g2, depth = _nystrom(a, rho, kernel, nodes)
+    return tau[0], depth[0] * g1[0] - g2[0], float(depth[0])

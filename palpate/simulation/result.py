@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.config.stage import Stage
@@ -21,6 +22,7 @@ from palpate.robot.trial.inputs import belief_fields
 from palpate.robot.trial.outcome import Outcome, outcome_fields
 from palpate.robot.trial.run import TrialResult
 from palpate.robot.trial.setup import sensor_section
+from palpate.sim.sample_law import contact_condition
 from palpate.simulation.world import TrialGeometry, TrialSpec, trial_sample
 from palpate.wire.dynamixel import TICKS_PER_REV
 
@@ -136,6 +138,13 @@ def outcome_of(
     )
 
 
+def believed_tip(sample: SampleConfig) -> str:
+    """The tip contact the operator knows of ``sample`` (its own): ``sticking`` where its
+    friction sticks in the world (``sim.sample_law.contact_condition``), else frictionless."""
+    stick = contact_condition(sample.friction, sample.poisson) == "stick"
+    return "sticking" if stick else "frictionless"
+
+
 def estimator_inputs(
     spec: TrialSpec,
     scene: SceneConfig,
@@ -157,6 +166,8 @@ def estimator_inputs(
         bonded=sample.bonded,
         poisson=sample.poisson,
         surface_radius=sample.curvature_radius,
+        material=sample.material,
+        tip_contact=believed_tip(sample),
     )
     return EstimatorInputs(
         kind=stage.kind,

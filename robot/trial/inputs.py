@@ -59,6 +59,10 @@ class EstimatorInputs:
             range), None: flat or unknown; the contact law takes :attr:`contact_radius`.
         rigid: the sample is a rigid reference: the trial calibrates the rig's compliance
             (``estimation.compliance``) instead of estimating a modulus.
+        material: the sample's believed material, ``"linear"`` or ``"neo-hookean"`` (the law
+            then carries the finite-strain departure, ``estimation.finite_strain``).
+        tip_contact: the believed tip contact, ``"frictionless"`` or ``"sticking"``;
+            tip_contact_options: both when the friction is ``unknown``, None otherwise.
         version: the inputs' format (VERSION; 1 for logs that predate it).
     """
 
@@ -85,6 +89,9 @@ class EstimatorInputs:
     probe_reason: str | None = None
     surface_radius: float | None = None
     motion_tolerance: float | None = None
+    material: str = "linear"
+    tip_contact: str = "frictionless"
+    tip_contact_options: tuple[str, ...] | None = None
     version: int = VERSION
 
     @property
@@ -118,7 +125,15 @@ class EstimatorInputs:
 
     def law(self) -> ContactLaw:
         """The nominal contact law."""
-        return ContactLaw(self.contact_radius, self.poisson, self.thickness, self.bonded, True)
+        return ContactLaw(
+            self.contact_radius,
+            self.poisson,
+            self.thickness,
+            self.bonded,
+            True,
+            material=self.material,  # type: ignore[arg-type]
+            tip=self.tip_contact,  # type: ignore[arg-type]
+        )
 
     def belief(self) -> Belief:
         """What the joint fit profiles over (``estimation.belief``)."""
@@ -133,6 +148,8 @@ class EstimatorInputs:
             thickness,
             self.bonded_options or (self.bonded,),
             self.compliance,
+            material=self.material,  # type: ignore[arg-type]
+            tips=self.tip_contact_options or (self.tip_contact,),  # type: ignore[arg-type]
         )
 
 
@@ -143,13 +160,17 @@ def belief_fields(
     bonded: bool | str,
     poisson: float,
     surface_radius: float | None = None,
+    material: str = "linear",
+    tip_contact: str = "frictionless",
 ) -> dict[str, Any]:
     """The :class:`EstimatorInputs` fields of an operator's belief (``poisson``, ``thickness``,
     ``bonded`` and their ranges): each key of ``assumed`` (``config.sample.AssumedConfig``)
     that is left out takes the default given here, in the same forms: ``thickness`` in m (None
     or ``"half-space"``: a half-space; ``"unknown"``), ``bonded`` (or ``"unknown"``),
-    ``poisson``, ``surface_radius`` (m, None: flat). A scene gives the sample's own values; the
-    bench gives thickness and bonding ``"unknown"``, the trial's Poisson ratio and no radius."""
+    ``poisson``, ``surface_radius`` (m, None: flat), ``material``, ``tip_contact``
+    (``frictionless`` or ``sticking``). A scene gives the sample's own values; the bench gives
+    thickness and bonding ``"unknown"``, the trial's Poisson ratio, no radius, a linear material
+    and a frictionless tip (the paper's law)."""
     a = assumed or AssumedConfig()
     h = thickness if a.thickness_mm is None else _thickness_m(a.thickness_mm)
     b = bonded if a.bonded is None else a.bonded
@@ -185,6 +206,18 @@ def belief_fields(
     radii = a.surface_radius(surface_radius)
     if radii is not None:
         out["surface_radius"] = 0.5 * (radii[0] + radii[1])
+    return out | _material_fields(a, material, tip_contact)
+
+
+def _material_fields(a: AssumedConfig, material: str, tip_contact: str) -> dict[str, Any]:
+    """The material and tip-contact fields of ``a`` (a left-out key takes the given default)."""
+    out: dict[str, Any] = {"material": material if a.material is None else a.material}
+    friction = tip_contact if a.friction is None else a.friction
+    if friction == UNKNOWN:
+        out["tip_contact_options"] = ("frictionless", "sticking")
+        out["tip_contact"] = "frictionless"
+    else:
+        out["tip_contact"] = friction
     return out
 
 

@@ -15,7 +15,15 @@ TRUTH = {"thickness": 6e-3, "bonded": False, "poisson": 0.45}
 
 
 def test_without_assumed_a_scene_tells_the_samples_own_values() -> None:
-    assert belief_fields(None, **TRUTH) == {"thickness": 6e-3, "bonded": False, "poisson": 0.45}
+    assert belief_fields(None, **TRUTH) == {
+        "thickness": 6e-3,
+        "bonded": False,
+        "poisson": 0.45,
+        "material": "linear",
+        "tip_contact": "frictionless",
+    }
+    own = belief_fields(None, **TRUTH, material="neo-hookean", tip_contact="sticking")
+    assert (own["material"], own["tip_contact"]) == ("neo-hookean", "sticking")
 
 
 def test_assumed_values_ranges_and_unknowns_become_ranges() -> None:
@@ -31,7 +39,23 @@ def test_assumed_values_ranges_and_unknowns_become_ranges() -> None:
     assert half["poisson_range"] == (0.0, 0.5)
     assert half["bonded"] is False  # left out: the sample's own value
     told = belief_fields(AssumedConfig(thickness_mm=10.0, bonded=True), **TRUTH)
-    assert told == {"thickness": 10e-3, "bonded": True, "poisson": 0.45}
+    assert told == {
+        "thickness": 10e-3,
+        "bonded": True,
+        "poisson": 0.45,
+        "material": "linear",
+        "tip_contact": "frictionless",
+    }
+    unknown = belief_fields(AssumedConfig(material="neo-hookean", friction="unknown"), **TRUTH)
+    assert unknown["material"] == "neo-hookean"
+    assert unknown["tip_contact_options"] == ("frictionless", "sticking")
+    inputs = EstimatorInputs(
+        "bench", 0.044, 0.0, 3.5e-3, encoder_resolution=5e-6, misalignment=0.0, **unknown
+    )
+    belief = inputs.belief()
+    assert belief.tips == ("frictionless", "sticking")
+    assert "tip" in belief.open_keys
+    assert {h.law.tip for h in belief.hypotheses(2e-4)} == {"frictionless", "sticking"}
 
 
 def test_on_the_bench_thickness_and_bonding_default_to_unknown() -> None:
