@@ -24,7 +24,6 @@ from palpate.estimation.layer_exact import kernel_transform, solve_contact
 from palpate.sim.fem.generate import SHIPPED
 from palpate.sim.fem.table import load_table
 
-
 UNRESOLVED = 0.03
 
 
@@ -67,7 +66,8 @@ def main() -> None:
         gap = float(np.max(np.abs(ours - theirs)[resolved]))
         group = f"{tip}, {'thin' if thin else 'thick'}"
         worst[group] = max(worst.get(group, 0.0), gap)
-        print(f"| {name} | {unit} {', '.join(f'{m:g}' for m in marks)} | {cells} | {100 * gap:.2f} |")
+        depths = ", ".join(f"{m:g}" for m in marks)
+        print(f"| {name} | {unit} {depths} | {cells} | {100 * gap:.2f} |")
     print()
     for group, gap in sorted(worst.items()):
         print(f"largest difference, {group}: {100 * gap:.2f} % of the force")

@@ -21,15 +21,16 @@ The force is ``F = dPi/ddelta``, so the relative departure from the linear law i
 - the sticking tip (full stick): a point keeps the radial displacement it had when the contact
   reached it, ``u_r(r) = u1_r(r; a = r)``, so ``C`` takes that frozen value instead; the
   stick's own shear field is left out, and :func:`_sticking` bridges the two limits where that
-  is right (a thin layer, a half-space). An approximation: within 0.6 % of the world's FE to
-  delta/h = 0.2 on the thin layers, 0.35 % on the lung and paper layers to delta/R = 0.1
+  is right (a thin layer, a half-space). An approximation: within 0.7 % of the world's FE to
+  delta/h = 0.2 on the thin layers, 0.5 % on the lung and paper layers to delta/R = 0.2
   (docs/layer-law.md); half the spread of its limits is carried in the interval
   (``estimation.jointfit.modelform``).
 
 ``u1`` comes from the exact linear layer law's contact density (``estimation.layer_exact``)
 and the layer's Hankel-space fields (:mod:`.fields`); nothing here uses the world's finite
 elements. Against them (docs/layer-law.md, "Finite strain"): the frictionless departure within
-0.3 % of the world's to delta/h = 0.3 on 1.5-3 mm layers, bonded and sliding.
+0.2 % of the world's to delta/h = 0.2 on 1.5-3 mm layers, bonded and sliding (0.44 % at 0.3),
+0.32 % on the thick ones to delta/R = 0.2.
 
     >>> row = departure_row(1 / 2.33, 0.45, bonded=True)     # h/R = 0.43
     >>> row.depth_ratio, row.frictionless, row.sticking      # delta/R, D, D
@@ -209,7 +210,7 @@ def _radii(thickness: float, nu: float, bonded: bool) -> FloatArray:
 
 
 def departure_row(thickness_ratio: float, poisson: float, bonded: bool) -> DepartureRow:
-    """The departure along one row (~6 s). ``thickness_ratio`` = h/R (``math.inf``: a
+    """The departure along one row (~1.2 s). ``thickness_ratio`` = h/R (``math.inf``: a
     half-space); ``poisson`` < 0.5 (the table's last row is 0.499)."""
     if not 0.0 <= poisson < 0.5:
         raise ValueError(f"poisson must be in [0, 0.5), got {poisson!r}")

@@ -19,9 +19,9 @@ exact for none of the tissues the sensor meets. What the literature says about i
 - a neo-Hookean law (``ContactLaw.material``) carries the finite-strain departure D to second
   order (``estimation.finite_strain``); what it leaves is the next order, of the size of D
   times the strain ``s = delta/R + delta/h``: ``max |D| s`` (over the record's depths)
-  replaces ``FINITE_STRAIN * strain``
-  (the second-order departure is within 0.3 % of the world's finite elements to delta/h = 0.3
-  with a frictionless tip, docs/layer-law.md). A sticking tip's departure bridges two limits
+  replaces ``FINITE_STRAIN * strain`` (the second-order departure is within 0.2 % of the
+  world's finite elements to delta/h = 0.2 with a frictionless tip, 0.44 % at 0.3:
+  docs/layer-law.md). A sticking tip's departure bridges two limits
   (``estimation.finite_strain.departure``): half their spread is added in quadrature.
 
 The two are independent and combine in quadrature, at the deepest indentation of the record
