@@ -21,7 +21,8 @@ exact for none of the tissues the sensor meets. What the literature says about i
   times the strain ``s = delta/R + delta/h``: ``max |D| s`` (over the record's depths)
   replaces ``FINITE_STRAIN * strain`` (the second-order departure is within 0.2 % of the
   world's finite elements to delta/h = 0.2 with a frictionless tip, 0.44 % at 0.3:
-  docs/layer-law.md). A sticking tip's departure bridges two limits
+  docs/layer-law.md); past its trusted depth (delta/R = 0.3) the linear law's bound applies.
+  A sticking tip's departure bridges two limits
   (``estimation.finite_strain.departure``): half their spread is added in quadrature.
 
 The two are independent and combine in quadrature, at the deepest indentation of the record
@@ -39,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..corrections import ContactLaw
+from ..corrections import DEPTH_RATIO_MAX_NEO_HOOKEAN, ContactLaw
 from ..finite_strain.table import stick_spread_curve
 
 LAYER_SERIES = 0.25
@@ -89,6 +90,8 @@ def _finite_strain(law: ContactLaw, max_depth: float) -> float:
     strain = ratio * curve.scale
     depths = np.linspace(0.0, ratio, 33)
     out = float(np.max(np.abs(curve.at(depths)[0]))) * strain
+    if ratio > DEPTH_RATIO_MAX_NEO_HOOKEAN:  # past the second order's reach: the linear bound
+        out = max(out, FINITE_STRAIN * ratio)
     if law.tip == "sticking":
         inverse = 0.0 if law.thickness is None else law.tip_radius / law.thickness
         spread = stick_spread_curve(law.poisson, law.bonded, inverse)
