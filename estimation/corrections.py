@@ -267,9 +267,10 @@ linear law) moves the force by several % (docs/estimation.md)."""
 LAYER_STRAIN_MAX_NEO_HOOKEAN = 0.3
 """The same for a neo-Hookean law, which carries the departure to second order: checked
 against the world's finite elements to delta/h = 0.3 (docs/layer-law.md)."""
-DEPTH_RATIO_MAX_NEO_HOOKEAN = 0.3
-"""Trusted sphere depth delta/R of a neo-Hookean law: within 0.35 % of the world's finite
-elements to here; at delta/R = 0.6 1-3 % off, at 1 up to 22 % (docs/layer-law.md)."""
+DEPTH_RATIO_MAX_NEO_HOOKEAN = 0.6
+"""Trusted sphere depth delta/R of a neo-Hookean law: its rows' reach (past it the departure is
+extrapolated). It is within 0.65 % of the world's finite elements to delta/R = 0.3 and 1-3 %
+off at 0.6, which the model-form bound carries (``jointfit.modelform``; docs/layer-law.md)."""
 
 
 def validity_warnings(
@@ -311,7 +312,7 @@ def exact_domain_warnings(law: ContactLaw, delta_max: float) -> list[str]:
     if law.material != "linear" and depth_ratio > DEPTH_RATIO_MAX_NEO_HOOKEAN:
         out.append(
             f"indentation beyond the neo-Hookean law's trusted depth: delta/R up to "
-            f"{depth_ratio:.3g} > {DEPTH_RATIO_MAX_NEO_HOOKEAN:g} (its second order is "
+            f"{depth_ratio:.3g} > {DEPTH_RATIO_MAX_NEO_HOOKEAN:g} (its departure is "
             f"extrapolated)"
         )
     if depth_ratio > DEPTH_RATIO_MAX:

@@ -128,13 +128,13 @@ def test_curve_rejects_bad_input() -> None:
         ContactLaw(3.5e-3, 0.45, material="rubber")  # type: ignore[arg-type]
 
 
-def test_past_its_trusted_depth_the_neo_hookean_law_is_flagged_and_bounded_as_linear() -> None:
+def test_deep_the_neo_hookean_law_widens_and_past_its_rows_is_flagged() -> None:
     from palpate.estimation.corrections import validity_warnings
     from palpate.estimation.jointfit.modelform import FINITE_STRAIN, model_form
 
     neo = ContactLaw(1.3e-3, 0.45, 10e-3, True, material="neo-hookean", tip="sticking")
-    shallow, deep = 0.2 * 1.3e-3, 0.6 * 1.3e-3
-    assert not any("trusted depth" in w for w in validity_warnings(neo, shallow))
-    assert any("neo-Hookean law's trusted depth" in w for w in validity_warnings(neo, deep))
+    shallow, deep, past = 0.2 * 1.3e-3, 0.5 * 1.3e-3, 0.7 * 1.3e-3
+    assert not any("trusted depth" in w for w in validity_warnings(neo, deep))
+    assert any("neo-Hookean law's trusted depth" in w for w in validity_warnings(neo, past))
     assert model_form(neo, shallow).finite_strain < 0.01
-    assert model_form(neo, deep).finite_strain >= FINITE_STRAIN * 0.6
+    assert model_form(neo, deep).finite_strain >= FINITE_STRAIN * (0.5 - 0.3)
