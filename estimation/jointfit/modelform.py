@@ -17,15 +17,16 @@ exact for none of the tissues the sensor meets. What the literature says about i
   error of about ``FINITE_STRAIN * delta/R`` (0.1: 1 % at Hertz's limit, 3 % at delta/R = 0.3).
 
 - a neo-Hookean law (``ContactLaw.material``) carries the finite-strain departure D to second
-  order (``estimation.finite_strain``); what it leaves is the next order, of the size of D
-  times the strain ``s = delta/R + delta/h``: ``max |D| s`` (over the record's depths)
-  replaces ``FINITE_STRAIN * strain`` (the second-order departure is within 0.2 % of the
-  world's finite elements to delta/h = 0.2 with a frictionless tip, 0.44 % at 0.3:
-  docs/layer-law.md). It is checked to delta/R = 0.3 (within 0.65 %); deeper, where the next
-  orders show (1-3 % at 0.6), the linear law's slope is added, ``FINITE_STRAIN (delta/R -
-  0.3)``.
-  A sticking tip's departure bridges two limits
-  (``estimation.finite_strain.departure``): half their spread is added in quadrature.
+  order (``estimation.finite_strain``): the correction moves the estimate, not the bound. The
+  material is the operator's belief, and tissue's second-order behaviour (Mooney-Rivlin,
+  Ogden, Fung) departs from the neo-Hookean one at the same order as the correction itself, so
+  the literature's ``FINITE_STRAIN * strain`` stays; it is raised where the correction's own
+  residual could be larger: the next order, ``max |D| s`` with ``s = delta/R + delta/h`` (the
+  second order is within 0.2 % of the world's finite elements to delta/h = 0.2 with a
+  frictionless tip, 0.44 % at 0.3: docs/layer-law.md), plus ``FINITE_STRAIN (delta/R - 0.3)``
+  past delta/R = 0.3, where it is checked (1-3 % off at 0.6); a sticking tip's departure
+  bridges two limits (``estimation.finite_strain.departure``): half their spread in
+  quadrature.
 
 The two are independent and combine in quadrature, at the deepest indentation of the record
 (where the load, hence the leverage on E, is largest): ``eps``. It is a bound on a bias of
@@ -69,16 +70,12 @@ def model_form(law: ContactLaw, max_depth: float) -> ModelForm:
     if not (math.isfinite(max_depth) and max_depth >= 0.0):
         raise ValueError(f"max_depth must be finite and >= 0 m, got {max_depth!r}")
     strain = max_depth / law.tip_radius
+    if law.layer_law == "exact" and law.thickness is not None:
+        strain = max(strain, max_depth / law.thickness)
+    series = 0.0 if law.layer_law == "exact" else _series(law, max_depth)
     if law.material != "linear":
-        return ModelForm(
-            0.0 if law.layer_law == "exact" else _series(law, max_depth),
-            _finite_strain(law, max_depth),
-        )
-    if law.layer_law == "exact":
-        if law.thickness is not None:
-            strain = max(strain, max_depth / law.thickness)
-        return ModelForm(0.0, FINITE_STRAIN * strain)
-    return ModelForm(_series(law, max_depth), FINITE_STRAIN * strain)
+        return ModelForm(series, max(FINITE_STRAIN * strain, _finite_strain(law, max_depth)))
+    return ModelForm(series, FINITE_STRAIN * strain)
 
 
 def _series(law: ContactLaw, max_depth: float) -> float:
