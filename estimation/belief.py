@@ -169,13 +169,18 @@ class Belief:
             out.append("thickness")
         if len(self.bonded) > 1:
             out.append("bonded")
-        if len(self.tips) > 1 and self.material != "linear":
+        if len(self.profiled_tips) > 1:
             out.append("tip")
         if self.poisson[0] != self.poisson[1]:
             out.append("poisson")
         if self.compliance[0] != self.compliance[1]:
             out.append("compliance")
         return tuple(out)
+
+    @property
+    def profiled_tips(self) -> tuple[Tip, ...]:
+        """The tips the hypotheses span: a linear law does not tell them apart, so one."""
+        return self.tips if self.material != "linear" else self.tips[:1]
 
     def provisional(self) -> Hypothesis:
         """The middle of every range (the half-space for an open-ended thickness): the
@@ -200,9 +205,8 @@ class Belief:
         n_c = RANGE_POINTS
         if max_force is not None and max_depth > 0:
             n_c = _count(1.5 * (c[1] - c[0]) * max_force / max_depth / E_STEP)
-        tips = self.tips if self.material != "linear" else self.tips[:1]
         grid = itertools.product(
-            inv, self.bonded, _poisson_points(self.poisson), _points(c, n_c), tips
+            inv, self.bonded, _poisson_points(self.poisson), _points(c, n_c), self.profiled_tips
         )
         return tuple(self._hypothesis(*point) for point in grid)
 

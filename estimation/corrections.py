@@ -142,12 +142,16 @@ class ContactLaw:
         return f"{base} x Dimitriadis {kind} (h = {self.thickness * 1e3:g} mm)"
 
     @property
+    def inverse_thickness(self) -> float:
+        """R/h (0 for a half-space)."""
+        return 0.0 if self.thickness is None else self.tip_radius / self.thickness
+
+    @property
     def finite_strain(self) -> DepartureCurve | None:
         """The neo-Hookean departure's curve (None: a linear material)."""
         if self.material == "linear":
             return None
-        inverse = 0.0 if self.thickness is None else self.tip_radius / self.thickness
-        return departure_curve(self.poisson, self.bonded, inverse, self.tip)
+        return departure_curve(self.poisson, self.bonded, self.inverse_thickness, self.tip)
 
     @property
     def exact_layer(self) -> LayerFactor | None:
@@ -241,7 +245,8 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
     half_space = (first.tip_radius, first.poisson, first.large_indentation)
     if any((law.tip_radius, law.poisson, law.large_indentation) != half_space for law in laws):
         raise ValueError("shape_values: the laws must share tip_radius, poisson, large_indentation")
-    half = _half_space(first.tip_radius, np.maximum(delta, 0.0), first.large_indentation)
+    dp = np.maximum(delta, 0.0)
+    half = _half_space(first.tip_radius, dp, first.large_indentation)
     f0 = half.f0
     scale = 1.0 / (1.0 - first.poisson**2)
     out: list[FloatArray] = []
@@ -256,7 +261,7 @@ def shape_values(laws: Sequence[ContactLaw], delta: FloatArray) -> list[FloatArr
             value = scale * f0 * dimitriadis_bracket(radius / law.thickness, k)[0]
         curve = law.finite_strain
         if curve is not None:
-            value = value * (1.0 + curve.at(np.maximum(delta, 0.0) / law.tip_radius)[0])
+            value = value * (1.0 + curve.at(dp / law.tip_radius)[0])
         out.append(np.asarray(value))
     return out
 

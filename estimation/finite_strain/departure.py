@@ -194,13 +194,12 @@ class DepartureRow:
 
 def _radii(thickness: float, nu: float, bonded: bool) -> FloatArray:
     """ROW_POINTS contact radii a/R reaching delta/h = STRAIN_REACH or delta/R = DEPTH_REACH."""
-    top_depth = (
-        DEPTH_REACH if not math.isfinite(thickness) else min(DEPTH_REACH, STRAIN_REACH * thickness)
-    )
+    top_depth = DEPTH_REACH
     if not math.isfinite(thickness):
         trial = np.linspace(0.01, 0.95, 400)
         depth = trial * np.arctanh(trial)
     else:
+        top_depth = min(DEPTH_REACH, STRAIN_REACH * thickness)
         alpha = np.linspace(0.01, 0.95, 400) / thickness
         alpha = alpha[alpha < min(1.0 / thickness, 7.5)]
         c = solve_contact(alpha, 1.0 / thickness, kernel_transform(nu, bonded))

@@ -93,8 +93,7 @@ def _finite_strain(law: ContactLaw, max_depth: float) -> float:
     out = float(np.max(np.abs(curve.at(depths)[0]))) * strain
     out += FINITE_STRAIN * max(0.0, ratio - SECOND_ORDER_DEPTH)
     if law.tip == "sticking":
-        inverse = 0.0 if law.thickness is None else law.tip_radius / law.thickness
-        spread = stick_spread_curve(law.poisson, law.bonded, inverse)
+        spread = stick_spread_curve(law.poisson, law.bonded, law.inverse_thickness)
         out = math.hypot(out, float(np.max(spread.at(depths)[0])))
     return out
 

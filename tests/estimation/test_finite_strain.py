@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from palpate.benchmarks.finite_strain import fe_departure
 from palpate.estimation.corrections import ContactLaw, shape_values
 from palpate.estimation.finite_strain.departure import _density, cubic_energy, departure_row
 from palpate.estimation.finite_strain.fields import Grid, pressure_transform, surface
@@ -20,9 +21,6 @@ from palpate.estimation.finite_strain.table import (
     departure_curve,
     load_rows,
 )
-from palpate.estimation.layer_exact import kernel_transform, solve_contact
-from palpate.sim.fem.generate import SHIPPED
-from palpate.sim.fem.table import load_table
 
 
 def _neo_hookean(H: tuple[float, ...], nu: float) -> float:
@@ -71,17 +69,6 @@ def test_shipped_rows_are_what_the_solver_gives() -> None:
     assert np.allclose(row.sticking, rows.sticking[j, 0, i], atol=1e-9)
 
 
-def _fe_departure(name: str, thickness: float, bonded: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The world's neo-Hookean FE force over the exact linear law: (delta/h, F_FE/F_lin - 1)."""
-    table = load_table(SHIPPED[name])
-    rho = 3.5 / thickness
-    c = solve_contact(
-        np.linspace(0.02, min(0.9 * rho, 2.5), 400), rho, kernel_transform(0.45, bonded)
-    )
-    linear = np.interp(table.depths, c.depth / rho**2, c.force / (1 - 0.45**2) / rho**3)
-    return table.depths * rho, table.forces / linear - 1.0
-
-
 @pytest.mark.parametrize("thickness", [1.5, 2.0, 3.0])
 @pytest.mark.parametrize("base", ["bonded", "sliding"])
 def test_frictionless_departure_matches_the_worlds_finite_elements(
@@ -89,9 +76,8 @@ def test_frictionless_departure_matches_the_worlds_finite_elements(
 ) -> None:
     """Second-order elasticity against the FE's nonlinear solves, delta/h 0.05-0.3: within
     0.45 % in force (the FE departures reach 6.5 %)."""
-    strain, fe = _fe_departure(
-        f"layers-nh-{thickness:g}mm-{base}-frictionless", thickness, base == "bonded"
-    )
+    depth, fe = fe_departure(f"layers-nh-{thickness:g}mm-{base}-frictionless")
+    strain = depth * 3.5 / thickness
     curve = departure_curve(0.45, base == "bonded", 3.5 / thickness, "frictionless")
     at = np.array([0.05, 0.1, 0.15, 0.2, 0.25, 0.3])
     ours = curve.at(at * thickness / 3.5)[0]
