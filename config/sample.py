@@ -220,7 +220,8 @@ class SampleConfig:
         return (x * MM, y * MM, z * MM)
 
 
-# Paper Table I: actual moduli (kPa) of the 11 PDMS / PA-gel phantoms.
+# Paper Table I: the 11 PDMS / PA-gel phantoms' reference moduli (kPa; its "actual" column, itself
+# measured: McKee et al. 2011).
 TABLE_I_KPA: tuple[float, ...] = (
     1023.67, 706.30, 504.03, 823.77, 529.33, 908.88, 1122.86, 314.53, 716.74, 499.56, 323.78,
 )  # fmt: skip

@@ -144,8 +144,18 @@ class BoardConfig:
     baudrate: int = field(default=921600, metadata=limits(gt=0))
     rate_hz: float = field(default=1000.0, metadata=limits(gt=0, le=100000))
     stale_timeout_s: float = field(default=0.1, metadata=limits(gt=0, le=60))
+    # a stream stale this long in a contact phase is lost: the trial faults and retracts
+    # (shorter gaps hold the motion and resume, as a servo bus's missed replies do)
+    lost_timeout_s: float = field(default=1.0, metadata=limits(gt=0, le=600))
     has_reference: bool = False
     has_force: bool = False
+
+    def validate(self) -> None:
+        if self.lost_timeout_s < self.stale_timeout_s:
+            raise ValueError(
+                f"lost_timeout_s: must be >= stale_timeout_s ({self.stale_timeout_s:g} s), got "
+                f"{self.lost_timeout_s:g}"
+            )
 
 
 @dataclass(frozen=True)

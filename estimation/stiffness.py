@@ -8,8 +8,9 @@
   just started to buckle), or a load the caller got elsewhere (e.g. an FBG fit of the beam state);
 - the Hertz sphere, Eq. 13: ``E = 3/4 P (1 - nu^2) / sqrt(delta^3 R_tip)``.
 
-``summarize`` gives one sample's row of Table I: mean estimate, RMSE against the actual modulus,
-IQR, relative error, count, after dropping estimates above 3 MPa as the paper did.
+``summarize`` gives one sample's row of Table I: mean estimate, RMSE against the modulus judged
+against (the true one in simulation, the reference measurement on the bench), IQR, relative error,
+count, after dropping estimates above 3 MPa as the paper did.
 
 Pure functions on floats; all moduli in Pa, lengths in m, forces in N.
 """
@@ -119,18 +120,19 @@ class SampleSummary:
     """One sample's statistics (a row of Tables I/II), in Pa; None where no estimate is left.
 
     Attributes:
-        actual: the reference modulus.
+        against: the modulus the estimates are judged against: the world's true modulus in
+            simulation, a sample's reference measurement on the bench.
         mean: mean of the kept estimates.
         median: median of the kept estimates.
-        rmse: sqrt(mean((E_i - actual)^2)) over the kept estimates.
+        rmse: sqrt(mean((E_i - against)^2)) over the kept estimates.
         iqr: 75th - 25th percentile (numpy's linear interpolation) of the kept estimates.
-        relative_error: (mean - actual) / actual.
+        relative_error: (mean - against) / against.
         count: estimates kept.
         outliers: estimates dropped by the outlier rule.
         failed: estimates that were missing (None, NaN or a failed StiffnessEstimate).
     """
 
-    actual: float
+    against: float
     mean: float | None
     median: float | None
     rmse: float | None
@@ -143,22 +145,23 @@ class SampleSummary:
 
 def summarize(
     estimates: Iterable[float | StiffnessEstimate | None],
-    actual: float,
+    against: float,
     outlier_above: float | None = PAPER_OUTLIER_ABOVE,
 ) -> SampleSummary:
-    """Mean, RMSE against ``actual``, IQR and counts of one sample's estimates.
+    """Mean, RMSE against ``against``, IQR and counts of one sample's estimates.
 
     Args:
         estimates: moduli in Pa, StiffnessEstimate results, or None for a failed trial.
-        actual: the sample's reference modulus (Pa, > 0).
+        against: what the estimates are judged against (Pa, > 0): the true modulus in
+            simulation, the sample's reference measurement on the bench.
         outlier_above: estimates strictly above this (Pa) are dropped, as in the paper;
             None keeps everything.
 
     Raises:
-        ValueError: ``actual`` not positive and finite.
+        ValueError: ``against`` not positive and finite.
     """
-    if not (math.isfinite(actual) and actual > 0):
-        raise ValueError(f"actual modulus must be positive and finite, got {actual}")
+    if not (math.isfinite(against) and against > 0):
+        raise ValueError(f"the modulus judged against must be > 0 and finite, got {against}")
     values: list[float] = []
     failed = 0
     for item in estimates:
@@ -171,16 +174,16 @@ def summarize(
     keep = arr if outlier_above is None else arr[arr <= outlier_above]
     outliers = int(arr.size - keep.size)
     if keep.size == 0:
-        return SampleSummary(actual, None, None, None, None, None, 0, outliers, failed)
+        return SampleSummary(against, None, None, None, None, None, 0, outliers, failed)
     mean = float(np.mean(keep))
     q75, q25 = np.percentile(keep, [75.0, 25.0])
     return SampleSummary(
-        actual=actual,
+        against=against,
         mean=mean,
         median=float(np.median(keep)),
-        rmse=float(np.sqrt(np.mean((keep - actual) ** 2))),
+        rmse=float(np.sqrt(np.mean((keep - against) ** 2))),
         iqr=float(q75 - q25),
-        relative_error=(mean - actual) / actual,
+        relative_error=(mean - against) / against,
         count=int(keep.size),
         outliers=outliers,
         failed=failed,

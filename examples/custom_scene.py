@@ -32,7 +32,7 @@ for trial in report.trials:
     lo, hi = row["joint_ci_kpa"] or (float("nan"), float("nan"))
     joint = f"{row['joint_kpa']:.1f} [{lo:.1f}, {hi:.1f}]" if row["joint_kpa"] else "-"
     print(
-        f"{row['trial']:<28} {row['actual_kpa']:>7.1f} {joint:>28} {row['verdict']:<8} "
+        f"{row['trial']:<28} {row['true_kpa']:>7.1f} {joint:>28} {row['verdict']:<8} "
         f"{row['paper_kpa']:>7.1f}"
     )
 print(f"results in {out}: {sorted(p.name for p in out.iterdir())}")

@@ -33,11 +33,13 @@ for trial in report.trials:
     if row["joint_kpa"] is None:
         print(f"{row['trial']}: no number ({'; '.join(row['verdict_reasons'])})")
         continue
-    truth.append(row["actual_kpa"])
+    truth.append(row["true_kpa"])
     joint.append(row["joint_kpa"])
     low.append(row["joint_kpa"] - row["joint_ci_kpa"][0])
     high.append(row["joint_ci_kpa"][1] - row["joint_kpa"])
-    print(f"{row['actual_kpa']:7.1f} kPa: {row['joint_kpa']:7.1f} ({row['verdict']})")
+    why = "; ".join(row["verdict_reasons"])
+    verdict = row["verdict"] if row["verdict"] == "ok" or not why else f"{row['verdict']}: {why}"
+    print(f"true {row['true_kpa']:7.1f} kPa, estimate {row['joint_kpa']:7.1f} kPa ({verdict})")
 
 fig, ax = plt.subplots(figsize=(6, 4.5))
 ax.errorbar(truth, joint, yerr=[low, high], fmt="o", capsize=3, label="joint fit (95 % interval)")

@@ -16,7 +16,10 @@ class Guards:
 
     max_travel_past_contact: float = 2.5e-3  # m; the beam or the tissue is at risk beyond
     strain_limit: float = 5e-3  # fiber strain (dimensionless); protects the fiber
-    stream_timeout: float = 0.1  # s without a fresh FBG frame
+    # s without a fresh FBG frame before the motion holds (the strains are stale: nothing is
+    # decided on them); it resumes when frames come again, and the gap is recorded
+    stream_timeout: float = 0.1
+    stream_lost: float = 1.0  # s without a frame in a contact phase: the stream is lost, a FAULT
     state_timeout: float = STATE_TIMEOUT  # s in any one state
     early_contact_margin: float = 0.5e-3  # contact this much before the plan is "unexpected"
     bus_grace: float = 0.5  # s of lost servo replies tolerated while retracting (goals still go)

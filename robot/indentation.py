@@ -19,6 +19,11 @@ With ``TrialPlan.hold_time`` > 0 the stage then stands still that long: the buck
 nearly a constant-force spring, so the hold is a creep test the gratings record
 (``estimation.relaxation``); a contact phase, every guard applies.
 
+A stale FBG stream (no frame for ``Guards.stream_timeout``) in a contact phase holds the motion:
+nothing is decided on old strains; when frames come again the machine goes on and reports the
+gap (``on_gap``). Only a stream silent for ``Guards.stream_lost`` faults (and retracts), as the
+servo bus is lost only after its own silence.
+
 With a ``prober`` (``robot.probing``) the first arrival at the stand-off goes to PROBING
 instead: light touches around the plan, a fitted surface, and the pose orthogonal to it, which
 replaces the plan's roll and contact advance (POSITIONING again, the strain zero taken again at
@@ -84,6 +89,8 @@ class IndentationMachine:
     guards: Guards
     detector: BucklingDetector
     on_transition: Callable[[Transition], None] = lambda tr: None
+    # a stale stream's gap, once frames come again: (start s, duration s, the state it held)
+    on_gap: Callable[[float, float, State], None] = lambda t, d, s: None
     prober: Callable[[TrialPlan], Prober] | None = None  # builds the probing step from the plan
     state: State = State.IDLE
     marks: TrialMarks = field(default_factory=TrialMarks)
@@ -97,6 +104,7 @@ class IndentationMachine:
     _rest: RestCheck = field(default_factory=lambda: RestCheck(REZERO_SETTLE_TICKS))
     _gate: tuple[bool, float | None] = (True, None)  # the gate last seen, the time it rose
     _contact_ticks: int = 0  # successive ticks with a contact
+    _stale_since: float | None = None  # when the stream went stale in a contact phase
     # how the trial will end once retracted: set with the reason, never read back from its text
     ending: State = State.FAULT
 
@@ -106,6 +114,11 @@ class IndentationMachine:
             raise ValueError(f"hold_time must be >= 0 s and below {timeout:g} s, got {hold!r}")
 
     # -- public -------------------------------------------------------------------------------
+    @property
+    def stream_held(self) -> bool:
+        """The motion holds for a stale stream: this tick's strains are old (not a record's)."""
+        return self._stale_since is not None
+
     @property
     def finished(self) -> bool:
         return self.state in TERMINAL
@@ -125,7 +138,7 @@ class IndentationMachine:
             self._gate = (obs.gate, obs.t if obs.gate and not open_ else rose)
         if not self.finished:
             self._check_guards(obs)
-        cmd = self._held(obs) or _HANDLERS[self.state](self, obs)
+        cmd = self._held(obs) or self._stream_hold(obs) or _HANDLERS[self.state](self, obs)
         self._last_command = cmd
         return cmd
 
@@ -163,7 +176,7 @@ class IndentationMachine:
         if obs.t - self._entered > self.guards.state_timeout:
             self._fault(obs, f"timeout in {self.state.value} after {self.guards.state_timeout:g} s")
             return
-        if self.state in CONTACT_PHASE and obs.stream_age > self.guards.stream_timeout:
+        if self.state in CONTACT_PHASE and obs.stream_age > self.guards.stream_lost:
             self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
             return
         if self.plan.gated and self.state in GATED and not obs.gate:
@@ -214,6 +227,19 @@ class IndentationMachine:
         """Hold still while a :class:`RestCheck` runs (re-zeroing on its last tick)."""
         rezero = self._rest.hold(self.state in AT_REST)
         return None if rezero is None else Command(obs.advance, obs.roll, 0.0, rezero=rezero)
+
+    def _stream_hold(self, obs: Observation) -> Command | None:
+        """Hold still while the stream is stale in a contact phase; report the gap when frames
+        come again."""
+        if self.state in CONTACT_PHASE and obs.stream_age > self.guards.stream_timeout:
+            if self._stale_since is None:
+                self._stale_since = obs.t - obs.stream_age
+            return Command(obs.advance, obs.roll, 0.0)
+        if self._stale_since is not None:
+            since, self._stale_since = self._stale_since, None
+            if not self.finished:
+                self.on_gap(since, obs.t - since, self.state)
+        return None
 
     def _hold(self, obs: Observation) -> Command:
         return Command(advance=obs.advance, roll=obs.roll, speed=0.0, torque=True)

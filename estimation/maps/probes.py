@@ -72,8 +72,26 @@ class Probe:
         return "no finite interval"
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Probe:
-        """The probe :meth:`as_dict` wrote (a survey's ``probes.jsonl`` line, read back)."""
+    def from_record(cls, d: dict[str, Any]) -> Probe:
+        """The probe :meth:`record` wrote (a survey's ``probes.jsonl`` line, read back): the
+        same floats, bit for bit, so a resumed survey is the survey it resumes. A line in the
+        older form (millimetres and kPa, as :meth:`as_dict`) is read too."""
+        if "x_m" not in d:
+            return cls._from_display(d)
+        ci = d["ci_pa"]
+        return cls(
+            float(d["x_m"]),
+            float(d["y_m"]),
+            None if d["modulus_pa"] is None else float(d["modulus_pa"]),
+            None if ci is None else (float(ci[0]), float(ci[1])),
+            d["status"],
+            tuple(d["reasons"]),
+            float(d["lab_time_s"]),
+            None if d["contact_radius_m"] is None else float(d["contact_radius_m"]),
+        )
+
+    @classmethod
+    def _from_display(cls, d: dict[str, Any]) -> Probe:
         ci = d["ci_kpa"]
         return cls(
             d["x_mm"] * MM,
@@ -86,7 +104,23 @@ class Probe:
             None if d.get("contact_radius_mm") is None else d["contact_radius_mm"] * MM,
         )
 
+    def record(self) -> dict[str, object]:
+        """The probe for a file that is read back (SI units: JSON writes a float at ``repr``
+        precision, so :meth:`from_record` gets the same probe)."""
+        return {
+            "x_m": self.x,
+            "y_m": self.y,
+            "modulus_pa": self.modulus,
+            "ci_pa": None if self.ci is None else list(self.ci),
+            "status": self.status,
+            "reasons": list(self.reasons),
+            "lab_time_s": self.lab_time,
+            "contact_radius_m": self.contact_radius,
+        }
+
     def as_dict(self) -> dict[str, object]:
+        """What a person reads (``--json``: millimetres and kPa); a file read back holds
+        :meth:`record` instead."""
         return {
             "x_mm": self.x * 1e3,
             "y_mm": self.y * 1e3,

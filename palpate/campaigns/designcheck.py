@@ -182,7 +182,7 @@ def run_check(
 
 
 def relative_error(o: TrialOutcome, method: str) -> float | None:
-    """(estimate - actual) / actual of one trial; None when it has no estimate."""
+    """(estimate - truth) / truth of one trial; None when it has no estimate."""
     m = o.modulus(method)
     return None if m is None else (m - o.spec.modulus) / o.spec.modulus
 

@@ -72,7 +72,7 @@ def survey_row(
         "map_s_per_probe": result.map_seconds / max(len(result.probes), 1),
         "found": bool(s is not None and s.found),
         **result.scores(),
-        "probe_list": [p.as_dict() for p in result.probes],  # to summarise again another way
+        "probe_list": [p.record() for p in result.probes],  # to summarise again (SI, exact)
     }
     return row
 

@@ -116,17 +116,18 @@ def pooled_by_sample(pairs: Iterable[tuple[str, Outcome]]) -> dict[str, PooledSa
     return {name: pooled_sample(outs) for name, outs in groups.items()}
 
 
-def pooled_fields(p: PooledSample | None, actual: float | None) -> dict[str, object]:
+def pooled_fields(p: PooledSample | None, against: float | None) -> dict[str, object]:
     """A sample record's pooled columns (kPa), the relative error and whether the interval
-    holds ``actual`` (Pa) when it is known; ``pooled_delta_chi2``: how much better the best
-    alternative to the stated point beliefs fits (negative: worse; None: no point belief)."""
+    holds ``against`` (Pa: the true modulus in simulation, the reference on the bench) when it
+    is known; ``pooled_delta_chi2``: how much better the best alternative to the stated point
+    beliefs fits (negative: worse; None: no point belief)."""
     if p is None:
         return dict.fromkeys(POOLED_COLUMNS)
     f = p.fit
     rel = covered = None
-    if f.modulus is not None and actual:
-        rel = (f.modulus - actual) / actual
-        covered = f.covers(actual)
+    if f.modulus is not None and against:
+        rel = (f.modulus - against) / against
+        covered = f.covers(against)
     return {
         "pooled_modulus": p.modulus,
         "pooled_kpa": None if f.modulus is None else f.modulus / 1e3,

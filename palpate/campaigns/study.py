@@ -96,7 +96,7 @@ class TrialErrors:
     """What the study needs from one trial: the truth, both estimates and the joint interval."""
 
     sample: str
-    actual: float  # Pa
+    truth: float  # Pa
     joint: float | None
     joint_low: float | None
     joint_high: float | None
@@ -128,7 +128,7 @@ class MethodStats:
 
 
 def method_stats(
-    actual: Sequence[float],
+    truth: Sequence[float],
     estimates: Sequence[float | None],
     intervals: Sequence[tuple[float | None, float | None]] | None = None,
 ) -> MethodStats:
@@ -136,13 +136,13 @@ def method_stats(
 
     Coverage counts the trials whose interval has both ends and holds the truth, over the trials
     with an interval."""
-    errors = [abs(e - a) / a for a, e in zip(actual, estimates, strict=True) if e is not None and a]
-    n = len(actual)
+    errors = [abs(e - a) / a for a, e in zip(truth, estimates, strict=True) if e is not None and a]
+    n = len(truth)
     coverage = None
     if intervals is not None:
         closed = [
             (a, lo, hi)
-            for a, (lo, hi) in zip(actual, intervals, strict=True)
+            for a, (lo, hi) in zip(truth, intervals, strict=True)
             if lo is not None and hi is not None
         ]
         held = sum(1 for a, lo, hi in closed if lo <= a <= hi)
@@ -162,14 +162,14 @@ class GroupStats:
     """The joint fit and the paper's estimate over one group (a sample, or every trial)."""
 
     name: str
-    actual: float | None  # Pa, the group's true modulus (None for the whole study)
+    truth: float | None  # Pa, the group's true modulus (None for the whole study)
     joint: MethodStats
     paper: MethodStats
 
     def as_dict(self) -> dict[str, Any]:
         return {
             "group": self.name,
-            "actual_kpa": None if self.actual is None else self.actual / 1e3,
+            "true_kpa": None if self.truth is None else self.truth / 1e3,
             "joint": self.joint.as_dict(),
             "paper": self.paper.as_dict(),
         }
@@ -188,15 +188,15 @@ class StudySummary:
         }
 
 
-def _group(name: str, actual: float | None, trials: Sequence[TrialErrors]) -> GroupStats:
-    truth = [t.actual for t in trials]
+def _group(name: str, truth: float | None, trials: Sequence[TrialErrors]) -> GroupStats:
+    truths = [t.truth for t in trials]
     return GroupStats(
         name,
-        actual,
+        truth,
         joint=method_stats(
-            truth, [t.joint for t in trials], [(t.joint_low, t.joint_high) for t in trials]
+            truths, [t.joint for t in trials], [(t.joint_low, t.joint_high) for t in trials]
         ),
-        paper=method_stats(truth, [t.paper for t in trials]),
+        paper=method_stats(truths, [t.paper for t in trials]),
     )
 
 
@@ -205,6 +205,6 @@ def summarize_study(trials: Iterable[TrialErrors]) -> StudySummary:
     groups: dict[str, list[TrialErrors]] = {}
     for t in trials:
         groups.setdefault(t.sample, []).append(t)
-    per_sample = [_group(name, ts[0].actual, ts) for name, ts in groups.items()]
+    per_sample = [_group(name, ts[0].truth, ts) for name, ts in groups.items()]
     everything = [t for ts in groups.values() for t in ts]
     return StudySummary(per_sample, _group("all", None, everything))

@@ -255,7 +255,7 @@ def read_probes(path: Path) -> list[Probe]:
     out = []
     for line in path.read_text(encoding="utf-8").splitlines():
         try:
-            out.append(Probe.from_dict(json.loads(line)))
+            out.append(Probe.from_record(json.loads(line)))
         except ValueError:
             break  # a line cut by a kill: the probe is run again
     return out
@@ -263,4 +263,4 @@ def read_probes(path: Path) -> list[Probe]:
 
 def append_probe(path: Path, probe: Probe) -> None:
     with path.open("a", encoding="utf-8") as fh:
-        fh.write(json.dumps(probe.as_dict(), separators=(",", ":")) + "\n")
+        fh.write(json.dumps(probe.record(), separators=(",", ":")) + "\n")

@@ -26,16 +26,16 @@ def bench_samples(outcomes: list[BenchOutcome], outlier_above: float) -> list[di
     pooled = pooled_by_sample((o.trial.sample, o) for outs in by_sample.values() for o in outs)
     rows = []
     for name, outs in by_sample.items():
-        actual = outs[0].trial.modulus
+        reference = outs[0].trial.modulus
         counts: dict[str, int] = {v: sum(1 for o in outs if o.status == v) for v in STATUSES}
-        if actual is None:
+        if reference is None:
             ok = [m for o in outs if o.status == "ok" and (m := o.modulus()) is not None]
             rows.append(
                 {
                     "sample": name,
                     "trials": len(outs),
                     **counts,
-                    "actual_kpa": None,
+                    "reference_kpa": None,
                     "joint_mean_kpa": _pa_to_kpa(sum(ok) / len(ok)) if ok else None,
                     "count": len(ok),
                     **pooled_fields(pooled.get(name), None),
@@ -43,14 +43,14 @@ def bench_samples(outcomes: list[BenchOutcome], outlier_above: float) -> list[di
             )
             continue
         kept = [o.modulus() if o.status == "ok" else None for o in outs]
-        s = summarize(kept, actual, outlier_above)
-        paper = summarize([_paper(o) for o in outs], actual, outlier_above)
+        s = summarize(kept, reference, outlier_above)
+        paper = summarize([_paper(o) for o in outs], reference, outlier_above)
         rows.append(
             {
                 "sample": name,
                 "trials": len(outs),
                 **counts,
-                "actual_kpa": actual / 1e3,
+                "reference_kpa": reference / 1e3,
                 "joint_mean_kpa": _pa_to_kpa(s.mean),
                 "joint_rmse_kpa": _pa_to_kpa(s.rmse),
                 "joint_iqr_kpa": _pa_to_kpa(s.iqr),
@@ -60,7 +60,7 @@ def bench_samples(outcomes: list[BenchOutcome], outlier_above: float) -> list[di
                 "failed": s.failed,
                 "paper_mean_kpa": _pa_to_kpa(paper.mean),
                 "paper_relative_error": paper.relative_error,
-                **pooled_fields(pooled.get(name), actual),
+                **pooled_fields(pooled.get(name), reference),
             }
         )
     return rows

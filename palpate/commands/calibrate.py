@@ -25,6 +25,7 @@ import argparse
 import json
 from pathlib import Path
 
+from palpate.argtypes import float_in, positive_float, positive_int
 from palpate.calibration import calibrate, config_lines
 from palpate.config import load_stack
 from palpate.config.loader import InputError
@@ -52,7 +53,10 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="a CSV (strain_ue, shift_pm), a raw frame stream, or rigid-reference trial logs",
     )
     parser.add_argument(
-        "--confidence", type=float, default=0.95, help="confidence level of the interval"
+        "--confidence",
+        type=float_in(0.0, 1.0, low_open=True, high_open=True),
+        default=0.95,
+        help="confidence level of the interval",
     )
     parser.add_argument(
         "--through-origin", action="store_true", help="CSV: fit shift = k * strain, no intercept"
@@ -62,11 +66,14 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--exposed-length-mm",
-        type=float,
+        type=positive_float,
         help="frames: the sensor's exposed length (default: sensor.exposed_length_mm)",
     )
     parser.add_argument(
-        "--rest-frames", type=int, default=20, help="frames: the first N are at rest (zero)"
+        "--rest-frames",
+        type=positive_int,
+        default=20,
+        help="frames: the first N are at rest (zero)",
     )
     parser.add_argument(
         "--tip",

@@ -90,8 +90,9 @@ def _written_note(args: argparse.Namespace) -> str:
         tip += " --pose any"
     if args.tip_mass_g is not None:
         tip += f" --tip-mass-g {args.tip_mass_g:g}"
+    lo, hi = args.modulus_range
     return (
-        f"Written by `palpate design --modulus-range {args.modulus_range} --unit {args.unit}"
+        f"Written by `palpate design --modulus-range {lo:g}:{hi:g} --unit {args.unit}"
         f"{tip}`:\nthe robot configuration ({args.config}) with the designed sensor."
     )
 

@@ -7,7 +7,16 @@ import argparse
 import math
 from pathlib import Path
 
-from palpate.argtypes import non_negative_int, positive_int
+from palpate.argtypes import (
+    float_in,
+    non_negative_float,
+    non_negative_int,
+    number_list,
+    number_range,
+    positive_float,
+    positive_int,
+    positive_or_inf,
+)
 from palpate.campaigns.campaign import default_workers
 from palpate.campaigns.designcheck import DEFAULT_TOLERANCE, UNITS
 from palpate.campaigns.executors import add_executor_arguments
@@ -32,27 +41,6 @@ from palpate.sensor.strain import strain_noise
 from palpate.wire.dynamixel import TICKS_PER_REV
 
 
-def _floats(text: str, what: str) -> tuple[float, ...]:
-    try:
-        values = tuple(float(v) for v in text.split(",") if v.strip())
-    except ValueError:
-        raise InputError(f"{what}: expected comma-separated numbers, got {text!r}") from None
-    if not values:
-        raise InputError(f"{what}: empty list")
-    return values
-
-
-def _pair(text: str, what: str) -> tuple[float, float]:
-    parts = text.split(":")
-    try:
-        lo, hi = (float(p) for p in parts)
-    except ValueError:
-        raise InputError(f"{what}: expected MIN:MAX, got {text!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
-        raise InputError(f"{what}: need 0 < MIN <= MAX, got {text!r}")
-    return lo, hi
-
-
 def register(parser: argparse.ArgumentParser) -> None:
     _add_tissue_arguments(parser)
     _add_space_arguments(parser)
@@ -62,22 +50,31 @@ def register(parser: argparse.ArgumentParser) -> None:
 def _add_tissue_arguments(parser: argparse.ArgumentParser) -> None:
     """The tissue to design for and what the design must resolve."""
     parser.add_argument(
-        "--modulus-range", required=True, metavar="MIN:MAX", help="tissue moduli, e.g. 1:10"
+        "--modulus-range",
+        type=number_range(positive_float),
+        required=True,
+        metavar="MIN:MAX",
+        help="tissue moduli, e.g. 1:10",
     )
     parser.add_argument("--unit", choices=sorted(UNITS), default="kPa", help="of --modulus-range")
-    parser.add_argument("--poisson", type=float, default=0.45, help="tissue Poisson ratio")
     parser.add_argument(
-        "--thickness-mm", type=float, default=20.0, help="tissue layer thickness (inf: half-space)"
+        "--poisson", type=float_in(0.0, 0.5), default=0.45, help="tissue Poisson ratio"
+    )
+    parser.add_argument(
+        "--thickness-mm",
+        type=positive_or_inf,
+        default=20.0,
+        help="tissue layer thickness (inf: half-space)",
     )
     parser.add_argument(
         "--imperfection",
-        type=float,
+        type=float_in(0.0, 0.1, high_open=True),
         default=5e-4,
         help="initial bow w0/L of the sensor (also used by the simulated campaign)",
     )
     parser.add_argument(
         "--max-depth-ratio",
-        type=float,
+        type=float_in(0.0, LAW_DEPTH_RATIO, low_open=True),
         default=None,
         help="the deepest delta/R at E_min the estimate may rely on (default 0.5, where the "
         "law's finite-strain bound reaches 5 %%; with --lumen-mm 1, the end of its tables: the "
@@ -85,7 +82,7 @@ def _add_tissue_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--resolution-multiple",
-        type=float,
+        type=positive_float,
         default=20.0,
         help="smallest indentation at buckling, in encoder counts",
     )
@@ -94,18 +91,41 @@ def _add_tissue_arguments(parser: argparse.ArgumentParser) -> None:
 def _add_space_arguments(parser: argparse.ArgumentParser) -> None:
     """The candidates the search considers."""
     space = DesignSpace()
-    for flag, values, what in (
-        ("--fiber-radii-um", [f"{r * 1e6:g}" for r in space.fiber_radii], "fiber radii"),
-        ("--wire-diameters-um", [f"{d * 1e6:g}" for d in space.wire_diameters], "wire diameters"),
-        ("--wire-counts", [str(n) for n in space.wire_counts], "numbers of NiTi wires"),
-        ("--tip-radii-mm", [f"{r * 1e3:g}" for r in space.tip_radii], "tip sphere radii"),
+    for flag, values, kind, what in (
+        (
+            "--fiber-radii-um",
+            [f"{r * 1e6:g}" for r in space.fiber_radii],
+            positive_float,
+            "fiber radii",
+        ),
+        (
+            "--wire-diameters-um",
+            [f"{d * 1e6:g}" for d in space.wire_diameters],
+            positive_float,
+            "wire diameters",
+        ),
+        (
+            "--wire-counts",
+            [str(n) for n in space.wire_counts],
+            non_negative_int,
+            "numbers of NiTi wires",
+        ),
+        (
+            "--tip-radii-mm",
+            [f"{r * 1e3:g}" for r in space.tip_radii],
+            positive_float,
+            "tip sphere radii",
+        ),
     ):
         parser.add_argument(
-            flag, default=",".join(values), help=f"{what} to consider (comma-separated)"
+            flag,
+            type=number_list(kind),
+            default=",".join(values),
+            help=f"{what} to consider (comma-separated)",
         )
     parser.add_argument(
         "--lumen-mm",
-        type=float,
+        type=positive_float,
         default=None,
         help="the working channel the whole sensor must pass (e.g. 2.8): tip, wires and fiber, "
         "the tip grating's element; implies --tip-grating with --tip-resolution-mn; reports the "
@@ -117,20 +137,24 @@ def _add_space_arguments(parser: argparse.ArgumentParser) -> None:
         default="vertical",
         help="any: the design must carry its own weight held across (the search's weight check, "
         "a solid printed tip sphere; in the body the sensor meets tissue at any angle to "
-        "gravity); vertical: the sag is only reported after the search (default)",
+        "gravity); vertical: the sag is only reported after the search",
     )
     parser.add_argument(
-        "--clearance-mm", type=float, default=0.2, help="what a tool leaves of the channel"
+        "--clearance-mm",
+        type=non_negative_float,
+        default=0.2,
+        help="what a tool leaves of the channel",
     )
     parser.add_argument(
         "--tip-resolution-mn",
-        type=float,
+        type=positive_float,
         default=0.05,
         help="with --lumen-mm, the tip grating's load resolution, 1 sigma (published: 0.25, "
         "0.13, about 0.05 mN)",
     )
     parser.add_argument(
         "--length-range-mm",
+        type=number_range(positive_float),
         default=":".join(f"{v * 1e3:g}" for v in space.length_range),
         metavar="MIN:MAX",
         help="exposed lengths to consider",
@@ -149,7 +173,7 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--contact-uncertainty-mm",
-        type=float,
+        type=non_negative_float,
         default=0.0,
         help="contact-detection error (1 sigma) in the simulated campaign",
     )
@@ -166,7 +190,7 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-sim", action="store_true", help="skip the simulated campaign")
     parser.add_argument(
         "--tolerance-pct",
-        type=float,
+        type=float_in(0.0, 100.0, low_open=True),
         default=100 * DEFAULT_TOLERANCE,
         help="the largest |relative error| of the joint fit on a phantom of the simulated check "
         "for the design to be usable (default %(default)g %%)",
@@ -179,7 +203,7 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--tip-mass-g",
-        type=float,
+        type=non_negative_float,
         default=None,
         help="the tip's mass for the weight check (default: sensor.tip_mass_g of --config)",
     )
@@ -196,7 +220,7 @@ def inputs(
     args: argparse.Namespace, stack: StackConfig, scene: SceneConfig
 ) -> tuple[tuple[float, float], DesignConstraints, DesignSpace]:
     unit = UNITS[args.unit]
-    lo, hi = _pair(args.modulus_range, "--modulus-range")
+    lo, hi = args.modulus_range
     thickness = None if math.isinf(args.thickness_mm) else args.thickness_mm * MM
     s = stack.sensor
     constraints = DesignConstraints(
@@ -216,16 +240,14 @@ def inputs(
         grating_centres_from_tip=s.grating_centres_from_tip(),
         grating_length=s.grating_length,
     )
-    lengths = _pair(args.length_range_mm, "--length-range-mm")
+    lengths = args.length_range_mm
     space = DesignSpace(
-        fiber_radii=tuple(r * 1e-6 for r in _floats(args.fiber_radii_um, "--fiber-radii-um")),
+        fiber_radii=tuple(r * 1e-6 for r in args.fiber_radii_um),
         fiber_modulus=s.fiber_modulus,
         wire_modulus=s.wire_modulus,
-        wire_diameters=tuple(
-            d * 1e-6 for d in _floats(args.wire_diameters_um, "--wire-diameters-um")
-        ),
-        wire_counts=tuple(int(n) for n in _floats(args.wire_counts, "--wire-counts")),
-        tip_radii=tuple(r * 1e-3 for r in _floats(args.tip_radii_mm, "--tip-radii-mm")),
+        wire_diameters=tuple(d * 1e-6 for d in args.wire_diameters_um),
+        wire_counts=tuple(int(n) for n in args.wire_counts),
+        tip_radii=tuple(r * 1e-3 for r in args.tip_radii_mm),
         length_range=(lengths[0] * 1e-3, lengths[1] * 1e-3),
     )
     return (lo * unit, hi * unit), constraints, space
@@ -233,8 +255,6 @@ def inputs(
 
 def _depth_ratio(args: argparse.Namespace) -> float:
     if args.max_depth_ratio is not None:
-        if not 0 < args.max_depth_ratio <= LAW_DEPTH_RATIO:
-            raise InputError(f"--max-depth-ratio must be in (0, {LAW_DEPTH_RATIO:g}]")
         return float(args.max_depth_ratio)
     return LAW_DEPTH_RATIO if args.lumen_mm is not None else DesignConstraints.max_depth_ratio
 
@@ -242,8 +262,6 @@ def _depth_ratio(args: argparse.Namespace) -> float:
 def _lumen(args: argparse.Namespace) -> Lumen | None:
     if args.lumen_mm is None:
         return None
-    if not args.tip_resolution_mn > 0:
-        raise InputError("--tip-resolution-mn must be > 0")
     try:
         return Lumen(args.lumen_mm * MM, args.clearance_mm * MM)
     except ValueError as exc:

@@ -18,7 +18,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from palpate.argtypes import positive_float
+from palpate.argtypes import non_negative_int, positive_float
 from palpate.config import load, load_stack, resolve
 from palpate.config.bench import load_bench
 from palpate.config.scene import SceneConfig
@@ -44,7 +44,9 @@ def register(parser: argparse.ArgumentParser) -> None:
         default="bench.yaml",
         help="with --scene: the bench file whose trials' stored poses place the samples",
     )
-    parser.add_argument("--seed", type=int, default=0, help="seed of the emulated FBG noise")
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="seed of the emulated FBG noise"
+    )
     parser.add_argument(
         "--seconds",
         type=positive_float,

@@ -53,6 +53,7 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--plans",
+        type=parse_plans,
         default="active:30,raster:25,raster:49,random:30",
         help="the study's plans, strategy:budget, comma-separated",
     )
@@ -135,12 +136,15 @@ def _survey(
 
 
 def parse_plans(text: str) -> list[tuple[str, int]]:
-    """``active:30,raster:49`` -> [("active", 30), ("raster", 49)]; InputError naming --plans."""
+    """``active:30,raster:49`` -> [("active", 30), ("raster", 49)] (``--plans``' type: a bad
+    item is argparse's error naming the option)."""
     plans = []
     for item in text.split(","):
         name, _, budget = item.strip().partition(":")
         if name not in STRATEGIES or not budget.isdigit() or int(budget) < 1:
-            raise InputError(f"--plans: {item!r} is not strategy:budget ({', '.join(STRATEGIES)})")
+            raise argparse.ArgumentTypeError(
+                f"{item!r} is not strategy:budget, budget >= 1 ({', '.join(STRATEGIES)})"
+            )
         plans.append((name, int(budget)))
     return plans
 
@@ -148,7 +152,7 @@ def parse_plans(text: str) -> list[tuple[str, int]]:
 def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
     from palpate.campaigns.mapstudy import run_map_study, summarise_study
 
-    plans = parse_plans(args.plans)
+    plans: list[tuple[str, int]] = args.plans
     total = args.worlds * (len(plans) + any(p[0] == "active" for p in plans))
     bar = progress_bar(total, f"{scene.name} map study")
 

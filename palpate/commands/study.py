@@ -21,6 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
+from palpate.argtypes import non_negative_int, positive_int
 from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
 from palpate.campaigns.executors import add_executor_arguments, open_executor
 from palpate.campaigns.study import Bounded, GroupStats, MethodStats, TrialErrors, summarize_study
@@ -40,11 +41,16 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--scene", type=Path, help="a scene YAML (overrides --campaign)")
     parser.add_argument(
-        "--repeats", type=int, default=10, help="seeded repeats of every trial of the campaign"
+        "--repeats",
+        type=positive_int,
+        default=10,
+        help="seeded repeats of every trial of the campaign",
     )
-    parser.add_argument("--seed", type=int, default=0, help="makes the study reproducible")
     parser.add_argument(
-        "--workers", type=int, default=default_workers(), help="trials run in parallel"
+        "--seed", type=non_negative_int, default=0, help="makes the study reproducible"
+    )
+    parser.add_argument(
+        "--workers", type=positive_int, default=default_workers(), help="trials run in parallel"
     )
     add_executor_arguments(parser)
     parser.add_argument(
@@ -65,7 +71,7 @@ def trial_errors(o: TrialOutcome) -> TrialErrors:
     jf = o.joint
     return TrialErrors(
         sample=o.spec.sample,
-        actual=o.spec.modulus,
+        truth=o.spec.modulus,
         joint=o.modulus("joint"),
         joint_low=None if jf is None else jf.ci_low,
         joint_high=None if jf is None else jf.ci_high,

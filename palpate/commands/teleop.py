@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from palpate.argtypes import positive_float
 from palpate.commands.teleop_screen import draw, key_name, render, screen_width
 from palpate.config import CONFIG_DIR, load, load_stack, resolve
 from palpate.config.bench import load_bench
@@ -59,7 +60,9 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--targets", type=Path, help="where s saves poses (default: the bench file's targets)"
     )
-    parser.add_argument("--rate", type=float, default=100.0, help="control ticks per second")
+    parser.add_argument(
+        "--rate", type=positive_float, default=100.0, help="control ticks per second"
+    )
     add_live_argument(parser, "the jog")
 
 

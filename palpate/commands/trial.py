@@ -236,7 +236,7 @@ def _print_summary(
     for line in config_lines(found):
         print(f"calibrated on the rigid reference (store in {robot}): {line}")
     for s in samples:
-        if s["actual_kpa"] is None:
+        if s["reference_kpa"] is None:
             print(
                 f"sample {s['sample']} (modulus not given): joint fit mean "
                 f"{_kpa(s['joint_mean_kpa'])} kPa over {s['count']} ok trials; verdicts "
@@ -247,7 +247,7 @@ def _print_summary(
         rel = s["joint_relative_error"]
         print(
             f"sample {s['sample']}: joint fit mean {_kpa(s['joint_mean_kpa'])} kPa vs "
-            f"{s['actual_kpa']:.2f} kPa, RMSE {_kpa(s['joint_rmse_kpa'])}, IQR "
+            f"{s['reference_kpa']:.2f} kPa, RMSE {_kpa(s['joint_rmse_kpa'])}, IQR "
             f"{_kpa(s['joint_iqr_kpa'])}, relative error "
             + ("-" if rel is None else f"{100 * rel:+.1f} %")
             + f" ({s['count']} ok kept, {s['outliers']} outliers; verdicts "
@@ -314,7 +314,7 @@ def _dry_run(
 
 _HEAD = (
     f"{'trial':<28} {'state':<9} {'joint fit kPa [95 % interval]':>30} {'verdict':<8} "
-    f"{'paper kPa':>9} {'actual':>9} {'rel.err':>8}  reason"
+    f"{'paper kPa':>9} {'reference':>9} {'rel.err':>8}  reason"
 )
 
 
@@ -349,5 +349,5 @@ def _row(d: dict[str, Any]) -> str:
         verdict = "calib."
     return (
         f"{d['trial']:<28} {d['state']:<9} {joint:>30} {verdict:<8} "
-        f"{_kpa(d['paper_kpa']):>9} {_kpa(d['actual_kpa']):>9} {rel:>8}  {why}"
+        f"{_kpa(d['paper_kpa']):>9} {_kpa(d['reference_kpa']):>9} {rel:>8}  {why}"
     )

@@ -79,7 +79,7 @@ class BenchOutcome(Outcome):
             "state": self.state,
             "reason": self.reason,
             **self.estimate_row(),
-            "actual_kpa": None if t.modulus is None else t.modulus / 1e3,
+            "reference_kpa": None if t.modulus is None else t.modulus / 1e3,
             "relative_error": rel,
             "duration_s": self.duration,
             "bus": self.bus,

@@ -8,6 +8,7 @@ trials, so neither is read for the other.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Iterable, Sequence
 from typing import Any
 
@@ -22,7 +23,7 @@ def kpa_fields(d: dict[str, object]) -> dict[str, object]:
     """A sample summary's fields with its moduli (Pa) in kPa, their keys suffixed ``_kpa``."""
     out: dict[str, object] = {}
     for k, v in d.items():
-        if k in ("actual", "mean", "median", "rmse", "iqr") and isinstance(v, float):
+        if k in ("against", "mean", "median", "rmse", "iqr") and isinstance(v, float):
             out[f"{k}_kpa"] = v / 1e3
         else:
             out[k] = v
@@ -48,7 +49,7 @@ def sample_records(
                 "trials": r.trials,
                 **counts,
                 "joint_mean_kpa": _kpa(s.mean),
-                "actual_kpa": _kpa(s.actual),
+                "true_kpa": _kpa(s.against),
                 "joint_rmse_kpa": _kpa(s.rmse),
                 "joint_iqr_kpa": _kpa(s.iqr),
                 "joint_relative_error": s.relative_error,
@@ -66,21 +67,24 @@ def _kpa(v: float | None) -> float | None:
     return None if v is None else v / 1e3
 
 
-TITLE = (
-    "{name} campaign: Young's modulus (kPa) per sample. joint: the joint fit (E and contact "
-    "fitted on the whole record) over the trials whose verdict is ok, outliers > 3 MPa removed; "
-    "paper: the paper's single-point estimate (Eqs. 13-14) over the same sample's trials; "
-    "ok/sus/none: verdicts; cover: 95 % intervals holding the truth / trials with a number; "
-    "pooled: every trial of the sample fitted together (one modulus, each trial's own contact), "
-    "with its interval and verdict (the pooled belief check); marked 'relaxed': the sample "
-    "relaxes in its holds, the answer is its relaxed modulus (docs/viscoelastic.md)"
+TITLE = "{name} campaign: Young's modulus (kPa) per sample"
+KEY = (
+    "joint: the joint fit (E and contact fitted on the whole record) over the trials whose "
+    "verdict is ok, outliers > 3 MPa removed; true: the simulated world's modulus, which errors "
+    "are judged against; paper: the paper's single-point estimate (Eqs. 13-14) over the same "
+    "sample's trials; ok/sus/none: verdicts; cover: 95 % intervals holding the true modulus / "
+    "trials with a number; pooled: every trial of the sample fitted together (one modulus, "
+    "each trial's own contact), with its interval and verdict (the pooled belief check); "
+    "marked 'relaxed': the sample relaxes in its holds, the answer is its relaxed modulus "
+    "(docs/viscoelastic.md)"
 )
 
 
 def print_table(name: str, records: Sequence[dict[str, Any]]) -> None:
     """The campaign's per-sample table (:func:`sample_records`), as a person reads it."""
     print(TITLE.format(name=name))
-    cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("joint", 10), ("actual", 9)]
+    print(textwrap.fill(KEY, width=100, initial_indent="  ", subsequent_indent="  "))
+    cols = [("sample", 8), ("trials", 6), ("ok/sus/none", 11), ("joint", 10), ("true", 9)]
     cols += [("RMSE", 9), ("IQR", 9), ("rel.err", 8), ("cover", 6), ("paper", 9)]
     cols += [("rel.err", 8), ("pooled [95 % interval]", 26), ("verdict", 8)]
     head = " ".join(f"{c:>{w}}" for c, w in cols)
@@ -91,7 +95,7 @@ def print_table(name: str, records: Sequence[dict[str, Any]]) -> None:
         cover = f"{r['intervals_holding_truth']}/{r['trials_with_number']}"
         print(
             f"{r['sample']:>8} {r['trials']:>6} {counts:>11} {_cell(r['joint_mean_kpa']):>10} "
-            f"{_cell(r['actual_kpa']):>9} {_cell(r['joint_rmse_kpa']):>9} "
+            f"{_cell(r['true_kpa']):>9} {_cell(r['joint_rmse_kpa']):>9} "
             f"{_cell(r['joint_iqr_kpa']):>9} {_pct(r['joint_relative_error']):>8} {cover:>6} "
             f"{_cell(r['paper_mean_kpa']):>9} {_pct(r['paper_relative_error']):>8} "
             f"{_pooled(r):>26} {r['pooled_verdict'] or '-':>8}"

@@ -157,7 +157,7 @@ def _design_rows(
 def _print_campaign(run: CheckRun) -> None:
     outcomes, unit = run.outcomes, UNITS[run.unit]
     print(f"simulated bench campaign with the proposed sensor ({run.executor} executor):")
-    head = f"  {'trial':<34} {'actual':>8}"
+    head = f"  {'trial':<34} {'true':>8}"
     for m in METHODS:
         head += f" {m:>8} {'rel.err':>8}"
     print(head + "  state")

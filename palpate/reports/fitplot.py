@@ -92,7 +92,10 @@ def _known(header: dict[str, Any]) -> dict[str, tuple[float, str]]:
     """The moduli the log knows (``replay.known_moduli``) as the model curves to draw beside
     the fit: the world's truth (simulation) and the stated reference, each with its style."""
     known = known_moduli(header)
-    names = {"truth": ("true modulus (simulation)", "--"), "reference": ("reference", ":")}
+    names = {
+        "truth": ("true modulus (simulation)", "--"),
+        "reference": ("reference measurement", ":"),
+    }
     return {names[k][0]: (float(v), names[k][1]) for k, v in known.items() if v is not None}
 
 
@@ -122,19 +125,19 @@ def _paper(ax: Any, estimate: dict[str, Any] | None) -> None:
 
 def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: str) -> Path:
     """Each trial's joint estimate with its 95 % interval (coloured by verdict) and the paper's
-    estimate beside it, relative to the truth (1), the sample's reported reference (what a lab
-    would have called the truth: the paper's 'actual') dashed, from the ``--json`` trial rows
-    of ``palpate sim`` (``joint_kpa``, ``joint_ci_kpa``, ``paper_kpa``, ``verdict``,
-    ``actual_kpa``, ``reference_kpa``). Trials are grouped by sample, named below. The axis
-    spans the joint fit's intervals; a paper estimate beyond it is drawn at the edge, pointing
-    out."""
+    estimate beside it, relative to the true modulus (1), the sample's reference measurement
+    (what a lab would have measured it to be, with its error: the paper's Table I column)
+    dashed, from the ``--json`` trial rows of ``palpate sim`` (``joint_kpa``,
+    ``joint_ci_kpa``, ``paper_kpa``, ``verdict``, ``true_kpa``, ``reference_kpa``). Trials are
+    grouped by sample, named below. The axis spans the joint fit's intervals; a paper estimate
+    beyond it is drawn at the edge, pointing out."""
     fig, ax = plt.subplots(figsize=(max(7.0, 0.18 * len(rows) + 3), 5.2))
     ax.axhline(1.0, color="k", lw=1)
     spans: list[float] = [0.9, 1.1]
     papers: list[tuple[int, float]] = []
     shown: set[str] = set()
     for i, r in enumerate(rows):
-        truth = r.get("actual_kpa")
+        truth = r.get("true_kpa")
         if not truth:
             continue
         if r.get("reference_kpa") is not None:
@@ -162,7 +165,7 @@ def estimates_with_intervals(rows: Sequence[dict[str, Any]], path: Path, title: 
     ax.set_ylabel("estimate / true modulus (95 % interval)", fontsize=10)
     ax.set_title(title, fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, bbox_inches="tight")  # the legend below the axes, whole
     plt.close(fig)
     return path
 
@@ -183,7 +186,7 @@ def _interval_legend(shown: set[str], papers: bool) -> list[Line2D]:
     """The legend of what the figure draws, and only that."""
     handles = [Line2D([], [], color="k", lw=1, label="true modulus (the simulated world's)")]
     if "reference" in shown:
-        text = "reported reference (the paper's 'actual')"
+        text = "the sample's reference measurement (drawn with its error)"
         handles.append(Line2D([], [], color="0.5", lw=1, ls="--", label=text))
     handles += [
         Line2D([], [], marker="o", ls="", color=c, label=f"joint fit, verdict {s}")

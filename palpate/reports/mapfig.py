@@ -19,6 +19,7 @@ import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
 from palpate.campaigns.survey import SurveyResult
@@ -30,7 +31,7 @@ COLOURS = {"ok": "k", "suspect": "tab:orange", "none": "0.6"}
 def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
     """Draw ``result`` (see the module docstring) as a PNG at ``path``; returns ``path``."""
     s = result.summary
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.4), layout="constrained")
     if s is None:
         for ax in axes:
             _probes(ax, result)
@@ -58,12 +59,35 @@ def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
             Rectangle((x0 / MM, y0 / MM), (x1 - x0) / MM, (y1 - y0) / MM, fill=False, color="k")
         )
         axes[2].plot(s.centre[0] / MM, s.centre[1] / MM, "kx", ms=9, label="estimated centre")
+    _legend(fig, result)
     verdict = "inclusion found" if s.found else "no inclusion found"
     fig.suptitle(
         f"{title}: {verdict}; {len(result.probes)} probes, {result.lab_time:.0f} s of lab time "
         f"({result.stopped})"
     )
     return _save(fig, path)
+
+
+def _legend(fig: Any, result: SurveyResult) -> None:
+    """What each mark means, below the panels (on grey: the path and the truth are white)."""
+    s = result.summary
+    handles = [
+        Line2D([], [], color="w", lw=0.6, marker="o", ms=4, mfc="w", mec="k",
+               label="probe, numbered in the order taken, and the path between"),
+        Line2D([], [], ls="", marker="o", ms=4, mfc="w", mec="tab:orange", label="suspect probe"),
+        Line2D([], [], ls="", marker="x", ms=4, color="0.6", label="probe without a number"),
+    ]  # fmt: skip
+    if s is not None and s.extent is not None:
+        handles.append(Line2D([], [], color="k", lw=1.5, label="the inclusion's extent (reported)"))
+    if s is not None and s.found:
+        handles.append(Line2D([], [], color="k", lw=0.8, label="P(above) = 0.5 (apparent region)"))
+    if s is not None and s.centre is not None:
+        handles.append(Line2D([], [], ls="", marker="x", ms=8, color="k",
+                              label="estimated centre; its 95 % box (right)"))  # fmt: skip
+    if result.truth is not None:
+        handles.append(Line2D([], [], color="w", ls="--", lw=1.2, marker="+", ms=8,
+                              label="the true inclusion and centre (simulation)"))  # fmt: skip
+    fig.legend(handles=handles, loc="outside lower center", ncol=4, fontsize=8, facecolor="0.75")
 
 
 def _probes(ax: Any, result: SurveyResult) -> None:

@@ -63,10 +63,41 @@ def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) ->
         lines.append(
             f"truth: centre ({t.centre[0] * 1e3:+.2f}, {t.centre[1] * 1e3:+.2f}) mm, "
             f"radius {t.radius * 1e3:.2f} mm, {t.depth * 1e3:.1f} mm deep, {t.contrast:.1f}x; "
-            f"scores {result.scores()}"
+            f"scores: {score_text(result.scores())}"
         )
     lines.append(f"run folder: {run_dir}")
     return lines
+
+
+SCORE_NAMES = {
+    "detected": "detected",
+    "false_alarm": "false alarm",
+    "sensitivity": "sensitivity",
+    "specificity": "specificity",
+    "boundary_error_mm2": "boundary error (mm^2)",
+    "center_error_mm": "centre error (mm)",
+    "center_in_ci": "centre in its 95 % box",
+    "radius_in_ci": "radius in its 95 % interval",
+}
+
+
+def score_text(scores: dict[str, object]) -> str:
+    """A survey's scores against the truth, named and rounded for a person.
+
+    >>> score_text({"detected": True, "sensitivity": 0.973164, "center_error_mm": 0.0612})
+    'detected yes, sensitivity 0.97, centre error (mm) 0.06'
+    """
+    parts = []
+    for key, value in scores.items():
+        name = SCORE_NAMES.get(key, key.replace("_", " "))
+        if isinstance(value, bool):
+            text = "yes" if value else "no"
+        elif isinstance(value, float):
+            text = f"{value:.2f}"
+        else:
+            text = str(value)
+        parts.append(f"{name} {text}")
+    return ", ".join(parts)
 
 
 def _radius_note(s: MapSummary) -> str:

@@ -1,11 +1,11 @@
 """``palpate sim --compare-paper``: the paper's Tables I and II beside the simulated ones.
 
-The paper's method (Eqs. 13-14, outliers above 3 MPa removed) per sample: the mean of its
-estimates against the reference modulus the lab reports (the paper's "actual", itself measured;
+The paper's method (Eqs. 13-14, outliers above 3 MPa removed) per sample: the mean of its estimates
+against the reference modulus the lab reports (the paper's Table I column, itself measured;
 ``fidelity.reference_error_sd``), as the paper compares them, and against the world's truth.
 The error structure of a table is what the calibration of the shipped bench scene is judged
 by: the median over samples of |error of the mean| (the paper: 18.8 %), the median of
-IQR / actual (the spread; the paper: 44.7 %) and how many samples are over- and
+IQR / reference (the spread; the paper: 44.7 %) and how many samples are over- and
 under-estimated (the paper: 3 over, 8 under). Simulated samples are matched to the paper's
 rows by their order in the scene (bench: S1..S11 = Table I's 1..11; robot: S7, S8 = Table II's
 "Soft", "Hard").
@@ -24,21 +24,22 @@ from palpate.simulation.trial import TrialOutcome
 
 @dataclass(frozen=True)
 class TableRow:
-    """One sample of a table (kPa): mean estimate, the modulus it is compared with, RMSE, IQR."""
+    """One sample of a table (kPa): mean estimate, the modulus it is judged against (the
+    paper's and the simulated reference measurement, or the world's true modulus), RMSE, IQR."""
 
     sample: str
     estimated: float | None
-    actual: float
+    against: float
     rmse: float | None
     iqr: float | None
 
     @property
     def relative_error(self) -> float | None:
-        return None if self.estimated is None else (self.estimated - self.actual) / self.actual
+        return None if self.estimated is None else (self.estimated - self.against) / self.against
 
     @property
     def spread(self) -> float | None:
-        return None if self.iqr is None else self.iqr / self.actual
+        return None if self.iqr is None else self.iqr / self.against
 
 
 # Paper Table I (bench top, 11 phantoms x 5 sensor lengths) and Table II (robot), kPa.
@@ -68,7 +69,7 @@ BAND = {"median_abs_error": (0.10, 0.30), "spread": (0.20, 0.60)}
 @dataclass(frozen=True)
 class ErrorStructure:
     """What a table's errors look like (fractions): the median over samples of |error of the
-    mean| and of IQR / actual, and the samples over- and under-estimated."""
+    mean| and of IQR / reference, and the samples over- and under-estimated."""
 
     median_abs_error: float | None
     spread: float | None
@@ -107,13 +108,13 @@ def simulated_rows(
     rows = []
     for name, outs in by_sample.items():
         spec = outs[0].spec
-        actual = spec.reported if against == "reference" else spec.modulus
-        s = summarize([o.modulus("paper") for o in outs], actual, outlier_above)
+        judged = spec.reported if against == "reference" else spec.modulus
+        s = summarize([o.modulus("paper") for o in outs], judged, outlier_above)
 
         def kpa(v: float | None) -> float | None:
             return None if v is None else v / 1e3
 
-        rows.append(TableRow(name, kpa(s.mean), actual / 1e3, kpa(s.rmse), kpa(s.iqr)))
+        rows.append(TableRow(name, kpa(s.mean), judged / 1e3, kpa(s.rmse), kpa(s.iqr)))
     return rows
 
 
@@ -151,12 +152,12 @@ def print_comparison(data: dict[str, Any], scene: str, seed: int) -> None:
     """The two tables side by side, then their error structures."""
     print(
         f"{scene} campaign (seed {seed}) beside the paper's {data['paper_table']}: "
-        f"{data['method']}; rel.err against the reported reference (the paper's 'actual'), "
-        "and against the world's truth"
+        f"{data['method']}; rel.err against the sample's reference measurement (the paper's "
+        "Table I column, itself measured with an error), and against the world's true modulus"
     )
     head = (
-        f"{'':>6} | {'paper est':>9} {'actual':>9} {'rel.err':>8} {'IQR/act':>8} | "
-        f"{'sim: est':>9} {'reference':>9} {'rel.err':>8} {'IQR/ref':>8} | {'truth':>8} "
+        f"{'':>6} | {'paper est':>9} {'reference':>9} {'rel.err':>8} {'IQR/ref':>8} | "
+        f"{'sim: est':>9} {'reference':>9} {'rel.err':>8} {'IQR/ref':>8} | {'true':>8} "
         f"{'rel.err':>8}"
     )
     print(head)
@@ -164,7 +165,7 @@ def print_comparison(data: dict[str, Any], scene: str, seed: int) -> None:
     for pair in data["rows"]:
         p, s, t = pair["paper"], pair["simulated"], pair["truth"]
         left = f"{p['sample']:>6} | " + (_cells(p) if p else " " * 37)
-        print(f"{left} | {_cells(s)} | {t['actual']:>8.1f} {_pct(t['relative_error']):>8}")
+        print(f"{left} | {_cells(s)} | {t['against']:>8.1f} {_pct(t['relative_error']):>8}")
     print()
     labels = {"paper": "paper", "simulated": "simulated", "simulated_against_truth": "vs truth"}
     for key, label in labels.items():
@@ -172,7 +173,7 @@ def print_comparison(data: dict[str, Any], scene: str, seed: int) -> None:
         med = 100 * (st["median_abs_error"] or 0)
         print(
             f"{label:>10}: median |error of the mean| {med:5.1f} %, "
-            f"median IQR/actual {100 * (st['spread'] or 0):5.1f} %, over {st['over']}, "
+            f"median IQR/modulus {100 * (st['spread'] or 0):5.1f} %, over {st['over']}, "
             f"under {st['under']}"
         )
     if data["paper_table"] != "Table I":
@@ -189,7 +190,7 @@ def print_comparison(data: dict[str, Any], scene: str, seed: int) -> None:
 def _cells(r: dict[str, Any]) -> str:
     est = "-" if r["estimated"] is None else f"{r['estimated']:.1f}"
     spread = "-" if r["spread"] is None else f"{100 * r['spread']:.1f}%"
-    return f"{est:>9} {r['actual']:>9.1f} {_pct(r['relative_error']):>8} {spread:>8}"
+    return f"{est:>9} {r['against']:>9.1f} {_pct(r['relative_error']):>8} {spread:>8}"
 
 
 def _pct(v: float | None) -> str:

@@ -33,13 +33,16 @@ class _Point:
     paper: float | None
 
 
-def estimates_vs_truth(outcomes: Sequence[TrialOutcome], path: Path, title: str) -> Path:
+def estimates_vs_truth(rows: Sequence[dict[str, Any]], path: Path, title: str) -> Path:
     """The headline figure, two panels over the true modulus: above, each trial's joint-fit
     estimate with its 95 % interval (coloured by verdict) and the paper's single point (Eqs.
     13-14) beside it, with y = x, on log axes where what is drawn spans decades; below, the
     same as estimate / truth, on an axis sized to the joint fit's intervals (a paper point
-    beyond it drawn at the edge, pointing out), where a 1 % error shows."""
-    points = _points([o for o in outcomes if o.calibration is None])
+    beyond it drawn at the edge, pointing out), where a 1 % error shows. Drawn from the
+    ``--json`` trial rows of ``palpate sim`` alone (``sample``, ``true_kpa``, ``joint_kpa``,
+    ``joint_ci_kpa``, ``paper_kpa``, ``verdict``), so a figure in the docs is redrawn from the
+    data it ships beside (``bench/docs_figures.py``)."""
+    points = _points([r for r in rows if r.get("calibration") is None])
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.5, 8.0), sharex=True)
     seen: set[str] = set()
     for pt in points:
@@ -65,7 +68,11 @@ def estimates_vs_truth(outcomes: Sequence[TrialOutcome], path: Path, title: str)
         title += f"\n({withheld} of {len(points)} trials without a number: verdict none)"
     top.set_title(title, fontsize=11)
     _ratio_axis(bottom, points)
-    bottom.set_xlabel("true Young's modulus (kPa; the simulated world's)", fontsize=10)
+    bottom.set_xlabel(
+        "true Young's modulus (kPa; the simulated world's). A sample's trials are spread "
+        "+-6 % along x\nabout its true modulus so that they can be told apart",
+        fontsize=9,
+    )
     for ax in (top, bottom):
         ax.tick_params(labelsize=9)
     fig.tight_layout()
@@ -80,29 +87,25 @@ def _minor_label(value: float, _: object) -> str:
     return f"{value:g}" if lead in "235" else ""
 
 
-def _points(trials: Sequence[TrialOutcome]) -> list[_Point]:
-    """The trials as :class:`_Point` (kPa), spread by up to +-6 % of x within a sample."""
+def _points(trials: Sequence[dict[str, Any]]) -> list[_Point]:
+    """The trial rows as :class:`_Point` (kPa), spread by up to +-6 % of x within a sample."""
     groups: dict[str, list[int]] = {}
-    for i, o in enumerate(trials):
-        groups.setdefault(o.spec.sample, []).append(i)
+    for i, r in enumerate(trials):
+        groups.setdefault(str(r["sample"]), []).append(i)
     spread = [0.0] * len(trials)
     for members in groups.values():
         for k, i in enumerate(members):
             spread[i] = 0.12 * ((k + 0.5) / len(members) - 0.5) if len(members) > 1 else 0.0
     points = []
-    for o, dx in zip(trials, spread, strict=True):
-        truth = o.spec.modulus / 1e3
+    for r, dx in zip(trials, spread, strict=True):
+        truth = float(r["true_kpa"])
+        status = str(r.get("verdict") or "none")
         joint = None
-        if o.joint is not None and o.joint.modulus is not None and o.status != "none":
-            lo, hi = o.joint.ci_low, o.joint.ci_high
-            joint = (o.joint.modulus / 1e3, _kpa(lo), _kpa(hi))
-        paper = _kpa(o.modulus("paper"))
-        points.append(_Point(truth * (1 + dx), truth, o.status, joint, paper))
+        if r.get("joint_kpa") is not None and status != "none":
+            lo, hi = r.get("joint_ci_kpa") or (None, None)
+            joint = (float(r["joint_kpa"]), lo, hi)
+        points.append(_Point(truth * (1 + dx), truth, status, joint, r.get("paper_kpa")))
     return points
-
-
-def _kpa(v: float | None) -> float | None:
-    return None if v is None else v / 1e3
 
 
 def _values(pt: _Point) -> list[float]:
@@ -188,7 +191,8 @@ def campaign_figures(
     from palpate.reports.fitplot import fit_figures
 
     title = f"{name} campaign: each trial's estimate against the truth"
-    figures = [str(estimates_vs_truth(outcomes, out_dir / "estimates.png", title))]
+    trial_rows = [o.as_dict() for o in outcomes]
+    figures = [str(estimates_vs_truth(trial_rows, out_dir / "estimates.png", title))]
     if outcomes[0].series.get("advance"):  # not when the first trial was resumed
         figures.append(str(trial_traces(outcomes[0], out_dir / "trial_traces.png")))
     return figures + fit_figures(outcomes, out_dir, name)

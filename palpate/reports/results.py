@@ -47,7 +47,7 @@ TRIAL_COLUMNS: tuple[tuple[str, Any], ...] = (
     ("reasons", lambda r: "; ".join(r.get("verdict_reasons") or [])),
     ("state", "state"),
     ("reason", "reason"),
-    ("actual_kpa", "actual_kpa"),
+    ("true_kpa", "true_kpa"),
     ("reference_kpa", "reference_kpa"),
 )
 SAMPLE_COLUMNS = (
@@ -57,7 +57,7 @@ SAMPLE_COLUMNS = (
     "suspect",
     "none",
     "joint_mean_kpa",
-    "actual_kpa",
+    "true_kpa",
     "joint_rmse_kpa",
     "joint_iqr_kpa",
     "joint_relative_error",

@@ -53,7 +53,7 @@ class TrialOutcome(Outcome):
             "orientation": self.spec.orientation,
             "roll_deg": math.degrees(self.spec.roll),
             "exposed_length_mm": self.spec.exposed_length * 1e3,
-            "actual_kpa": self.spec.modulus / 1e3,
+            "true_kpa": self.spec.modulus / 1e3,
             "reference_kpa": None if self.spec.reference is None else self.spec.reference / 1e3,
             **self.estimate_row(),
             "joint_contact_mm": None if jf is None or jf.contact is None else jf.contact * 1e3,

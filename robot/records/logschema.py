@@ -253,6 +253,12 @@ RECORDS: dict[str, dict[str, Field]] = {
         "advance": req(number(null=True)),
         "strains": req(numbers(null_items=True)),
     },
+    # a stale FBG stream the motion held through (robot.indentation), once frames came again
+    "stream_gap": {
+        "t": req(number()),
+        "duration": req(number(ge=0)),
+        "state": req(string()),
+    },
     "estimate": {
         "success": req(boolean),
         "modulus": opt(number(null=True)),

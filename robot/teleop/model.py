@@ -331,7 +331,7 @@ class Teleop:
             reason = f"servo fault: {obs.servo_fault}"
         elif (violation := limit_violation(self.guards, obs, self.x_contact)) is not None:
             reason = violation
-        elif self.x_contact is not None and obs.stream_age > self.guards.stream_timeout:
+        elif self.x_contact is not None and obs.stream_age > self.guards.stream_lost:
             reason = f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)"
         if reason is not None:
             self.fault = reason

@@ -73,6 +73,8 @@ class TrialResult:
     # each row's tip-grating load (N; NaN where the rig had none), empty without a tip grating
     tip_forces: list[float] = field(default_factory=list)
     probe: ProbeResult | None = None  # what probing found, when the trial probed
+    # the stale stream's gaps the motion held through: (start s, duration s, state held)
+    stream_gaps: list[tuple[float, float, str]] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -111,8 +113,13 @@ def run_trial(
         if log is not None:
             log.write(_transition_record(tr))
 
+    def record_gap(t: float, duration: float, state: State) -> None:
+        out.stream_gaps.append((t, duration, state.value))
+        if log is not None:
+            log.write({"kind": "stream_gap", "t": t, "duration": duration, "state": state.value})
+
     machine = IndentationMachine(
-        plan, guards, detector, on_transition=record_transition, prober=prober
+        plan, guards, detector, on_transition=record_transition, on_gap=record_gap, prober=prober
     )
     t0 = clock.now()
     ticks, recovered, probe_logged = 0, False, False
@@ -121,12 +128,14 @@ def run_trial(
             if _out_of_ticks(machine, clock.now(), ticks, max_ticks):
                 break
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
-            out.record.append((machine.state.value, obs.measured_advance, tuple(obs.strains)))
+            # a row whose strains are stale has no advance: no estimate reads it (as a missed read)
+            advance = math.nan if machine.stream_held else obs.measured_advance
+            out.record.append((machine.state.value, advance, tuple(obs.strains)))
             out.times.append(obs.t)
             if obs.tip_force is not None or out.tip_forces:
                 _append_tip(out, obs.tip_force)
             if log is not None:
-                probe_logged = _write_tick(log, obs, machine, cmd, probe_logged)
+                probe_logged = _write_tick(log, obs, advance, machine, cmd, probe_logged)
             if on_tick is not None:
                 on_tick(obs, machine.state)
             ticks += 1
@@ -159,11 +168,16 @@ def _out_of_ticks(machine: IndentationMachine, t: float, ticks: int, max_ticks: 
 
 
 def _write_tick(
-    log: TrialLogWriter, obs: Observation, machine: IndentationMachine, cmd: Command, probed: bool
+    log: TrialLogWriter,
+    obs: Observation,
+    advance: float,
+    machine: IndentationMachine,
+    cmd: Command,
+    probed: bool,
 ) -> bool:
-    """The tick's sample record, then what probing found once it is found; returns whether the
-    probe record is written."""
-    log.write(_sample_record(obs, machine.state, cmd))
+    """The tick's sample record (``advance`` as the record keeps it), then what probing found
+    once it is found; returns whether the probe record is written."""
+    log.write(_sample_record(obs, advance, machine.state, cmd))
     if machine.probe is not None and not probed:
         log.write({"kind": "probe", **machine.probe.as_dict()})
         return True
@@ -203,12 +217,12 @@ def _crashed(
         log.write(end_record(crashed))
 
 
-def _sample_record(obs: Observation, state: State, cmd: Command) -> dict[str, Any]:
+def _sample_record(obs: Observation, advance: float, state: State, cmd: Command) -> dict[str, Any]:
     record = {
         "kind": "sample",
         "t": obs.t,
         "state": state.value,
-        "advance": obs.measured_advance,
+        "advance": advance,
         "roll": obs.roll,
         "strains": list(obs.strains),
         "contact": obs.contact,

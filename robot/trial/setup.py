@@ -45,12 +45,14 @@ SETTLE_ALLOWANCE = 0.4  # s per touch at rest for the strain zero (10 ticks at 2
 
 
 def guards_for(campaign: CampaignConfig, stack: StackConfig, tick: float) -> Guards:
-    """The trial guards of a campaign: travel past contact, fiber strain, stream timeout (at
-    least five control periods ``tick``, s)."""
+    """The trial guards of a campaign: travel past contact, fiber strain, the stream's stale
+    timeout (at least five control periods ``tick``, s) and its lost timeout (at least that)."""
+    stale = max(stack.board.stale_timeout_s, 5 * tick)
     return Guards(
         max_travel_past_contact=campaign.max_travel_past_contact_mm * MM,
         strain_limit=stack.fbg.strain_limit,
-        stream_timeout=max(stack.board.stale_timeout_s, 5 * tick),
+        stream_timeout=stale,
+        stream_lost=max(stack.board.lost_timeout_s, stale),
         max_twist=stack.drive.max_twist,
     )
 

@@ -63,6 +63,12 @@ def test_cross_field_rule_names_section(tmp_path: Path) -> None:
         load(StackConfig, write(tmp_path, text))
 
 
+def test_a_stream_lost_before_it_is_stale_is_refused(tmp_path: Path) -> None:
+    text = "board: {stale_timeout_s: 0.5, lost_timeout_s: 0.2}\n"
+    with pytest.raises(ConfigError, match=r"board: lost_timeout_s: must be >= stale_timeout_s"):
+        load(StackConfig, write(tmp_path, text))
+
+
 def test_malformed_yaml_names_file_and_line(tmp_path: Path) -> None:
     p = write(tmp_path, "sensor:\n  wire_count: [1, 2\n")
     with pytest.raises(ConfigError, match=r"malformed YAML: line \d+"):

@@ -36,4 +36,4 @@ def test_the_plateau_waits_for_the_beam_where_the_strain_threshold_fires_at_the_
     assert _share(threshold["verdict_reasons"]) < 10  # the sag's bending: a few % of P_cr
     assert _share(plateau["verdict_reasons"]) > 25  # the tilted beam gives way at about a third
     low, high = plateau["joint_ci_kpa"]
-    assert low <= plateau["actual_kpa"] <= high
+    assert low <= plateau["true_kpa"] <= high

@@ -1,6 +1,7 @@
-"""docs/python-api.md's code blocks and examples/'s scripts run as a user runs them: in a fresh
-interpreter, from a folder holding decoy config.py, sim.py and robot.py (the stack installs
-under palpate: docs/architecture.md)."""
+"""docs/python-api.md's code blocks, the README's and examples/'s scripts run as a user runs
+them: in a fresh interpreter, from a folder holding decoy config.py, sim.py and robot.py (the
+stack installs under palpate: docs/architecture.md); the README's from the checkout's root, as
+its paths are written."""
 
 from __future__ import annotations
 
@@ -39,6 +40,17 @@ def test_every_block_of_the_python_api_page_runs(tmp_path: Path) -> None:
     assert "<python>" in out.stdout
     assert "samples[0].modulus_kpa" in out.stdout
     assert "results.json" in out.stdout
+
+
+def test_the_readme_s_python_runs_from_the_checkout(tmp_path: Path) -> None:
+    [block] = BLOCK.findall((ROOT / "README.md").read_text(encoding="utf-8"))
+    script = tmp_path / "readme_block.py"
+    script.write_text(block, encoding="utf-8")
+    out = run(ROOT, str(script))
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert len(lines) == 3
+    assert all(" kPa " in line for line in lines)
 
 
 def test_there_are_examples() -> None:

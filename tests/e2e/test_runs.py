@@ -65,7 +65,7 @@ def assert_results_on_disk(payload: dict) -> None:  # type: ignore[type-arg]
     assert [r["trial"] for r in rows] == [t["trial"] for t in payload["trials"]]
     for row, t in zip(rows, payload["trials"], strict=True):
         assert row["verdict"] == t["verdict"]
-        assert float(row["actual_kpa"]) == t["actual_kpa"]
+        assert float(row["true_kpa"]) == t["true_kpa"]
         assert (row["joint_kpa"] == "") == (t["joint_kpa"] is None)
         assert (row["paper_kpa"] == "") == (t["paper_kpa"] is None)
     with open(run_dir / "samples.csv", encoding="utf-8", newline="") as fh:

@@ -12,6 +12,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -52,7 +53,8 @@ class ScriptedRig:
     roll: float = 0.0
     fault_at: float | None = None  # advance where the servo reports a fault
     fault_clears: bool = True
-    stream_dies_at: float | None = None
+    stream_dies_at: float | None = None  # advance past which no frame comes again
+    stream_gap: tuple[float, float] | None = None  # times (s) between which no frame comes
     strain_gain: float = 0.02  # strain per metre past buckling
     glitch_at: float | None = None  # advance where one tick reads a contact (the zero's noise)
     torque: bool = True
@@ -61,6 +63,7 @@ class ScriptedRig:
     _last: float = 0.0
     _fault: bool = False
     released: int = 0
+    _died: float | None = None  # when the stream died
 
     def observe(self, t: float) -> Observation:
         dt = t - self._last
@@ -76,7 +79,10 @@ class ScriptedRig:
         strains = (self.strain_gain * past, -self.strain_gain * past, 0.5 * self.strain_gain * past)
         age = 0.0
         if self.stream_dies_at is not None and self.advance >= self.stream_dies_at:
-            age = 1.0
+            self._died = t if self._died is None else self._died
+            age = t - self._died + self.tick
+        if self.stream_gap is not None and self.stream_gap[0] <= t < self.stream_gap[1]:
+            age = t - self.stream_gap[0] + self.tick
         glitch = self.glitch_at is not None and self.advance >= self.glitch_at
         if glitch:
             self.glitch_at = None
@@ -103,6 +109,16 @@ class ScriptedRig:
     def release(self) -> None:
         self.released += 1
         self.torque = False
+
+
+@dataclass
+class ListLog:
+    """A trial log in memory: the records written, in order."""
+
+    records: list[dict[str, Any]] = field(default_factory=list)
+
+    def write(self, record: dict[str, Any]) -> None:
+        self.records.append(record)
 
 
 def plan(**kw: float) -> TrialPlan:
@@ -202,6 +218,40 @@ def test_stream_loss_during_indentation_faults() -> None:
     assert "FBG stream lost" in result.reason
 
 
+def test_a_stale_stream_holds_the_motion_records_the_gap_and_resumes() -> None:
+    first = run(ScriptedRig(VirtualClock()))
+    start = next(tr.t for tr in first.transitions if tr.target is State.INDENTING)
+    gap = (start + 0.01, start + 0.5)  # past the stale timeout, short of the lost one
+    rig = ScriptedRig(VirtualClock(), stream_gap=gap)
+    log = ListLog()
+    result = run(rig, log=log)
+    assert result.state is State.DONE, result.reason
+    assert states(result.transitions) == states(first.transitions)
+    [(t, duration, state)] = result.stream_gaps
+    assert t == pytest.approx(gap[0], abs=2 * rig.tick)
+    assert duration == pytest.approx(gap[1] - gap[0], abs=2 * rig.tick)
+    assert state == "indenting"
+    held = [i for i, t in enumerate(result.times) if gap[0] + Guards().stream_timeout < t < gap[1]]
+    assert held
+    assert all(math.isnan(result.record[i][1]) for i in held)  # no estimate reads stale strains
+    goals = {rig.commands[i].advance for i in held}
+    assert all(rig.commands[i].speed == 0.0 for i in held)  # the motion held
+    assert len(goals) == 1
+    [record] = [r for r in log.records if r["kind"] == "stream_gap"]
+    assert record["state"] == "indenting"
+    assert record["duration"] == pytest.approx(duration)
+
+
+def test_a_stream_stale_past_the_lost_timeout_faults_after_holding() -> None:
+    rig = ScriptedRig(VirtualClock(), stream_dies_at=10.1e-3)
+    result = run(rig, guards=Guards(stream_timeout=0.1, stream_lost=0.4))
+    assert result.state is State.FAULT
+    assert "FBG stream lost" in result.reason
+    died = next(t for t, (_, a, _) in zip(result.times, result.record, strict=True) if a > 10.1e-3)
+    fault = next(tr.t for tr in result.transitions if tr.target is State.RETRACTING)
+    assert fault - died == pytest.approx(0.4, abs=3 * rig.tick)
+
+
 def test_servo_fault_recovers_and_retracts() -> None:
     rig = ScriptedRig(VirtualClock(), fault_at=10.1e-3)
     result = run(rig)
@@ -294,7 +344,7 @@ class TimedFaultRig(ScriptedRig):
             self._fault = True
             return dataclasses.replace(obs, servo_fault="overload")
         if self.stream_dies_t is not None and t >= self.stream_dies_t:
-            return dataclasses.replace(obs, stream_age=1.0)
+            return dataclasses.replace(obs, stream_age=t - self.stream_dies_t + self.tick)
         return obs
 
 
