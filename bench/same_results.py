@@ -5,7 +5,9 @@ run folders and log paths). Prints each difference and exits 1 when there is one
     python3 bench/same_results.py BEFORE.json AFTER.json [--new-keys]
 
 ``--new-keys``: a key only in AFTER is not a difference (a change that adds an output and
-leaves every earlier one as it was).
+leaves every earlier one as it was). A key renamed since BEFORE was written
+(:data:`RENAMED`: ``actual_kpa`` is ``true_kpa`` since the two moduli got one name each) is
+compared under its new name.
 
 Used to show that a restructure moved code only: run the seeded campaign on both commits (e.g.
 ``palpate sim --campaign paper --no-plots --json`` and ``palpate sim --faults --no-plots
@@ -23,6 +25,19 @@ from typing import Any
 CLOCK_OR_PLACE = frozenset(
     {"wall_s", "speedup", "fit_ms_per_trial", "log", "log_dir", "run_dir", "cpu_s", "elapsed_s"}
 )
+
+
+# an output key's old name -> its name now
+RENAMED = {"actual_kpa": "true_kpa", "actual": "against"}
+
+
+def renamed(value: Any) -> Any:
+    """``value`` with every key of :data:`RENAMED` under its new name."""
+    if isinstance(value, dict):
+        return {RENAMED.get(k, k): renamed(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [renamed(v) for v in value]
+    return value
 
 
 def differences(a: Any, b: Any, path: str = "", new_keys: bool = False) -> list[str]:
@@ -62,7 +77,7 @@ def main(argv: list[str]) -> int:
         print(__doc__, file=sys.stderr)
         return 2
     before, after = (json.loads(Path(p).read_text(encoding="utf-8")) for p in paths)
-    found = differences(before, after, new_keys=new_keys)
+    found = differences(renamed(before), after, new_keys=new_keys)
     for line in found:
         print(line)
     print(f"{len(found)} differences" if found else "identical (clock and folder fields left out)")

@@ -19,10 +19,8 @@ With ``TrialPlan.hold_time`` > 0 the stage then stands still that long: the buck
 nearly a constant-force spring, so the hold is a creep test the gratings record
 (``estimation.relaxation``); a contact phase, every guard applies.
 
-A stale FBG stream (no frame for ``Guards.stream_timeout``) in a contact phase holds the motion:
-nothing is decided on old strains; when frames come again the machine goes on and reports the
-gap (``on_gap``). Only a stream silent for ``Guards.stream_lost`` faults (and retracts), as the
-servo bus is lost only after its own silence.
+A stale FBG stream (``Guards.stream_timeout``) in a contact phase holds the motion and reports
+the gap once frames come again (``on_gap``); a stream silent ``Guards.stream_lost`` faults.
 
 With a ``prober`` (``robot.probing``) the first arrival at the stand-off goes to PROBING
 instead: light touches around the plan, a fitted surface, and the pose orthogonal to it, which
@@ -229,11 +227,9 @@ class IndentationMachine:
         return None if rezero is None else Command(obs.advance, obs.roll, 0.0, rezero=rezero)
 
     def _stream_hold(self, obs: Observation) -> Command | None:
-        """Hold still while the stream is stale in a contact phase; report the gap when frames
-        come again."""
+        """Hold still while the stream is stale in a contact phase; report the gap after."""
         if self.state in CONTACT_PHASE and obs.stream_age > self.guards.stream_timeout:
-            if self._stale_since is None:
-                self._stale_since = obs.t - obs.stream_age
+            self._stale_since = self._stale_since or obs.t - obs.stream_age
             return Command(obs.advance, obs.roll, 0.0)
         if self._stale_since is not None:
             since, self._stale_since = self._stale_since, None

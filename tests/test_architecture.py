@@ -9,6 +9,7 @@ wire, estimation, config; robot wire, estimation, sensor, config; sim wire, esti
 from __future__ import annotations
 
 import ast
+import functools
 import itertools
 from collections.abc import Iterator
 from pathlib import Path
@@ -26,6 +27,12 @@ ALLOWED: dict[str, frozenset[str]] = {
     "palpate": frozenset({"palpate", "wire", "config", "estimation", "sensor", "robot", "sim"}),
 }
 PACKAGES = frozenset(ALLOWED)
+
+
+@functools.cache
+def parsed(path: Path) -> ast.Module:
+    """A module's syntax tree, parsed once for every check (the checks read the whole tree)."""
+    return ast.parse(path.read_text(encoding="utf-8"), str(path))
 
 
 def module_name(path: Path, root: Path = ROOT) -> str:
@@ -49,7 +56,7 @@ def imported_modules(path: Path, root: Path = ROOT) -> Iterator[tuple[int, str]]
     """(line, absolute name) of every import in the file, relative ones resolved; ``from a
     import b`` gives ``a.b`` (``b`` may be a module or a name in ``a``); names in the layers'
     terms (:func:`layer_name`)."""
-    tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+    tree = parsed(path)
     package = module_name(path, root)
     if path.name != "__init__.py":
         package = package.rpartition(".")[0]
@@ -167,6 +174,7 @@ def test_no_two_packages_import_each_other() -> None:
     assert find_cycle(graph) is None
 
 
+@pytest.mark.slow
 def test_no_two_subpackages_import_each_other() -> None:
     """Inside a layer too: e.g. palpate.faults may use palpate.reports.replay, but not a command
     module that imports palpate.faults back."""
@@ -209,7 +217,7 @@ def oversized(root: Path = ROOT) -> list[str]:
             where = path.relative_to(root)
             if text.count("\n") > MAX_MODULE_LINES:
                 found.append(f"{where}: {text.count(chr(10))} lines")
-            for node in ast.walk(ast.parse(text, str(path))):
+            for node in ast.walk(parsed(path)):
                 if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                     length = (node.end_lineno or node.lineno) - node.lineno + 1
                     if length > MAX_FUNCTION_LINES:
@@ -316,13 +324,14 @@ def test_the_room_check_sees_an_arrow_running_back_up(tmp_path: Path) -> None:
     ]
 
 
+@pytest.mark.slow
 def test_our_code_imports_the_layers_by_their_installed_names() -> None:
     """``from palpate.config import ...``, never ``from config import ...``: a bare name would
     be shadowed by a user's own config.py (or sim.py, robot.py, ...) beside their script."""
     bare = []
     for folder in sorted({*LAYERS, "palpate", "tests", "bench", "examples"}):
         for path in sorted((ROOT / folder).rglob("*.py")):
-            tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+            tree = parsed(path)
             for node in ast.walk(tree):
                 names = []
                 if isinstance(node, ast.Import):

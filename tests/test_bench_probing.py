@@ -56,6 +56,7 @@ def test_exact_prediction_puts_the_tip_on_the_true_surface() -> None:
     assert exact.roll_limits == base.roll_limits
 
 
+@pytest.mark.slow
 def test_exact_surface_probes_no_slower_and_the_hooks_go_away() -> None:
     specs, scene, stack = trial_subset(quick=True, seed=0)
     spec = specs[1]  # a 10 deg tilt on the 15 deg tube, sideways

@@ -69,6 +69,7 @@ def test_measured_puts_every_original_back_even_on_error() -> None:
     assert all(a is b for a, b in zip(_hooked(), originals, strict=True))
 
 
+@pytest.mark.slow
 def test_sides_of_two_trials_add_up_and_leave_the_estimates_alone(tmp_path: Path) -> None:
     sides = measure_sides(quick=True, seed=0, log_dir=tmp_path / "m", limit=2)
     assert sides.trials == 2

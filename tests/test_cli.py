@@ -97,6 +97,7 @@ def test_the_command_is_the_first_word_that_is_not_an_option() -> None:
     assert command_in(["nosuch", "sim"]) is None
 
 
+@pytest.mark.slow
 def test_diagnostics_go_to_stderr_and_quiet_hides_them(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:

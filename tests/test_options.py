@@ -112,3 +112,9 @@ def test_a_bad_value_is_exit_2_naming_the_option(
         err = capsys.readouterr().err
         assert f"argument {flag}" in err, (argv, err)
         assert "internal error" not in err
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_a_help_text_states_each_default_once(command: str) -> None:
+    text = " ".join(command_parser(command).format_help().split())
+    assert not re.search(r"\(default\b[^()]*\) \(default", text), text

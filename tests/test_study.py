@@ -103,6 +103,7 @@ def test_summary_groups_by_sample_then_all() -> None:
     assert json.loads(json.dumps(s.as_dict()))["overall"]["group"] == "all"
 
 
+@pytest.mark.slow
 def test_palpate_study_streams_results_and_reports_json(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

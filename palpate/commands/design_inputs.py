@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import Any
 
 from palpate.argtypes import (
     float_in,
@@ -88,39 +89,26 @@ def _add_tissue_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _candidate_lists(space: DesignSpace) -> list[tuple[str, list[float], Any, str]]:
+    """The search's candidate lists as options: flag, default values (the option's unit), the
+    type of an item, what they are."""
+    return [
+        ("--fiber-radii-um", [r * 1e6 for r in space.fiber_radii], positive_float, "fiber radii"),
+        ("--wire-diameters-um", [d * 1e6 for d in space.wire_diameters], positive_float,
+         "wire diameters"),
+        ("--wire-counts", list(space.wire_counts), non_negative_int, "numbers of NiTi wires"),
+        ("--tip-radii-mm", [r * 1e3 for r in space.tip_radii], positive_float, "tip sphere radii"),
+    ]  # fmt: skip
+
+
 def _add_space_arguments(parser: argparse.ArgumentParser) -> None:
     """The candidates the search considers."""
     space = DesignSpace()
-    for flag, values, kind, what in (
-        (
-            "--fiber-radii-um",
-            [f"{r * 1e6:g}" for r in space.fiber_radii],
-            positive_float,
-            "fiber radii",
-        ),
-        (
-            "--wire-diameters-um",
-            [f"{d * 1e6:g}" for d in space.wire_diameters],
-            positive_float,
-            "wire diameters",
-        ),
-        (
-            "--wire-counts",
-            [str(n) for n in space.wire_counts],
-            non_negative_int,
-            "numbers of NiTi wires",
-        ),
-        (
-            "--tip-radii-mm",
-            [f"{r * 1e3:g}" for r in space.tip_radii],
-            positive_float,
-            "tip sphere radii",
-        ),
-    ):
+    for flag, values, kind, what in _candidate_lists(space):
         parser.add_argument(
             flag,
             type=number_list(kind),
-            default=",".join(values),
+            default=",".join(f"{v:g}" for v in values),
             help=f"{what} to consider (comma-separated)",
         )
     parser.add_argument(

@@ -114,9 +114,7 @@ def run_trial(
             log.write(_transition_record(tr))
 
     def record_gap(t: float, duration: float, state: State) -> None:
-        out.stream_gaps.append((t, duration, state.value))
-        if log is not None:
-            log.write({"kind": "stream_gap", "t": t, "duration": duration, "state": state.value})
+        _record_gap(out, log, (t, duration, state.value))
 
     machine = IndentationMachine(
         plan, guards, detector, on_transition=record_transition, on_gap=record_gap, prober=prober
@@ -149,6 +147,15 @@ def run_trial(
     out.state, out.reason, out.marks = machine.state, machine.marks.reason, machine.marks
     out.ticks, out.duration, out.probe = ticks, clock.now() - t0, machine.probe
     return out
+
+
+def _record_gap(
+    out: TrialResult, log: TrialLogWriter | None, gap: tuple[float, float, str]
+) -> None:
+    """A stale stream's gap the motion held through: in the result and as a log record."""
+    out.stream_gaps.append(gap)
+    if log is not None:
+        log.write({"kind": "stream_gap", "t": gap[0], "duration": gap[1], "state": gap[2]})
 
 
 def _append_tip(out: TrialResult, force: float | None) -> None:

@@ -90,6 +90,7 @@ def test_nan_rejected() -> None:
         from_mapping(SensorConfig, {"tip_radius_mm": float("nan")}, "x.yaml")
 
 
+@pytest.mark.slow
 @given(st.dictionaries(st.text(max_size=8), st.integers() | st.text(max_size=4) | st.none()))
 def test_fuzzed_mappings_raise_only_config_error(data: dict[str, object]) -> None:
     with contextlib.suppress(ConfigError):

@@ -125,6 +125,7 @@ def test_bad_configuration_exits_2_naming_file_and_key_and_nothing_moves(
     assert moves == []  # nothing moved: no servo packet, no driver connect
 
 
+@pytest.mark.slow
 def test_the_spy_sees_a_good_run(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], moves: list[str]
 ) -> None:

@@ -88,6 +88,7 @@ def test_a_bad_map_is_refused_with_its_key(
     assert where in str(err.value)
 
 
+@pytest.mark.slow
 def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(tmp_path: Path) -> None:
     """Nine probes of a 3 x 3 raster over the map scene's inclusion (5x, 2.5 mm radius, 3.5 mm
     deep at (3, -2) mm): the stage's servos take the sample to each point (the world sees the

@@ -17,6 +17,8 @@ from palpate.robot.records.log import read_log
 from palpate.simulation.result import TrialOutcome
 from palpate.simulation.trial import run_sim_trial
 
+pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
+
 SCENE = load(SceneConfig, resolve("scenes/invivo/breath-hold.yaml"))
 STACK = load_stack(SCENE.robot)
 

@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import statistics
 
+import pytest
+
 from palpate.campaigns.campaign import campaign_trials, run_campaign
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.reports.papertables import comparison
 
 
+@pytest.mark.slow
 def test_the_bench_scene_reproduces_table_one_and_the_joint_fit_is_accurate() -> None:
     scene = load(SceneConfig, resolve("scenes/bench.yaml"))
     stack = load_stack(resolve(scene.robot))

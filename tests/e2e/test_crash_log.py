@@ -24,6 +24,7 @@ STACK = load_stack(resolve(SCENE.robot))
 READY_AFTER = 300  # log lines (header included) written before the parent kills the child
 
 
+@pytest.mark.slow
 def test_sigkill_mid_trial_keeps_every_record_written(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -12,6 +12,7 @@ from palpate.cli import main
 QUICK = ["--tip-radii-mm", "3,4,5,6,8", "--wire-diameters-um", "25,50,100"]
 
 
+@pytest.mark.slow
 def test_design_for_soft_tissue_and_its_simulated_check(capsys: pytest.CaptureFixture[str]) -> None:
     argv = ["design", "--modulus-range", "1:10", "--unit", "kPa", "--json", *QUICK]
     code = main([*argv, "--moduli", "3", "--lengths", "1", "--executor", "serial"])

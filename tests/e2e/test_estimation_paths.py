@@ -22,6 +22,7 @@ def scene(name: str) -> SceneConfig:
     return load(SceneConfig, MISMATCH / f"{name}.yaml")
 
 
+@pytest.mark.slow
 def test_60_kpa_tissue_ends_safely_with_verdict_none_and_the_reason(tmp_path: Path) -> None:
     sc = scene("soft60")
     stack = load_stack(resolve(sc.robot))
@@ -40,6 +41,7 @@ def test_60_kpa_tissue_ends_safely_with_verdict_none_and_the_reason(tmp_path: Pa
         assert replay(Path(str(o.log_path)))["identical"] is True
 
 
+@pytest.mark.slow
 def test_a_rigid_reference_calibrates_the_compliance_before_the_other_trials(
     tmp_path: Path,
 ) -> None:
@@ -69,6 +71,7 @@ def test_a_rigid_reference_calibrates_the_compliance_before_the_other_trials(
     assert report["replayed_calibration"]["compliance"] == ref.calibration.compliance
 
 
+@pytest.mark.slow
 def test_palpate_sim_reports_verdicts_and_replay_tells_an_old_log(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

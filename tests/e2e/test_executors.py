@@ -85,6 +85,7 @@ def pooled() -> list[tuple[object, ...]]:
         return _fingerprint(run_campaign(SPECS, BENCH, STACK, executor=executor))
 
 
+@pytest.mark.slow
 def test_a_local_dask_cluster_gives_the_process_pools_table(
     pooled: list[tuple[object, ...]], serial: list[tuple[object, ...]]
 ) -> None:

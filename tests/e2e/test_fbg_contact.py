@@ -12,6 +12,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import pytest
+
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.robot.rig import RigSettings
@@ -35,6 +37,7 @@ def _spec(sample: str, modulus_kpa: float) -> TrialSpec:
     )  # fmt: skip
 
 
+@pytest.mark.slow
 def test_fbg_contact_lands_just_after_the_true_touch() -> None:
     for sample, modulus_kpa in (("S8", 314.53), ("S7", 1122.86)):
         event = run_sim_trial(_spec(sample, modulus_kpa), _scene("event"), STACK)

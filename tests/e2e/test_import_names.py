@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 DECOYS = ("config", "sim", "robot", "sensor", "wire", "estimation")
 
 SCRIPT = """
@@ -36,6 +38,7 @@ def test_a_script_beside_decoys_imports_palpate_and_its_own_modules(tmp_path: Pa
     assert out.stdout.split()[-1] == "True"
 
 
+@pytest.mark.slow
 def test_the_command_line_beside_decoys_runs_a_campaign(tmp_path: Path) -> None:
     folder = decoy_folder(tmp_path)
     argv = ["-m", "palpate.cli", "sim", "--campaign", "bench", "--limit", "1", "--workers", "1",

@@ -7,6 +7,8 @@ import pytest
 
 from palpate import api
 
+pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
+
 SCENE = "scenes/inclusions/bench.yaml"
 
 

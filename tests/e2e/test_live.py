@@ -114,6 +114,7 @@ def test_a_client_on_localhost_gets_every_channel_during_a_trial(tmp_path: Path)
     # after stop() returns: waited for, within the bound)
 
 
+@pytest.mark.slow
 def test_a_map_survey_shows_its_map_live() -> None:
     """``palpate map --live``: the map and the probes reach a client as point clouds."""
     from palpate.campaigns.survey import publish_map, run_survey

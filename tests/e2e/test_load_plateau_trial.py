@@ -7,6 +7,8 @@ from __future__ import annotations
 import dataclasses
 import re
 
+import pytest
+
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
@@ -24,6 +26,7 @@ def _share(reasons: list[str]) -> float:
     return found[0] if found else 100.0
 
 
+@pytest.mark.slow
 def test_the_plateau_waits_for_the_beam_where_the_strain_threshold_fires_at_the_sag() -> None:
     assert SCENE.campaign.detector == "tip"
     spec = next(s for s in campaign_trials(SCENE, STACK, 0) if s.trial_id.startswith("N3-bent15-d"))

@@ -18,6 +18,8 @@ from palpate.reports.replay import replay
 from palpate.robot.trial.states import LOADING_STATES
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 
+pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
+
 LUNG = load(SceneConfig, resolve("scenes/lung/lung.yaml"))
 STACK = load_stack(LUNG.robot)
 

@@ -65,6 +65,7 @@ def test_a_killed_survey_resumes_from_its_probes_file(scene: SceneConfig, tmp_pa
     assert again.summary is not None  # four probes with numbers make a map
 
 
+@pytest.mark.slow
 def test_palpate_map_prints_the_map_and_writes_its_run_folder(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -133,6 +134,7 @@ def test_a_study_places_each_world_s_inclusion_inside_the_patch(scene: SceneConf
     assert world_scene(scene, 4, seed=3, plain=True).samples[0].inclusions == ()
 
 
+@pytest.mark.slow
 def test_a_study_scores_every_survey_against_its_world(scene: SceneConfig) -> None:
     from palpate.campaigns.mapstudy import run_map_study, summarise_study, wilson
 

@@ -12,6 +12,7 @@ import pytest
 from palpate.cli import main
 
 
+@pytest.mark.slow
 def test_the_bench_campaign_pools_a_samples_five_lengths(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -33,6 +34,7 @@ def test_the_bench_campaign_pools_a_samples_five_lengths(
     assert row["pooled_verdict"] == "ok"
 
 
+@pytest.mark.slow
 def test_a_bench_sample_without_a_stated_modulus_gets_its_pooled_answer(tmp_path: Path) -> None:
     """On the bench the modulus is what a lab wants to learn: a sample pressed twice with no
     ``modulus_kpa`` still gets its row, its trials pooled (the emulators on a virtual clock)."""
@@ -56,6 +58,7 @@ def test_a_bench_sample_without_a_stated_modulus_gets_its_pooled_answer(tmp_path
     assert row["pooled_ci_low_kpa"] <= row["pooled_kpa"] <= row["pooled_ci_high_kpa"]
 
 
+@pytest.mark.slow
 def test_a_wrong_thickness_is_caught_when_the_trials_span_depths(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -34,6 +34,7 @@ def spec(
     )  # fmt: skip
 
 
+@pytest.mark.slow
 def test_probing_finds_a_tilted_surface_and_indents_square_to_it(tmp_path: Path) -> None:
     out = run_sim_trial(spec("S8-t15"), TILTED, STACK, log_dir=tmp_path)
     assert out.state == "done", out.reason
@@ -104,6 +105,7 @@ def test_the_twist_guard_stops_and_retracts_when_the_inner_gear_lags() -> None:
     assert out.marks.x_contact is None
 
 
+@pytest.mark.slow
 def test_probing_ends_on_the_near_side_and_stays_within_its_simulated_budget() -> None:
     """The last touch lies on the side of the orthogonal pose (the surface's nearest rays), the
     way out rolls there at once, and the step's simulated time stays where it was measured
@@ -119,6 +121,7 @@ def test_probing_ends_on_the_near_side_and_stays_within_its_simulated_budget() -
     assert out.probing_time < 8.2  # s simulated, roll to the pose included (7.7; 10.1 before)
 
 
+@pytest.mark.slow
 def test_the_rolls_between_touches_never_load_the_beam(monkeypatch: pytest.MonkeyPatch) -> None:
     """The moves between touches keep behind everywhere the surface can be, so the beam stays
     free while the tube rolls (only the weight's pre-bend, tens of microstrain): the FBG

@@ -22,6 +22,8 @@ from palpate.sim.dynamixel.bus import EmulatedBus
 from palpate.sim.world import World, WorldState
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 
+pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
+
 STACK = load_stack()
 TILTED = load(SceneConfig, resolve("scenes/tilted.yaml"))
 LENGTH = 42e-3

@@ -30,6 +30,7 @@ def run(folder: Path, *argv: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+@pytest.mark.slow
 def test_every_block_of_the_python_api_page_runs(tmp_path: Path) -> None:
     blocks = BLOCK.findall(DOC.read_text(encoding="utf-8"))
     assert len(blocks) >= 5
@@ -42,6 +43,7 @@ def test_every_block_of_the_python_api_page_runs(tmp_path: Path) -> None:
     assert "results.json" in out.stdout
 
 
+@pytest.mark.slow
 def test_the_readme_s_python_runs_from_the_checkout(tmp_path: Path) -> None:
     [block] = BLOCK.findall((ROOT / "README.md").read_text(encoding="utf-8"))
     script = tmp_path / "readme_block.py"
@@ -57,6 +59,7 @@ def test_there_are_examples() -> None:
     assert len(EXAMPLES) >= 3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
 def test_each_example_runs(script: Path, tmp_path: Path) -> None:
     out = run(decoys(tmp_path), str(script))

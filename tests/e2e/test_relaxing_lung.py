@@ -16,6 +16,8 @@ from palpate.estimation.jointfit.beliefcheck import CONTRADICTED
 from palpate.reports.replay import replay
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 
+pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
+
 LUNG = load(SceneConfig, resolve("scenes/lung/relaxing.yaml"))
 STACK = load_stack(LUNG.robot)
 

@@ -84,6 +84,7 @@ def test_a_second_writer_is_refused(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert "another palpate run" in refused["stderr"]
 
 
+@pytest.mark.slow
 def test_resume_reads_complete_trials_and_reruns_the_rest(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -155,6 +156,7 @@ def _wait(condition: object, timeout_s: float, what: str) -> None:
         tick.wait(0.05)  # a poll interval, not a wait for something to happen
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="reads children from /proc")
 def test_pool_workers_die_with_a_killed_parent(tmp_path: Path) -> None:
     argv = [sys.executable, "-m", "palpate", "-qq", "sim", "--campaign", "paper"]

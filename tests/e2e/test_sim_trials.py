@@ -26,6 +26,7 @@ def bench_spec(seed: int = 3) -> TrialSpec:
     )
 
 
+@pytest.mark.slow
 def test_wire_and_fast_paths_give_the_same_trial(tmp_path: Path) -> None:
     # wire: dynamixel-sdk's packets and the board's bytes over ptys; fast: the driver's calls on
     # the servos' registers and the board's frames in memory. The same trial, record by record.

@@ -104,6 +104,7 @@ def patient_robot(path: Path) -> Path:
     data = yaml.safe_load(resolve("robot.yaml").read_text(encoding="utf-8"))
     data["servos"]["timeout_ms"] = 2000
     data["board"]["stale_timeout_s"] = 10.0
+    data["board"]["lost_timeout_s"] = 10.0
     path.write_text(yaml.safe_dump(data), encoding="utf-8")
     return path
 
@@ -155,6 +156,7 @@ def reading(text: str, label: str) -> float | None:
     return None if m is None else float(m.group(1))
 
 
+@pytest.mark.slow
 @needs_tmux
 def test_jog_save_emergency_stop_and_quit_in_a_terminal(
     tmp_path: Path, bench: SimulatedBench, terminal: Terminal
@@ -213,6 +215,7 @@ def test_jog_save_emergency_stop_and_quit_in_a_terminal(
     assert not any(s.torque_enabled for s in bench.bus.servos)
 
 
+@pytest.mark.slow
 @needs_tmux
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="finds the pid through /proc")
 def test_sigterm_releases_torque(bench: SimulatedBench, terminal: Terminal) -> None:
@@ -252,6 +255,7 @@ campaign:
 """
 
 
+@pytest.mark.slow
 @needs_tmux
 def test_the_default_simulator_shows_contact_and_strains(tmp_path: Path) -> None:
     """No ports: both emulators in-process with a tissue sample; jog into it and back."""

@@ -109,6 +109,7 @@ def session_on_ptys(
         return outcomes, torque, sim.servo("translation").position_ticks
 
 
+@pytest.mark.slow
 def test_a_session_on_the_emulators_ptys_runs_logs_and_releases(tmp_path: Path) -> None:
     outcomes, torque, ticks = session_on_ptys(tmp_path, ONE)
     assert torque == [False, False, False]  # the bus closed with torque off
@@ -163,6 +164,7 @@ REHEARSAL = (
 )
 
 
+@pytest.mark.slow
 def test_a_session_with_the_live_view_runs_as_without_it(tmp_path: Path) -> None:
     """``palpate trial --live``'s path: the view serves on a free port while the session runs
     (nobody connects: the publisher does no work) and the trial ends as it would without."""
@@ -175,6 +177,7 @@ def test_a_session_with_the_live_view_runs_as_without_it(tmp_path: Path) -> None
     assert o.joint.modulus is not None
 
 
+@pytest.mark.slow
 def test_a_hold_on_the_ptys_is_logged_fitted_and_replayed(tmp_path: Path) -> None:
     """The bench file's hold (issue 27) over the hardware path: the stage stands still after
     buckling, every held tick is logged, the relaxation fit reads an elastic sample as such,
@@ -195,6 +198,7 @@ def test_a_hold_on_the_ptys_is_logged_fitted_and_replayed(tmp_path: Path) -> Non
     assert report["replayed_relaxation"] == next(log.of_kind("estimate"))["relaxation"]
 
 
+@pytest.mark.slow
 def test_a_rehearsal_on_the_twin_calibrates_on_the_reference_then_estimates(
     tmp_path: Path,
 ) -> None:
@@ -229,6 +233,7 @@ def test_a_rehearsal_on_the_twin_calibrates_on_the_reference_then_estimates(
     assert replay(Path(str(s8.log_path)))["identical"] is True
 
 
+@pytest.mark.slow
 def test_a_fault_stops_the_session_and_skips_the_rest(tmp_path: Path) -> None:
     trials = "  - {target: up, sample: S8}\n" + ONE  # nothing above the sensor: no contact
     # without probing the approach's window is the plan's: no contact there is a guard's fault
@@ -242,6 +247,7 @@ def test_a_fault_stops_the_session_and_skips_the_rest(tmp_path: Path) -> None:
     assert read_log(Path(str(first.log_path))).complete
 
 
+@pytest.mark.slow
 def test_a_sample_probing_cannot_find_ends_unreachable_and_the_session_goes_on(
     tmp_path: Path,
 ) -> None:
@@ -365,6 +371,7 @@ def test_port_errors_say_what_to_do() -> None:
     assert "power supply" in msg
 
 
+@pytest.mark.slow
 def test_a_silent_servo_bus_is_reported_with_the_port(tmp_path: Path) -> None:
     """A pty nobody answers on: the port opens, no servo replies, torque was never on."""
     loaded = load_bench(bench_file(tmp_path, ONE))

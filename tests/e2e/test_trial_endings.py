@@ -85,6 +85,7 @@ def closed(log_path: Path) -> tuple[str, list[float]]:
     return str(log.end["state"]), force
 
 
+@pytest.mark.slow
 def test_a_done_trial_from_the_home_pose_closes_its_log_and_recording(tmp_path: Path) -> None:
     (path,) = session(tmp_path, ONE, VirtualClock())
     state, force = closed(path)
@@ -92,17 +93,20 @@ def test_a_done_trial_from_the_home_pose_closes_its_log_and_recording(tmp_path: 
     assert min(f for f in force if not math.isnan(f)) < -0.5  # the beam buckled (P_cr ~1.4 N)
 
 
+@pytest.mark.slow
 def test_a_faulted_trial_closes_its_log_and_recording(tmp_path: Path) -> None:
     trials = "  - {target: up, sample: S8}\n"  # nothing above the sensor: no contact
     (path,) = session(tmp_path, trials, VirtualClock(), "campaign: {probe: false}\n")
     assert closed(path)[0] == "fault"
 
 
+@pytest.mark.slow
 def test_an_unreachable_trial_closes_its_log_and_recording(tmp_path: Path) -> None:
     (path,) = session(tmp_path, "  - {target: up, sample: S8}\n", VirtualClock())
     assert closed(path)[0] == "unreachable"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("exc", [KeyboardInterrupt(), Terminated("SIGTERM")], ids=repr)
 def test_an_interrupted_trial_closes_its_log_and_recording(
     tmp_path: Path, exc: BaseException
@@ -116,6 +120,7 @@ def test_an_interrupted_trial_closes_its_log_and_recording(
     assert read_log(path).end["reason"].startswith(f"crash: {type(exc).__name__}")  # type: ignore[index]
 
 
+@pytest.mark.slow
 def test_export_of_a_log_that_starts_in_the_tube_exits_0(tmp_path: Path) -> None:
     (path,) = session(tmp_path, ONE, VirtualClock())
     assert main(["export", str(path), "--out", str(tmp_path / "again")]) == 0
@@ -123,6 +128,7 @@ def test_export_of_a_log_that_starts_in_the_tube_exits_0(tmp_path: Path) -> None
         assert make_reader(fh).get_summary() is not None
 
 
+@pytest.mark.slow
 def test_palpate_trial_exits_1_on_a_fault_and_prints_its_results(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -15,6 +15,8 @@ from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 
+pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
+
 STACK = load_stack()
 GELS = load(SceneConfig, resolve("scenes/viscoelastic/gels.yaml"))
 ELASTIC = load(SceneConfig, resolve("scenes/viscoelastic/elastic-hold.yaml"))

@@ -21,6 +21,7 @@ def _rel(a: np.ndarray, b: np.ndarray, floor: float = 0.0) -> float:
     return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), floor)))
 
 
+@pytest.mark.slow
 def test_fast_matches_accurate_on_a_dense_grid() -> None:
     e = GRID[:, None]
     fast, ref = post_buckling(e, "fast"), post_buckling(e, "accurate")

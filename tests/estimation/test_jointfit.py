@@ -77,6 +77,7 @@ def test_outliers_do_not_pull_the_robust_fit() -> None:
     assert r.modulus == pytest.approx(300e3, rel=0.03)
 
 
+@pytest.mark.slow
 def test_interval_coverage_is_about_95_percent() -> None:
     rng = np.random.default_rng(20240611)
     trials, hits = 200, 0

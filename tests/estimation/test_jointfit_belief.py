@@ -134,6 +134,7 @@ def test_the_model_form_bound_is_reported_and_grows_with_depth() -> None:
     assert 0 < stiff.model_form < soft.model_form < 0.1
 
 
+@pytest.mark.slow
 def test_coverage_with_open_thickness_and_bonding_is_at_least_90_percent() -> None:
     rng = np.random.default_rng(8)
     belief = Belief(R, thickness=(5e-3, 20e-3), bonded=(True, False))

@@ -60,6 +60,7 @@ def belief(poisson: tuple[float, float], thickness: float = 10e-3) -> Belief:
     return Belief(R, poisson=poisson, thickness=(thickness, thickness))
 
 
+@pytest.mark.slow
 def test_an_open_poisson_range_is_carried_into_the_relaxed_interval() -> None:
     truth = ContactLaw(R, 0.49, 10e-3, True)
     rec = record(truth)

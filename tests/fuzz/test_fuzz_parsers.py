@@ -141,6 +141,7 @@ def test_config_loader_on_random_mappings(cls: type, data: object) -> None:
     fuzzconfig.config_mapping_case(cls, data)
 
 
+@pytest.mark.slow
 @given(SCHEMAS, seeds)
 def test_config_loader_on_mutated_defaults(cls: type, seed: int) -> None:
     rng = np.random.default_rng(seed)
@@ -157,6 +158,7 @@ def test_config_loader_on_random_text(
     fuzzconfig.config_text_case(cls, text, path)
 
 
+@pytest.mark.slow
 @given(SCHEMAS, seeds)
 def test_config_loader_on_mutated_yaml(
     tmp_path_factory: pytest.TempPathFactory, cls: type, seed: int
@@ -201,6 +203,7 @@ def valid_logs(tmp_path_factory: pytest.TempPathFactory) -> list[list[str]]:
     return fuzzfiles.sample_logs(tmp_path_factory.mktemp("logs"))
 
 
+@pytest.mark.slow
 @given(seeds)
 def test_replay_on_mutated_logs(
     tmp_path_factory: pytest.TempPathFactory, valid_logs: list[list[str]], seed: int

@@ -35,6 +35,7 @@ def _with(*inclusions: Inclusion, **changes: object) -> InclusionProblem:
     return dataclasses.replace(SMALL, inclusions=inclusions, **changes)
 
 
+@pytest.mark.slow
 def test_without_inclusions_the_3d_solve_is_the_axisymmetric_layer(layer_forces) -> None:
     depths, forces, _ = solver3d.forces(SMALL)
     assert depths.tolist() == SMALL.layer().depths()
@@ -45,6 +46,7 @@ def test_without_inclusions_the_3d_solve_is_the_axisymmetric_layer(layer_forces)
     assert np.max(error[depths >= 0.25]) < 0.01, error
 
 
+@pytest.mark.slow
 def test_on_the_axis_the_world_matches_an_axisymmetric_solve_holding_it(layer_forces) -> None:
     ratios = solve_ratios(_with(BELOW)).ratios
     held = solve_indentation(SMALL.layer(inclusion=(1.0, 0.5, 5.0, 0.45)))
@@ -55,6 +57,7 @@ def test_on_the_axis_the_world_matches_an_axisymmetric_solve_holding_it(layer_fo
     assert np.max(np.abs(world / held.forces - 1.0)) < 0.02
 
 
+@pytest.mark.slow
 def test_the_factor_is_mesh_converged() -> None:
     coarse = solve_ratios(_with(BELOW, fine=0.14))
     fine = solve_ratios(_with(BELOW, fine=0.1))
@@ -65,6 +68,7 @@ def test_the_factor_is_mesh_converged() -> None:
     assert np.max(change) < 0.03, change
 
 
+@pytest.mark.slow
 def test_a_far_inclusion_changes_nothing_and_a_near_one_does() -> None:
     wide = {"radius_ratio": 5.5, "fine": 0.2}
     far = solve_ratios(_with(Inclusion(3.5, 0.0, 1.0, 0.5, 5.0), **wide)).ratios
@@ -73,6 +77,7 @@ def test_a_far_inclusion_changes_nothing_and_a_near_one_does() -> None:
     assert near[-1] > 1.05
 
 
+@pytest.mark.slow
 def test_the_symmetry_reductions_agree_with_the_full_layer() -> None:
     aside = Inclusion(0.8, 0.0, 1.0, 0.5, 5.0)
     decoy = Inclusion(0.0, 1.5, 1.0, 0.3, 1.0)  # contrast 1: nothing, but no mirror plane left
@@ -94,16 +99,19 @@ def test_an_inclusion_turned_about_the_vertical_is_the_same_solve() -> None:
     assert [i.x for i in a[1]] == pytest.approx([i.x for i in b[1]])
 
 
+@pytest.mark.slow
 def test_a_contrast_of_one_is_exactly_the_layer() -> None:
     assert np.array_equal(solve_ratios(_with(Inclusion(0, 0, 1.0, 0.5, 1.0))).ratios, np.ones(6))
 
 
+@pytest.mark.slow
 def test_stiffer_inclusions_push_back_harder_and_softer_ones_less() -> None:
     factors = [solve_ratios(_with(dataclasses.replace(BELOW, contrast=c))).ratios[-1]
                for c in (0.2, 2.0, 5.0, 30.0)]  # fmt: skip
     assert factors[0] < 1.0 < factors[1] < factors[2] < factors[3]
 
 
+@pytest.mark.slow
 def test_an_active_set_that_does_not_settle_is_reported(monkeypatch) -> None:
     monkeypatch.setattr(solver3d, "_MAX_SWEEPS", 0)
     with pytest.raises(solver3d.ContactError, match="did not settle"):
@@ -130,6 +138,7 @@ def test_an_inclusion_outside_the_layer_is_refused(bad) -> None:
             0.0, 0.0, bad["depth"], bad["radius"], 5.0))  # fmt: skip
 
 
+@pytest.mark.slow
 def test_the_world_law_is_the_layer_times_the_factor(monkeypatch, tmp_path) -> None:
     monkeypatch.setenv("PALPATE_CACHE_DIR", str(tmp_path))
     layer = LayerProblem(2.0, 4.0, depth_max=0.36, n_depths=6)
