@@ -247,15 +247,12 @@ PALPATE_ROOMS: dict[str, frozenset[str]] = {
     "palpate.campaigns": frozenset({"palpate", "palpate.simulation"}),
     "palpate.reports": _BELOW_REPORTS,
     "palpate.faults": _BELOW_REPORTS | {"palpate.reports"},
-    "palpate.benchmarks": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
-    "palpate.commands": _BELOW_REPORTS
-    | {"palpate.reports", "palpate.faults", "palpate.benchmarks", "palpate.lab"},
+    "palpate.commands": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
     # the Python API (palpate/api.py): the commands' surface for scripts, above them all
     "palpate.api": _BELOW_REPORTS
     | {
         "palpate.reports",
         "palpate.faults",
-        "palpate.benchmarks",
         "palpate.lab",
         "palpate.commands",
     },
@@ -344,3 +341,15 @@ def test_our_code_imports_the_layers_by_their_installed_names() -> None:
                     if n.partition(".")[0] in LAYERS
                 ]
     assert not bare, "\n".join(bare)
+
+
+def test_the_product_never_imports_the_benchmarks() -> None:
+    """``benchmarks/`` is not installed: a module of ``palpate`` that imported it would break
+    in a wheel (``palpate bench`` finds it at run time, and says so when it is not there)."""
+    found = [
+        f"{path.relative_to(ROOT)}:{line} {name}"
+        for path in sorted((ROOT / "palpate").rglob("*.py"))
+        for line, name in imported_modules(path)
+        if name.partition(".")[0] == "benchmarks"
+    ]
+    assert found == []

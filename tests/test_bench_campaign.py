@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from palpate.benchmarks.campaign import CHEAPEST, LEVELS, REFERENCE, LevelRow, pareto_front, usable
+from benchmarks.campaign import CHEAPEST, LEVELS, REFERENCE, LevelRow, pareto_front, usable
 from palpate.config import load, resolve
 from palpate.config.scene import SceneConfig
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from palpate.benchmarks.hold import HOLDS_S, SCENES, hold_scene, scene_speeds
+from benchmarks.hold import HOLDS_S, SCENES, hold_scene, scene_speeds
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig

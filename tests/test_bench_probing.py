@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import palpate.simulation.trial
-from palpate.benchmarks.patching import patched
-from palpate.benchmarks.probing import (
+from benchmarks.patching import patched
+from benchmarks.probing import (
     ExactSurfaceGeometry,
     faster_drive,
     prober_hooks,

@@ -10,7 +10,7 @@ import pytest
 import palpate.robot.trial.run
 import palpate.robot.trial.session
 import palpate.sim.contact_table
-from palpate.benchmarks.sides import (
+from benchmarks.sides import (
     BOUNDARIES,
     CONTROL,
     ESTIMATOR,
@@ -94,7 +94,7 @@ def test_sides_of_two_trials_add_up_and_leave_the_estimates_alone(tmp_path: Path
 
 
 def test_the_estimator_check_says_when_the_estimate_got_slower() -> None:
-    from palpate.benchmarks.sides import REGRESSION, Sides, estimator_check
+    from benchmarks.sides import REGRESSION, Sides, estimator_check
 
     def sides(estimator_s: float) -> Sides:
         parts = {b.part: 0.0 for b in BOUNDARIES}

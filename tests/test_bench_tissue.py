@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from palpate.benchmarks.tissue import LEVELS, VISCO, level_scene
-from palpate.benchmarks.tissue_fe import _markdown_tables
+from benchmarks.tissue import LEVELS, VISCO, level_scene
+from benchmarks.tissue_fe import _markdown_tables
 from palpate.config import load, resolve
 from palpate.config.scene import SceneConfig
 

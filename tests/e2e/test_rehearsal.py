@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader  # type: ignore[import-untyped,unused-ignore]
 
-from palpate.benchmarks.rehearsal import cpu_load, rehearse
+from benchmarks.rehearsal import cpu_load, rehearse
 from palpate.robot.records.log import read_log
 
 

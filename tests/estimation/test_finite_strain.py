@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from palpate.benchmarks.finite_strain import fe_departure
+from benchmarks.finite_strain import fe_departure
 from palpate.estimation.corrections import ContactLaw, shape_values
 from palpate.estimation.finite_strain.departure import _density, cubic_energy, departure_row
 from palpate.estimation.finite_strain.fields import Grid, pressure_transform, surface

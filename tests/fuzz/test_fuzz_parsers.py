@@ -2,7 +2,7 @@
 servo emulator's packet handling, the driver's reply handling, the config loader, replay of
 mutated trial logs and the checks of mutated scenes take any input and fail only in their
 documented ways. The targets and their invariants live in
-``palpate/benchmarks/fuzztargets.py``, ``fuzzconfig.py`` and ``fuzzfiles.py``; ``palpate bench
+``benchmarks/fuzztargets.py``, ``fuzzconfig.py`` and ``fuzzfiles.py``; ``palpate bench
 --only fuzz`` runs them long."""
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.benchmarks import fuzzconfig, fuzzfiles
-from palpate.benchmarks import fuzztargets as fuzz
+from benchmarks import fuzzconfig, fuzzfiles
+from benchmarks import fuzztargets as fuzz
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.sim.dynamixel import protocol

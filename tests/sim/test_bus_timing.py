@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from palpate.benchmarks.busrate import measured_rate, model_rate
+from benchmarks.busrate import measured_rate, model_rate
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import ServoBusConfig

@@ -2,7 +2,7 @@
 
 Every solve here is a small layer (h = 2 R, 4-5 R wide) on a coarse patch, a second or two;
 docs/inclusions.md has the same checks on the shipped meshes (python -m
-palpate.benchmarks.inclusions --section validation).
+benchmarks.inclusions --section validation).
 """
 
 from __future__ import annotations

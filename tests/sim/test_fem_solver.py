@@ -1,7 +1,7 @@
 """The finite-element indentation solver against closed forms, under refinement, and failing.
 
 Coarse meshes (resolution 3-4) keep the file fast; the reference-grade numbers are in
-docs/tissue-fe.md (``python -m palpate.benchmarks.tissue_fe``).
+docs/tissue-fe.md (``python -m benchmarks.tissue_fe``).
 """
 
 from __future__ import annotations

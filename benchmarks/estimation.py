@@ -19,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.calibration import is_reference
 from palpate.campaigns.campaign import CampaignRun, campaign_trials, default_workers, run_campaigns
 from palpate.config import load, load_stack, resolve

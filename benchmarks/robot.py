@@ -7,7 +7,7 @@ integrates motion on wall time, as ``palpate emulate`` does). The target is >= 5
 same tick through bare SDK group objects shows the driver's overhead; IK/FK timings show what a
 trial pays for planning. What a real U2D2 bus allows (wire time, Return Delay Time, the FTDI
 latency timer at 16 ms and 1 ms) is counted on the virtual clock
-(:mod:`palpate.benchmarks.busrate`).
+(:mod:`benchmarks.busrate`).
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from palpate.benchmarks import busrate
-from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
+from benchmarks import busrate
+from benchmarks.report import BenchContext, BenchSection, Table, median_time
 from palpate.config.schema import DEFAULT_TUBES, ServoBusConfig
 from palpate.robot.dynamixel.driver import DynamixelBus
 from palpate.robot.kinematics import forward, inverse

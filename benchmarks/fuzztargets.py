@@ -15,9 +15,9 @@ the code under test misbehaves:
 - ``config``: random and mutated YAML text through :func:`config.loader.read_yaml` and
   :func:`config.loader.from_mapping` (robot and scene schemas); only ``ConfigError`` comes out.
 
-The config target lives in :mod:`palpate.benchmarks.fuzzconfig`; :func:`targets` gathers all four.
+The config target lives in :mod:`benchmarks.fuzzconfig`; :func:`targets` gathers all four.
 The tests in ``tests/fuzz`` drive the same targets from Hypothesis (seeded, bounded); the bench
-section :mod:`palpate.benchmarks.fuzz` runs them long on a seeded numpy generator.
+section :mod:`benchmarks.fuzz` runs them long on a seeded numpy generator.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from palpate.benchmarks.fuzzconfig import (
+from benchmarks.fuzzconfig import (
     SCHEMAS,
     config_mapping_case,
     config_text_case,

@@ -1,6 +1,6 @@
 """The estimator's neo-Hookean departure against the world's finite elements.
 
-    python bench/finite_strain_check.py      # or: python -m palpate.benchmarks.finite_strain
+    python bench/finite_strain_check.py      # or: python -m benchmarks.finite_strain
 
 For every neo-Hookean FE table the scenes ship (``sim.fem.generate``: the thin layers under the
 paper's tip, the paper's phantom, the lung layers), the world's force over the exact linear

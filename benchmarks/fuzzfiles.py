@@ -11,7 +11,7 @@ scene YAML (``palpate sim --scene``), both as mutations of valid files.
   ``ValueError`` may come out.
 
 :func:`file_targets` builds both (the valid logs come from two short simulated trials);
-:mod:`palpate.benchmarks.fuzz` runs them with a hang guard, ``tests/fuzz`` from Hypothesis.
+:mod:`benchmarks.fuzz` runs them with a hang guard, ``tests/fuzz`` from Hypothesis.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from palpate.benchmarks.fuzzconfig import mutate_mapping, mutate_text
+from benchmarks.fuzzconfig import mutate_mapping, mutate_text
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig

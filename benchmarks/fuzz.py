@@ -1,5 +1,5 @@
-"""The fuzz bench section: each target of :mod:`palpate.benchmarks.fuzztargets` (frame parser,
-servo packets, driver replies, config loader) and :mod:`palpate.benchmarks.fuzzfiles` (replay
+"""The fuzz bench section: each target of :mod:`benchmarks.fuzztargets` (frame parser,
+servo packets, driver replies, config loader) and :mod:`benchmarks.fuzzfiles` (replay
 logs, scene YAML) run long on a seeded numpy generator, with the inputs run, the failures, the
 hangs and the first failure reported per target.
 
@@ -22,9 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from palpate.benchmarks.fuzzfiles import file_targets
-from palpate.benchmarks.fuzztargets import Rng, targets
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.fuzzfiles import file_targets
+from benchmarks.fuzztargets import Rng, targets
+from benchmarks.report import BenchContext, BenchSection, Table
 
 FILE_TARGET_INPUTS = 10_000  # default inputs for the file targets (tens of ms each)
 

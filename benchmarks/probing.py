@@ -20,7 +20,7 @@ trial, spanning tilts, tubes and orientations; every 19th with ``--quick``) at:
 Per row: trials done, the probing time (simulated) median / min / max, the true residual at
 indentation (the world's angle between the sensor and the normal) and the joint fit's median
 |relative error| of E. Every row but the shipped one replaces two functions of
-``palpate.simulation.trial`` for the duration (``palpate.benchmarks.patching``); shipped code has no
+``palpate.simulation.trial`` for the duration (``benchmarks.patching``); shipped code has no
 hook for it.
 """
 
@@ -32,8 +32,8 @@ import statistics
 from collections.abc import Callable
 from typing import Any
 
-from palpate.benchmarks.patching import patched
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.patching import patched
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import (
     campaign_trials,
     median_abs_relative_error,
@@ -48,6 +48,7 @@ from palpate.robot.probe_plan import ProbeGeometry, ProbeSettings
 from palpate.robot.probe_result import Touch
 from palpate.robot.probing import ProbeRoutine
 from palpate.sim.world import Surface
+from palpate.simulation import trial as sim_trial
 from palpate.simulation.trial import TrialOutcome
 from palpate.simulation.world import TrialGeometry
 
@@ -112,8 +113,8 @@ def _three_touches(routine: ProbeRoutine) -> ProbeRoutine:
     return routine
 
 
-def prober_hooks(exact: bool, touches: int = 4) -> list[tuple[str, str, Callable[[Any], Any]]]:
-    """Replacements (for :func:`palpate.benchmarks.patching.patched`) that change what each
+def prober_hooks(exact: bool, touches: int = 4) -> list[tuple[Any, str, Callable[[Any], Any]]]:
+    """Replacements (for :func:`benchmarks.patching.patched`) that change what each
     trial's prober is: told the trial's true surface (``exact``; the trial's geometry is kept as
     it is planned), and/or three touches instead of four. The prober factory wraps what it
     builds."""
@@ -139,8 +140,8 @@ def prober_hooks(exact: bool, touches: int = 4) -> list[tuple[str, str, Callable
         return factory
 
     return [
-        ("palpate.simulation.trial", "trial_geometry", keep_geometry),
-        ("palpate.simulation.trial", "prober_for", prober),
+        (sim_trial, "trial_geometry", keep_geometry),
+        (sim_trial, "prober_for", prober),
     ]
 
 

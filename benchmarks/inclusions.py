@@ -1,6 +1,6 @@
 """The three-dimensional inclusion world: its validation and what a palpation can see.
 
-``python -m palpate.benchmarks.inclusions [--section NAME]`` prints the markdown tables of
+``python -m benchmarks.inclusions [--section NAME]`` prints the markdown tables of
 docs/inclusions.md (tens of minutes the first time: every geometry is a 3-D solve; the tables
 are cached, so a second run reads them):
 
@@ -226,7 +226,7 @@ SECTIONS = {
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m palpate.benchmarks.inclusions")
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.inclusions")
     parser.add_argument("--section", action="append", choices=sorted(SECTIONS))
     args = parser.parse_args(argv)
     for name in args.section or list(SECTIONS):

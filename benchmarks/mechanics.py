@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
+from benchmarks.report import BenchContext, BenchSection, Table, median_time
 from palpate.config.optics import MM
 from palpate.config.schema import SensorConfig
 from palpate.estimation.beam import Beam

@@ -14,7 +14,7 @@ benchmark; nothing here asserts a time.
 
 Usage::
 
-    from palpate.benchmarks.rehearsal import cpu_load, rehearse
+    from benchmarks.rehearsal import cpu_load, rehearse
     with cpu_load(busy=2):
         session = rehearse(Path("/tmp/rehearsal"))
     assert session.exit_code == 0, session.stderr
@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.config import resolve
 
 SCENE = "scenes/robot.yaml"

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table, median_time
+from benchmarks.report import BenchContext, BenchSection, Table, median_time
 from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
 from palpate.config import load, load_stack, resolve
 from palpate.config.sample import SampleConfig

@@ -43,12 +43,22 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from palpate.benchmarks.patching import patched
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.patching import patched
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
+from palpate.robot.records.recording import McapRecorder
+from palpate.robot.trial import estimate as trial_estimate
+from palpate.robot.trial import run as trial_run
+from palpate.robot.trial import session as trial_session
+from palpate.robot.trial import states as trial_states
+from palpate.sim import contact_table
+from palpate.sim.clock import VirtualClock
 from palpate.sim.contact_table import equilibrium_on_grid
+from palpate.sim.dynamixel.bus import EmulatedBus
+from palpate.sim.inprocess import FramePipe
+from palpate.simulation import result as sim_result
 from palpate.simulation.trial import TrialOutcome
 
 SIMULATOR, CONTROL, ESTIMATOR = "simulator", "control path", "estimator"
@@ -56,39 +66,34 @@ SIMULATOR, CONTROL, ESTIMATOR = "simulator", "control path", "estimator"
 
 @dataclass(frozen=True)
 class Boundary:
-    """A function measured: ``owner`` (a module or a class, by import path) and its attribute;
-    ``part`` names it in the table, ``side`` groups the parts."""
+    """A function measured: ``owner`` (a module or a class) and its attribute, which must exist
+    (checked when the boundary is made: a rename fails here, not at run time); ``part`` names
+    it in the table, ``side`` groups the parts."""
 
-    owner: str
+    owner: Any
     attribute: str
     part: str
     side: str
 
+    def __post_init__(self) -> None:
+        getattr(self.owner, self.attribute)  # AttributeError now, naming the renamed function
+
 
 BOUNDARIES = (
-    Boundary(
-        "palpate.sim.clock:VirtualClock",
-        "advance",
-        "clock advance: servos, board, world",
-        SIMULATOR,
-    ),
-    Boundary(
-        "palpate.sim.dynamixel.bus:EmulatedBus", "exchange", "emulated bus requests", SIMULATOR
-    ),
-    Boundary("palpate.sim.inprocess:FramePipe", "take_frames", "frame pipe", SIMULATOR),
-    Boundary("palpate.sim.contact_table", "equilibrium_on_grid", "contact tables", SIMULATOR),
-    Boundary("palpate.robot.trial.session", "run_trial", "trial loop", CONTROL),
-    Boundary("palpate.robot.trial.run", "_tick", "ticks (observe, decide, command)", CONTROL),
-    Boundary("palpate.robot.records.recording:McapRecorder", "write", "MCAP recording", CONTROL),
-    Boundary(
-        "palpate.robot.records.recording:McapRecorder", "close", "MCAP close (tip force)", CONTROL
-    ),
-    Boundary("palpate.robot.trial.estimate", "joint_fit", "joint fit", ESTIMATOR),
-    Boundary("palpate.robot.trial.states", "infer_states", "beam states", ESTIMATOR),
-    Boundary("palpate.robot.trial.estimate", "fit_strains", "paper's strain fit", ESTIMATOR),
-    Boundary("palpate.robot.trial.estimate", "lean_of_rows", "lean and slip-path fits", ESTIMATOR),
-    Boundary("palpate.robot.trial.estimate", "relaxation_of", "relaxation fit", ESTIMATOR),
-    Boundary("palpate.simulation.result", "estimate_trial", "rest of the estimate", ESTIMATOR),
+    Boundary(VirtualClock, "advance", "clock advance: servos, board, world", SIMULATOR),
+    Boundary(EmulatedBus, "exchange", "emulated bus requests", SIMULATOR),
+    Boundary(FramePipe, "take_frames", "frame pipe", SIMULATOR),
+    Boundary(contact_table, "equilibrium_on_grid", "contact tables", SIMULATOR),
+    Boundary(trial_session, "run_trial", "trial loop", CONTROL),
+    Boundary(trial_run, "_tick", "ticks (observe, decide, command)", CONTROL),
+    Boundary(McapRecorder, "write", "MCAP recording", CONTROL),
+    Boundary(McapRecorder, "close", "MCAP close (tip force)", CONTROL),
+    Boundary(trial_estimate, "joint_fit", "joint fit", ESTIMATOR),
+    Boundary(trial_states, "infer_states", "beam states", ESTIMATOR),
+    Boundary(trial_estimate, "fit_strains", "paper's strain fit", ESTIMATOR),
+    Boundary(trial_estimate, "lean_of_rows", "lean and slip-path fits", ESTIMATOR),
+    Boundary(trial_estimate, "relaxation_of", "relaxation fit", ESTIMATOR),
+    Boundary(sim_result, "estimate_trial", "rest of the estimate", ESTIMATOR),
 )
 TICKS = "ticks (observe, decide, command)"
 SHIPPED, LEAN, ROBOT = "scenes/bench.yaml", "scenes/bench-lean.yaml", "scenes/robot.yaml"

@@ -20,7 +20,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, default_workers, run_campaign, warm_up
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig

@@ -1,6 +1,6 @@
 """The finite-element tissue against the closed forms: the numbers in docs/tissue-fe.md.
 
-``python -m palpate.benchmarks.tissue_fe [--quick]`` prints markdown tables:
+``python -m benchmarks.tissue_fe [--quick]`` prints markdown tables:
 
 1. validation: Hertz (thick layer, small depth), Sneddon (thick layer, deep), Dimitriadis'
    first-order term (h = R/2, chi <= 0.5, bonded and sliding);
@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.estimation.hertz import hertz_force
 from palpate.estimation.layer import dimitriadis_bracket, dimitriadis_coefficients
 from palpate.sim.fem.law import curve_from_table
@@ -279,7 +279,7 @@ def run(ctx: BenchContext) -> BenchSection:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m palpate.benchmarks.tissue_fe")
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.tissue_fe")
     parser.add_argument(
         "--section", choices=["validation", "convergence", "departures", "timings"], action="append"
     )

@@ -1,6 +1,6 @@
 """Fuzz target for the configuration loader: random and mutated YAML trees and text through
 :func:`config.loader.read_yaml` and :func:`config.loader.from_mapping` (robot and scene schemas);
-only ``ConfigError`` may come out (:mod:`palpate.benchmarks.fuzztargets` lists every target).
+only ``ConfigError`` may come out (:mod:`benchmarks.fuzztargets` lists every target).
 """
 
 from __future__ import annotations

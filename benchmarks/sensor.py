@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.config.schema import SensorConfig
 from palpate.estimation.detect_buckling import (
     CusumDetector,

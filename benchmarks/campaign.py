@@ -26,7 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from palpate.benchmarks.report import BenchContext, BenchSection, Table
+from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import (
     campaign_trials,
     median_abs_relative_error,
