@@ -38,7 +38,12 @@ PYTHON = "<python>"  # the source named in errors about a scene built in code
 
 def load_scene(path: str | Path) -> SceneConfig:
     """A scene file (the format of config/scenes/*.yaml), checked; a name that is not a file
-    is looked up among the shipped ones (``"scenes/bench.yaml"``)."""
+    is looked up among the shipped ones (``"scenes/bench.yaml"``).
+
+    >>> scene = load_scene("scenes/bench.yaml")
+    >>> scene.name, len(scene.samples)
+    ('bench', 11)
+    """
     from palpate.config import load, resolve
     from palpate.config.scene import SceneConfig
 
@@ -47,7 +52,18 @@ def load_scene(path: str | Path) -> SceneConfig:
 
 def scene_from_dict(data: Mapping[str, Any]) -> SceneConfig:
     """A scene built in code: the mapping a scene file holds (``name``, ``samples``,
-    ``campaign``, ...), checked like a file (errors name ``<python>`` and the key)."""
+    ``campaign``, ...), checked like a file (errors name ``<python>`` and the key).
+
+    >>> sample = {"name": "gel", "modulus_kpa": 300.0, "poisson": 0.45}
+    >>> campaign = {"kind": "bench", "exposed_lengths_mm": [44], "repeats": 1}
+    >>> scene = scene_from_dict({"name": "mine", "samples": [sample], "campaign": campaign})
+    >>> [(s.name, s.modulus) for s in scene.samples]  # SI inside: Pa
+    [('gel', 300000.0)]
+    >>> scene_from_dict({"name": "bad", "samples": [{**sample, "modulus_kpa": -1}]})
+    Traceback (most recent call last):
+    ...
+    palpate.config.loader.ConfigError: <python>: samples[0].modulus_kpa: must be > 0, got -1.0
+    """
     from palpate.config import from_mapping
     from palpate.config.scene import SceneConfig
 
@@ -55,7 +71,12 @@ def scene_from_dict(data: Mapping[str, Any]) -> SceneConfig:
 
 
 def load_robot(path: str | Path = "robot.yaml") -> StackConfig:
-    """A robot configuration (robot, sensor, drive, tubes, board); the shipped one by default."""
+    """A robot configuration (robot, sensor, drive, tubes, board); the shipped one by default.
+
+    >>> robot = load_robot()
+    >>> robot.sensor.exposed_length, [tube.name for tube in robot.tubes]
+    (0.042, ['straight', 'bent15', 'bent30', 'bent50'])
+    """
     from palpate.config import load_stack
 
     return load_stack(path)
@@ -64,7 +85,12 @@ def load_robot(path: str | Path = "robot.yaml") -> StackConfig:
 def trials(
     scene: SceneConfig, *, seed: int = 0, robot: StackConfig | None = None
 ) -> list[TrialSpec]:
-    """The campaign's trials in order (each seeded from ``seed``), checked to be reachable."""
+    """The campaign's trials in order (each seeded from ``seed``), checked to be reachable.
+
+    >>> specs = trials(load_scene("scenes/robot.yaml"))
+    >>> len(specs), specs[0].trial_id
+    (20, 'S7-straight-downward-L42')
+    """
     from palpate.campaigns.campaign import campaign_trials
     from palpate.simulation.preflight import check_campaign, check_reachable
 
@@ -87,7 +113,12 @@ def simulate(
     """Run the scene's campaign in simulation (its first ``limit`` trials); ``out``: a folder
     for the trials' logs (``out/logs``) and the results files (``results.json``,
     ``trials.csv``, ``samples.csv``), None for none. The report's ``as_dict()`` is what
-    ``palpate sim --json`` prints."""
+    ``palpate sim --json`` prints.
+
+    >>> report = simulate(load_scene("scenes/bench.yaml"), limit=2)
+    >>> [trial.as_dict()["verdict"] for trial in report.trials]
+    ['ok', 'ok']
+    """
     from palpate.campaigns.campaign import run_campaign
     from palpate.reports.payload import campaign_report, run_folder_files
 
@@ -119,7 +150,19 @@ def simulate_trial(
     log_dir: str | Path | None = None,
     robot: StackConfig | None = None,
 ) -> TrialOutcome:
-    """One trial of the scene's campaign (by index or trial id), its log in ``log_dir``."""
+    """One trial of the scene's campaign (by index or trial id), its log in ``log_dir``.
+
+    >>> import tempfile
+    >>> trial = simulate_trial(load_scene("scenes/bench.yaml"), 0, log_dir=tempfile.mkdtemp())
+    >>> trial.spec.trial_id, trial.status, 0.95 < trial.modulus("joint") / trial.spec.modulus < 1.05
+    ('S1-straight-downward-L42', 'ok', True)
+    >>> read_log(trial.log_path).end["state"]
+    'done'
+    >>> replay(trial.log_path)["identical"]  # the estimates re-run on the log, as recorded
+    True
+    >>> read_recording(trial.log_path.replace(".jsonl", ".mcap")).complete
+    True
+    """
     from palpate.config import InputError
     from palpate.simulation.trial import run_sim_trial
 
@@ -176,7 +219,13 @@ def survey(
     whole simulated trials; ``.summary`` is the map's answer (``found``, ``centre``,
     ``centre_ci``, ``radius``), ``.scores()`` compares it with the truth, ``.as_dict()`` is
     what ``--json`` prints. ``run_dir``: the probes file and trial logs (a second call
-    carries on from its probes)."""
+    carries on from its probes).
+
+    >>> scene = load_scene("scenes/maps/inclusion.yaml")
+    >>> result = survey(scene, strategy="raster", max_probes=4)
+    >>> len(result.probes), result.stopped
+    (4, '4 of 4 probes')
+    """
     from palpate.campaigns.survey import run_survey
     from palpate.config import InputError
 
@@ -199,7 +248,12 @@ def design(
     """``palpate design``: a sensor for ``modulus_range`` (in ``unit``), its checks and its
     simulated check, with the verdict (``.verdict.usable``, ``.reasons``). ``options`` are the
     command's options by name (``tip_grating=True``, ``moduli=3``, ``no_sim=True``,
-    ``thickness_mm=10``, ...); ``.as_dict()`` is what ``--json`` prints."""
+    ``thickness_mm=10``, ...); ``.as_dict()`` is what ``--json`` prints.
+
+    >>> found = design((300, 1100), unit="kPa", no_sim=True, thickness_mm=10)
+    >>> found.result.success, found.verdict.usable  # a design; not simulated: not judged
+    (True, None)
+    """
     from palpate.commands import design as command
 
     lo, hi = modulus_range

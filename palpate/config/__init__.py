@@ -1,6 +1,12 @@
 """Configuration: YAML files shipped here and the one loader that validates them.
 
-``load_stack("robot.yaml")`` returns a :class:`config.schema.StackConfig` in SI-ready form.
+``load_stack("robot.yaml")`` returns a :class:`config.schema.StackConfig` in SI-ready form
+(the YAML's millimetres in metres)::
+
+    >>> from palpate.config import load_stack
+    >>> stack = load_stack("robot.yaml")
+    >>> stack.sensor.tip_radius, [tube.name for tube in stack.tubes]
+    (0.0035, ['straight', 'bent15', 'bent30', 'bent50'])
 """
 
 from __future__ import annotations
