@@ -17,7 +17,6 @@ call; examples/ holds whole scripts.
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections.abc import Mapping
 from pathlib import Path
@@ -25,12 +24,12 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the heavy modules load when a function needs them: `import palpate` is cheap
     from palpate.campaigns.survey import SurveyResult
-    from palpate.commands.design import DesignOutcome
     from palpate.config.scene import SceneConfig
     from palpate.config.schema import StackConfig
     from palpate.reports.payload import CampaignReport
     from palpate.robot.records.log import TrialLog
     from palpate.robot.records.recording import Recording
+    from palpate.services.design import DesignOutcome
     from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 PYTHON = "<python>"  # the source named in errors about a scene built in code
@@ -254,23 +253,12 @@ def design(
     >>> found.result.success, found.verdict.usable  # a design; not simulated: not judged
     (True, None)
     """
-    from palpate.commands import design as command
+    from palpate.services.design import DesignRequest, evaluate
 
-    lo, hi = modulus_range
-    argv = ["--modulus-range", f"{lo!r}:{hi!r}", "--unit", unit]
-    for key, value in options.items():
-        flag = "--" + key.replace("_", "-")
-        if value is True:
-            argv.append(flag)
-        elif value is not False and value is not None:
-            argv += [flag, str(value)]
-    parser = argparse.ArgumentParser(prog="palpate.design", exit_on_error=False)
-    command.register(parser)
     try:
-        args = parser.parse_args(argv)
-    except (argparse.ArgumentError, SystemExit) as exc:
+        request = DesignRequest((float(modulus_range[0]), float(modulus_range[1])), unit, **options)
+    except TypeError as exc:  # an option the command does not have
         from palpate.config import InputError
 
-        raise InputError(f"palpate.design: {exc}") from None
-    args.json = True
-    return command.evaluate(args)
+        raise InputError(f"{PYTHON}: palpate.design: {exc}") from None
+    return evaluate(request)

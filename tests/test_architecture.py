@@ -247,15 +247,14 @@ PALPATE_ROOMS: dict[str, frozenset[str]] = {
     "palpate.campaigns": frozenset({"palpate", "palpate.simulation"}),
     "palpate.reports": _BELOW_REPORTS,
     "palpate.faults": _BELOW_REPORTS | {"palpate.reports"},
-    "palpate.commands": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
-    # the Python API (palpate/api.py): the commands' surface for scripts, above them all
+    # the work both front ends call (the command line, the Python API)
+    "palpate.services": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
+    "palpate.commands": _BELOW_REPORTS
+    | {"palpate.reports", "palpate.faults", "palpate.lab", "palpate.services"},
+    # the Python API (palpate/api.py): the other front end, beside the commands (never above
+    # them: both call the rooms below, the services first)
     "palpate.api": _BELOW_REPORTS
-    | {
-        "palpate.reports",
-        "palpate.faults",
-        "palpate.lab",
-        "palpate.commands",
-    },
+    | {"palpate.reports", "palpate.faults", "palpate.lab", "palpate.services"},
 }
 FRONT_DOOR = "palpate/__init__.py"  # the installed name re-exports the API, and only that
 MAX_PALPATE_TOP_MODULES = 6  # besides __init__, __main__, cli and api

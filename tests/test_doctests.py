@@ -16,6 +16,7 @@ LAYER_FRONTS = (
     "palpate.sim",
     "palpate.wire",
     "palpate.reports.mapresults",
+    "palpate.services.design",
 )
 
 

@@ -1,0 +1,391 @@
+"""Designing a sensor, the service ``palpate design`` and ``palpate.design`` both call: a
+:class:`DesignRequest` (the command's options as typed fields, their defaults and checks stated
+once here) in, a :class:`DesignOutcome` out (the search, the simulated check, the verdict).
+
+    >>> request = DesignRequest((300.0, 1100.0), thickness_mm=10.0, no_sim=True)
+    >>> evaluate(request).result.success
+    True
+    >>> DesignRequest((1.0, 20.0), poisson=0.7)
+    Traceback (most recent call last):
+    ...
+    palpate.config.loader.InputError: <python>: poisson: must be in [0, 0.5], got 0.7
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from palpate.argtypes import (
+    float_in,
+    non_negative_float,
+    non_negative_int,
+    number_list,
+    number_range,
+    positive_float,
+    positive_int,
+    positive_or_inf,
+)
+from palpate.campaigns.campaign import campaign_trials, default_workers
+from palpate.campaigns.designcheck import (
+    DEFAULT_TOLERANCE,
+    UNITS,
+    CheckSettings,
+    DesignVerdict,
+    design_scene,
+    design_verdict,
+    designed_stack,
+    run_check,
+)
+from palpate.config import load, load_stack, resolve
+from palpate.config.loader import InputError, write_yaml
+from palpate.config.optics import MM
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig
+from palpate.estimation.design import (
+    DesignConstraints,
+    DesignResult,
+    DesignSpace,
+    design_sensor,
+)
+from palpate.estimation.design.lumen import LAW_DEPTH_RATIO, Lumen, span_range
+from palpate.estimation.design.tipgrating import (
+    TipGratingChoice,
+    choose_tip_grating,
+    tip_grating_for_resolution,
+)
+from palpate.estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
+from palpate.estimation.section import composite_section
+from palpate.progress import progress_bar
+from palpate.reports.design import CheckRun, payload
+from palpate.reports.lumen import LumenReport
+from palpate.sensor.strain import strain_noise
+from palpate.simulation.trial import TrialOutcome
+from palpate.wire.dynamixel import TICKS_PER_REV
+
+PYTHON = "<python>"  # the source named in a keyword's error
+_SPACE = DesignSpace()
+
+# each numeric field's check, the command line's option type (palpate.argtypes) too
+FIELD_TYPES: dict[str, Callable[[str], Any]] = {
+    "modulus_range": number_range(positive_float),
+    "poisson": float_in(0.0, 0.5),
+    "thickness_mm": positive_or_inf,
+    "imperfection": float_in(0.0, 0.1, high_open=True),
+    "max_depth_ratio": float_in(0.0, LAW_DEPTH_RATIO, low_open=True),
+    "resolution_multiple": positive_float,
+    "fiber_radii_um": number_list(positive_float),
+    "wire_diameters_um": number_list(positive_float),
+    "wire_counts": number_list(non_negative_int),
+    "tip_radii_mm": number_list(positive_float),
+    "lumen_mm": positive_float,
+    "clearance_mm": non_negative_float,
+    "tip_resolution_mn": positive_float,
+    "length_range_mm": number_range(positive_float),
+    "moduli": positive_int,
+    "lengths": positive_int,
+    "contact_uncertainty_mm": non_negative_float,
+    "seed": non_negative_int,
+    "workers": positive_int,
+    "tolerance_pct": float_in(0.0, 100.0, low_open=True),
+    "tip_mass_g": non_negative_float,
+}
+
+
+@dataclass(frozen=True)
+class DesignRequest:
+    """What to design for and how to check it: ``palpate design``'s options by name, in their
+    units (``thickness_mm``, ``tolerance_pct``, ``modulus_range`` in ``unit``). Each numeric
+    field is checked as the command line checks its option (InputError naming the field)."""
+
+    modulus_range: tuple[float, float]
+    unit: str = "kPa"
+    poisson: float = 0.45
+    thickness_mm: float = 20.0  # inf: a half-space
+    imperfection: float = 5e-4
+    max_depth_ratio: float | None = None
+    resolution_multiple: float = 20.0
+    fiber_radii_um: tuple[float, ...] = tuple(r * 1e6 for r in _SPACE.fiber_radii)
+    wire_diameters_um: tuple[float, ...] = tuple(d * 1e6 for d in _SPACE.wire_diameters)
+    wire_counts: tuple[int, ...] = _SPACE.wire_counts
+    tip_radii_mm: tuple[float, ...] = tuple(r * 1e3 for r in _SPACE.tip_radii)
+    lumen_mm: float | None = None
+    pose: str = "vertical"
+    clearance_mm: float = 0.2
+    tip_resolution_mn: float = 0.05
+    length_range_mm: tuple[float, float] = (
+        _SPACE.length_range[0] * 1e3,
+        _SPACE.length_range[1] * 1e3,
+    )
+    config: str = "robot.yaml"
+    scene: Path | None = None
+    moduli: int = 4
+    lengths: int = 2
+    contact_uncertainty_mm: float = 0.0
+    seed: int = 0
+    workers: int = field(default_factory=default_workers)
+    executor: str = "process"
+    scheduler: str | None = None
+    no_sim: bool = False
+    tolerance_pct: float = 100 * DEFAULT_TOLERANCE
+    tip_grating: bool = False
+    tip_mass_g: float | None = None
+    write: Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.unit not in UNITS:
+            raise InputError(f"{PYTHON}: unit: must be one of {sorted(UNITS)}, got {self.unit!r}")
+        if self.pose not in ("any", "vertical"):
+            raise InputError(f"{PYTHON}: pose: must be 'any' or 'vertical', got {self.pose!r}")
+        for name, kind in FIELD_TYPES.items():
+            value = getattr(self, name)
+            if value is None:
+                continue
+            try:
+                kind(as_option(name, value))
+            except argparse.ArgumentTypeError as exc:
+                raise InputError(f"{PYTHON}: {name}: {exc}") from None
+
+    @classmethod
+    def from_options(cls, options: argparse.Namespace) -> DesignRequest:
+        """The request of ``palpate design``'s parsed options (already checked by their types)."""
+        return cls(**{f.name: getattr(options, f.name) for f in fields(cls)})
+
+
+def as_option(name: str, value: object) -> str:
+    """A field's value as its option is written: ``1:20`` for a range, ``1,2.5`` for a list.
+
+    >>> as_option("length_range_mm", (20.0, 100.0)), as_option("wire_counts", [0, 1, 2])
+    ('20:100', '0,1,2')
+    """
+    if isinstance(value, tuple | list):
+        sep = ":" if name.endswith(("range", "range_mm")) else ","
+        return sep.join(f"{v:g}" for v in value)
+    return repr(value)
+
+
+def inputs(
+    req: DesignRequest, stack: StackConfig, scene: SceneConfig
+) -> tuple[tuple[float, float], DesignConstraints, DesignSpace]:
+    unit = UNITS[req.unit]
+    lo, hi = req.modulus_range
+    thickness = None if math.isinf(req.thickness_mm) else req.thickness_mm * MM
+    s = stack.sensor
+    constraints = DesignConstraints(
+        poisson=req.poisson,
+        thickness=thickness,
+        encoder_resolution=stack.drive.lead / TICKS_PER_REV,
+        resolution_multiple=req.resolution_multiple,
+        strain_limit=stack.fbg.strain_limit,
+        strain_noise=strain_noise(
+            scene.fidelity.fbg_noise_pm, stack.fbg.strain_coefficient_pm_per_ue
+        ),
+        imperfection=req.imperfection,
+        max_depth_ratio=_depth_ratio(req),
+        held_across=req.pose == "any",
+        tip_force_resolution=None if req.lumen_mm is None else req.tip_resolution_mn * 1e-3,
+        post_buckling_travel=scene.campaign.post_buckling,
+        grating_centres_from_tip=s.grating_centres_from_tip(),
+        grating_length=s.grating_length,
+    )
+    lengths = req.length_range_mm
+    space = DesignSpace(
+        fiber_radii=tuple(r * 1e-6 for r in req.fiber_radii_um),
+        fiber_modulus=s.fiber_modulus,
+        wire_modulus=s.wire_modulus,
+        wire_diameters=tuple(d * 1e-6 for d in req.wire_diameters_um),
+        wire_counts=tuple(int(n) for n in req.wire_counts),
+        tip_radii=tuple(r * 1e-3 for r in req.tip_radii_mm),
+        length_range=(lengths[0] * 1e-3, lengths[1] * 1e-3),
+    )
+    return (lo * unit, hi * unit), constraints, space
+
+
+def _depth_ratio(req: DesignRequest) -> float:
+    if req.max_depth_ratio is not None:
+        return float(req.max_depth_ratio)
+    return LAW_DEPTH_RATIO if req.lumen_mm is not None else DesignConstraints.max_depth_ratio
+
+
+def _lumen(req: DesignRequest) -> Lumen | None:
+    if req.lumen_mm is None:
+        return None
+    try:
+        return Lumen(req.lumen_mm * MM, req.clearance_mm * MM)
+    except ValueError as exc:
+        raise InputError(f"--lumen-mm/--clearance-mm: {exc}") from None
+
+
+def search(
+    req: DesignRequest,
+    modulus_range: tuple[float, float],
+    constraints: DesignConstraints,
+    space: DesignSpace,
+) -> tuple[DesignResult, LumenReport | None]:
+    """The design search; with ``--lumen-mm`` in the lumen's space, spanning the range with
+    as few sensors as it takes (the first one is the design the command goes on with)."""
+    lumen = _lumen(req)
+    if lumen is None:
+        return design_sensor(modulus_range, constraints, space), None
+    try:
+        space = lumen.space(space)
+    except ValueError as exc:
+        raise InputError(f"--lumen-mm: {exc}") from None
+    span = span_range(modulus_range, constraints, space)
+    result = span.designs[0] if span.designs else design_sensor(modulus_range, constraints, space)
+    return result, LumenReport(lumen, span, constraints, req.unit)
+
+
+def tip_grating(
+    req: DesignRequest, result: DesignResult, noise_pm: float
+) -> TipGratingChoice | None:
+    assert result.evaluation is not None
+    p_cr = result.evaluation.critical_load
+    if req.lumen_mm is not None:
+        try:
+            return tip_grating_for_resolution(p_cr, noise_pm, req.tip_resolution_mn * 1e-3)
+        except ValueError as exc:
+            raise InputError(f"--tip-resolution-mn: {exc}") from None
+    return choose_tip_grating(p_cr, noise_pm) if req.tip_grating else None
+
+
+def _settings(req: DesignRequest) -> CheckSettings:
+    return CheckSettings(
+        unit=req.unit,
+        moduli=req.moduli,
+        lengths=req.lengths,
+        poisson=req.poisson,
+        thickness_mm=req.thickness_mm,
+        imperfection=req.imperfection,
+        contact_uncertainty_mm=req.contact_uncertainty_mm,
+    )
+
+
+def _run_sim(
+    scene: SceneConfig, stack: StackConfig, req: DesignRequest
+) -> tuple[list[TrialOutcome], float]:
+    specs = campaign_trials(scene, stack, req.seed)
+    bar = progress_bar(len(specs), "design check")
+
+    def progress(o: TrialOutcome) -> None:
+        bar.update(1)
+        bar.set_postfix_str(o.spec.trial_id)
+
+    outcomes, wall = run_check(
+        specs,
+        scene,
+        stack,
+        executor=req.executor,
+        workers=req.workers,
+        scheduler=req.scheduler,
+        progress=progress,
+    )
+    bar.close()
+    return outcomes, wall
+
+
+def _written_note(req: DesignRequest) -> str:
+    tip = " --tip-grating" if req.tip_grating else ""
+    if req.lumen_mm is not None:
+        tip += f" --lumen-mm {req.lumen_mm:g} --tip-resolution-mn {req.tip_resolution_mn:g}"
+    if req.pose == "any":
+        tip += " --pose any"
+    if req.tip_mass_g is not None:
+        tip += f" --tip-mass-g {req.tip_mass_g:g}"
+    lo, hi = req.modulus_range
+    return (
+        f"Written by `palpate design --modulus-range {lo:g}:{hi:g} --unit {req.unit}"
+        f"{tip}`:\nthe robot configuration ({req.config}) with the designed sensor."
+    )
+
+
+def _tip_payload(tip: TipGratingChoice | None) -> dict[str, object]:
+    return {} if tip is None else {"tip_grating": tip.as_dict()}
+
+
+def sag_text(weight: WeightCheck) -> str:
+    verdict = "within" if weight.ok else "beyond"
+    limit = weight.tip_mass_limit * 1e3
+    lighter = (
+        f"a tip under {_two_digits_down(limit):g} g would be within"
+        if limit > 0
+        else "the beam's own weight sags it beyond, whatever its tip"
+    )
+    return (
+        f"the tip sags {weight.sag * 1e3:.3g} mm ({weight.sag_over_length:.1%} of L, {verdict} "
+        f"{SAG_LIMIT:.1%}; {lighter})"
+    )
+
+
+def _two_digits_down(x: float) -> float:
+    """``x`` > 0 to two significant digits, rounded down (a limit printed is one that holds)."""
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.floor(x / scale) * scale
+
+
+@dataclass(frozen=True)
+class DesignOutcome:
+    """What ``palpate design`` found: the search's result, its constraints, the simulated
+    check (its trials, none when skipped), the tip grating and weight checks, and the verdict
+    (``usable``, ``reasons``, ``conditions``); :meth:`as_dict` is what ``--json`` prints."""
+
+    result: DesignResult
+    constraints: DesignConstraints
+    check: CheckRun
+    tip: TipGratingChoice | None
+    weight: WeightCheck | None
+    verdict: DesignVerdict
+    lumen: LumenReport | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        w = self.weight
+        extra = {**_tip_payload(self.tip), **({} if w is None else {"weight": w.as_dict()})}
+        if self.lumen is not None:
+            extra["lumen"] = self.lumen.as_dict()
+        return {**self.verdict.as_dict(), **payload(self.result, self.constraints, self.check),
+                **extra}  # fmt: skip
+
+
+def evaluate(req: DesignRequest) -> DesignOutcome:
+    """The search, the designed robot configuration (written with ``write``), the weight
+    check and the simulated check of a request (``palpate design``'s options, or
+    ``palpate.design``'s keywords)."""
+    stack = load_stack(req.config)
+    base = load(SceneConfig, req.scene if req.scene else resolve("scenes/bench.yaml"))
+    modulus_range, constraints, space = inputs(req, stack, base)
+    result, lumen = search(req, modulus_range, constraints, space)
+    outcomes: list[TrialOutcome] = []
+    wall = 0.0
+    tip: TipGratingChoice | None = None
+    weight: WeightCheck | None = None
+    if result.success:
+        assert result.evaluation is not None
+        assert result.length_window is not None
+        scene, sim_stack = design_scene(
+            result.evaluation, result.length_window, stack, base, _settings(req)
+        )
+        tip = tip_grating(req, result, max(base.fidelity.fbg_noise_pm, 1e-3))
+        sensor_range = result.evaluation.modulus_range
+        sim_stack = designed_stack(sim_stack, sensor_range, tip, req.tip_mass_g)
+        s = sim_stack.sensor
+        section = composite_section(
+            s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
+        )
+        weight = weight_check(s.tip_mass, s.linear_mass, section.EI, s.exposed_length)
+        if req.write is not None:
+            write_yaml(sim_stack, req.write, _written_note(req))
+        if not req.no_sim:
+            outcomes, wall = _run_sim(scene, sim_stack, req)
+    verdict = design_verdict(
+        result.success,
+        None if req.no_sim else outcomes,
+        None if weight is None else weight.ok,
+        "" if weight is None else sag_text(weight),
+        req.tolerance_pct / 100,
+    )
+    check = CheckRun(outcomes, wall, req.unit, req.executor)
+    return DesignOutcome(result, constraints, check, tip, weight, verdict, lumen)
