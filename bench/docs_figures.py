@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import re
 import shutil
@@ -27,6 +26,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+from same_results import differences  # bench/, beside this script
 
 import palpate
 from palpate.campaigns.survey import SurveyResult
@@ -69,27 +70,6 @@ FIGURES: dict[str, Callable[[], Figure]] = {
     "estimates": estimates,
     "map-active": map_active,
 }
-
-
-def differences(old: Any, new: Any, where: str = "") -> list[str]:
-    """Where ``new`` differs from ``old``: numbers beyond RTOL, anything else at all."""
-    if isinstance(old, dict) and isinstance(new, dict):
-        out = [f"{where}.{k}: only in one" for k in sorted(set(old) ^ set(new))]
-        for k in sorted(set(old) & set(new)):
-            out += differences(old[k], new[k], f"{where}.{k}")
-        return out
-    if isinstance(old, list) and isinstance(new, list):
-        if len(old) != len(new):
-            return [f"{where}: {len(old)} items, now {len(new)}"]
-        return [d for i, (a, b) in enumerate(zip(old, new, strict=True)) for d in
-                differences(a, b, f"{where}[{i}]")]  # fmt: skip
-    numbers = (int, float)
-    if isinstance(old, numbers) and isinstance(new, numbers) and not isinstance(old, bool):
-        if math.isclose(old, new, rel_tol=RTOL, abs_tol=1e-12):
-            return []
-    elif old == new:
-        return []
-    return [f"{where}: {old!r}, now {new!r}"]
 
 
 def rehearsal_map(path: Path) -> None:
@@ -154,7 +134,7 @@ def main() -> int:
         print(f"{name}: data in {time.perf_counter() - t0:.0f} s", flush=True)
         if args.check:
             old = json.loads(shipped.read_text(encoding="utf-8")) if shipped.exists() else {}
-            problems += [f"{name}{d}" for d in differences(old, data)]
+            problems += [f"{name}{d}" for d in differences(old, data, rtol=RTOL)]
             continue
         shipped.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
         draw(IMG / f"{name}.png")

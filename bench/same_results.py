@@ -2,12 +2,14 @@
 leaving out what depends on the clock or on where the run wrote (wall and CPU times, speed-ups,
 run folders and log paths). Prints each difference and exits 1 when there is one.
 
-    python3 bench/same_results.py BEFORE.json AFTER.json [--new-keys]
+    python3 bench/same_results.py BEFORE.json AFTER.json [--new-keys] [--rtol 1e-3]
 
 ``--new-keys``: a key only in AFTER is not a difference (a change that adds an output and
 leaves every earlier one as it was). A key renamed since BEFORE was written
 (:data:`RENAMED`: ``actual_kpa`` is ``true_kpa`` since the two moduli got one name each) is
-compared under its new name.
+compared under its new name. ``--rtol R``: numbers within R of each other (relative) are the
+same; strings, booleans and verdicts must still be equal (the tolerance results may move
+within, docs/speed.md).
 
 Used to show that a restructure moved code only: run the seeded campaign on both commits (e.g.
 ``palpate sim --campaign paper --no-plots --json`` and ``palpate sim --faults --no-plots
@@ -40,7 +42,9 @@ def renamed(value: Any) -> Any:
     return value
 
 
-def differences(a: Any, b: Any, path: str = "", new_keys: bool = False) -> list[str]:
+def differences(
+    a: Any, b: Any, path: str = "", new_keys: bool = False, rtol: float = 0.0
+) -> list[str]:
     """Every place where ``a`` and ``b`` differ, outside the clock's and the folders' fields
     (and, with ``new_keys``, the keys only ``b`` has)."""
     if isinstance(a, dict) and isinstance(b, dict):
@@ -53,7 +57,7 @@ def differences(a: Any, b: Any, path: str = "", new_keys: bool = False) -> list[
             if key not in a or key not in b:
                 out.append(f"{path}/{key}: only in {'after' if key in b else 'before'}")
             else:
-                out += differences(a[key], b[key], f"{path}/{key}", new_keys)
+                out += differences(a[key], b[key], f"{path}/{key}", new_keys, rtol)
         return out
     if isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
@@ -61,23 +65,32 @@ def differences(a: Any, b: Any, path: str = "", new_keys: bool = False) -> list[
         return [
             d
             for i, (x, y) in enumerate(zip(a, b, strict=True))
-            for d in differences(x, y, f"{path}[{i}]", new_keys)
+            for d in differences(x, y, f"{path}[{i}]", new_keys, rtol)
         ]
     if a == b or (
         isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)
     ):
         return []  # a NaN in both runs is the same result (NaN != NaN in Python)
+    numbers = isinstance(a, int | float) and isinstance(b, int | float)
+    plain = numbers and not isinstance(a, bool) and not isinstance(b, bool)
+    if rtol and plain and math.isclose(a, b, rel_tol=rtol):
+        return []
     return [f"{path}: {a!r} before, {b!r} after"]
 
 
 def main(argv: list[str]) -> int:
     new_keys = "--new-keys" in argv
+    rtol = 0.0
+    if "--rtol" in argv:
+        i = argv.index("--rtol")
+        rtol = float(argv[i + 1])
+        argv = argv[:i] + argv[i + 2 :]
     paths = [a for a in argv if a != "--new-keys"]
     if len(paths) != 2:
         print(__doc__, file=sys.stderr)
         return 2
     before, after = (json.loads(Path(p).read_text(encoding="utf-8")) for p in paths)
-    found = differences(renamed(before), after, new_keys=new_keys)
+    found = differences(renamed(before), after, new_keys=new_keys, rtol=rtol)
     for line in found:
         print(line)
     print(f"{len(found)} differences" if found else "identical (clock and folder fields left out)")
