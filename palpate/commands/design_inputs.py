@@ -11,7 +11,7 @@ from typing import Any
 
 from palpate.campaigns.designcheck import UNITS
 from palpate.campaigns.executors import add_executor_arguments
-from palpate.services.design import FIELD_TYPES, DesignRequest, as_option
+from palpate.services.design import FIELD_TYPES, POSES, DesignRequest, as_option
 
 _FIELDS = {f.name: f for f in dataclasses.fields(DesignRequest)}
 
@@ -82,7 +82,7 @@ def _add_space_arguments(parser: argparse.ArgumentParser) -> None:
         "any: the design must carry its own weight held across (the search's weight check, a "
         "solid printed tip sphere; in the body the sensor meets tissue at any angle to "
         "gravity); vertical: the sag is only reported after the search",
-        choices=("any", "vertical"),
+        choices=POSES,
     )
     _option(parser, "--clearance-mm", "what a tool leaves of the channel")
     _option(

@@ -229,7 +229,8 @@ class IndentationMachine:
     def _stream_hold(self, obs: Observation) -> Command | None:
         """Hold still while the stream is stale in a contact phase; report the gap after."""
         if self.state in CONTACT_PHASE and obs.stream_age > self.guards.stream_timeout:
-            self._stale_since = self._stale_since or obs.t - obs.stream_age
+            if self._stale_since is None:  # a gap starts at its last frame (t 0.0 is one)
+                self._stale_since = obs.t - obs.stream_age
             return Command(obs.advance, obs.roll, 0.0)
         if self._stale_since is not None:
             since, self._stale_since = self._stale_since, None

@@ -68,6 +68,7 @@ from palpate.simulation.trial import TrialOutcome
 from palpate.wire.dynamixel import TICKS_PER_REV
 
 PYTHON = "<python>"  # the source named in a keyword's error
+POSES = ("any", "vertical")  # how the sensor meets the tissue (``pose``)
 _SPACE = DesignSpace()
 
 # each numeric field's check, the command line's option type (palpate.argtypes) too
@@ -139,8 +140,8 @@ class DesignRequest:
     def __post_init__(self) -> None:
         if self.unit not in UNITS:
             raise InputError(f"{PYTHON}: unit: must be one of {sorted(UNITS)}, got {self.unit!r}")
-        if self.pose not in ("any", "vertical"):
-            raise InputError(f"{PYTHON}: pose: must be 'any' or 'vertical', got {self.pose!r}")
+        if self.pose not in POSES:
+            raise InputError(f"{PYTHON}: pose: must be one of {list(POSES)}, got {self.pose!r}")
         for name, kind in FIELD_TYPES.items():
             value = getattr(self, name)
             if value is None:
