@@ -5,7 +5,8 @@
 For every neo-Hookean FE table the scenes ship (``sim.fem.generate``: the thin layers under the
 paper's tip, the paper's phantom, the lung layers), the world's force over the exact linear
 law, ``F_FE / F_lin - 1``, beside the estimator's second-order departure D
-(``estimation.finite_strain``, shipped rows, as a law evaluates them) at a few depths: delta/h
+(``estimation.contact.finite_strain``, shipped rows, as a law evaluates them) at a few depths:
+delta/h
 on the thin layers (h < R), delta/R on the others. The FE solves the nonlinear problem on a
 finite dish; the departure is second-order elasticity on the exact linear layer's fields: two
 methods that share only the material's definition. Prints a markdown table and the largest
@@ -19,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from palpate.estimation.finite_strain.table import Tip, departure_curve
-from palpate.estimation.layer_exact import kernel_transform, solve_contact
+from palpate.estimation.contact.finite_strain.table import Tip, departure_curve
+from palpate.estimation.contact.layer_exact import kernel_transform, solve_contact
 from palpate.sim.fem.generate import SHIPPED
 from palpate.sim.fem.table import load_table
 

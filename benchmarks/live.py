@@ -22,7 +22,7 @@ from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, warm_up
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.estimation.section import sensor_section
+from palpate.estimation.beam.section import sensor_section
 from palpate.live import HOST, TOPICS, LiveView
 from palpate.simulation.trial import run_sim_trial
 

@@ -26,11 +26,11 @@ from numpy.typing import NDArray
 from benchmarks.report import BenchContext, BenchSection, Table, median_time
 from palpate.config.optics import MM
 from palpate.config.schema import SensorConfig
-from palpate.estimation.beam import Beam
-from palpate.estimation.elastica import E_OVER_L_MAX, accurate, fast, shooting
-from palpate.estimation.elastica._scipy import solve_ivp
-from palpate.estimation.section import sensor_section
-from palpate.estimation.strain_fit import fit_strains
+from palpate.estimation.beam.elastica import E_OVER_L_MAX, accurate, fast, shooting
+from palpate.estimation.beam.elastica._scipy import solve_ivp
+from palpate.estimation.beam.model import Beam
+from palpate.estimation.beam.section import sensor_section
+from palpate.estimation.fits.strain_fit import fit_strains
 
 FloatArray = NDArray[np.float64]
 L_PAPER = 0.042

@@ -43,7 +43,7 @@ from palpate.campaigns.campaign import (
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.estimation.surface import SurfaceGeometry
+from palpate.estimation.pose.surface import SurfaceGeometry
 from palpate.robot.probe_plan import ProbeGeometry, ProbeSettings
 from palpate.robot.probe_result import Touch
 from palpate.robot.probing import ProbeRoutine

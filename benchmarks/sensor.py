@@ -27,18 +27,19 @@ from numpy.typing import NDArray
 
 from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.config.schema import SensorConfig
-from palpate.estimation.detect_buckling import (
+from palpate.estimation.beam.elastica.constants import P_CRIT
+from palpate.estimation.beam.section import grating_intervals
+from palpate.estimation.detect.buckling import (
     CusumDetector,
     Detector,
     NormThreshold,
     first_mode_pattern,
     first_mode_strains,
 )
-from palpate.estimation.elastica.constants import P_CRIT
 from palpate.sensor.clock import SystemClock
 from palpate.sensor.parser import FrameParser
 from palpate.sensor.reader import FrameReader
-from palpate.sensor.strain import grating_intervals, strain_noise
+from palpate.sensor.strain import strain_noise
 from palpate.sim.board import BoardEmulator, BoardFaults, BoardSample
 from palpate.sim.clock import VirtualClock
 from palpate.wire.frame import FrameLayout
@@ -253,7 +254,7 @@ def _section(sensor: SensorConfig) -> tuple[float, float, float]:
     """(EI, EA, fiber offset) of the paper's composite beam: fiber on a row of wires.
 
     The bending plane is normal to the row; a small inline copy of the composite-section sum
-    (the library version is ``estimation.section``) so this benchmark stands alone.
+    (the library version is ``estimation.beam.section``) so this benchmark stands alone.
     """
     rf, rw = sensor.fiber_radius, sensor.wire_radius
     Ef, Ew = sensor.fiber_modulus, sensor.wire_modulus

@@ -48,11 +48,11 @@ from benchmarks.report import BenchContext, BenchSection, Table
 from palpate.campaigns.campaign import campaign_trials, run_campaign, warm_up
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
+from palpate.estimation.trial import estimate as trial_estimate
+from palpate.estimation.trial import states as trial_states
 from palpate.robot.records.recording import McapRecorder
-from palpate.robot.trial import estimate as trial_estimate
 from palpate.robot.trial import run as trial_run
 from palpate.robot.trial import session as trial_session
-from palpate.robot.trial import states as trial_states
 from palpate.sim import contact_table
 from palpate.sim.clock import VirtualClock
 from palpate.sim.contact_table import equilibrium_on_grid

@@ -10,7 +10,8 @@
 4. the time to build a table (median of 3 solves) and to read one back (median of 21 reads).
 
 Every FE number is F / (E R^2) or a ratio of forces; the closed forms are the estimator's own
-(estimation.hertz, estimation.corrections) and today's world law (sim.tissue.TissueModel with
+(estimation.contact.hertz, estimation.contact.law) and today's world law (sim.tissue.TissueModel
+with
 Sneddon's sphere and the Dimitriadis series). Not part of ``palpate bench`` (minutes of solves).
 """
 
@@ -27,8 +28,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from benchmarks.report import BenchContext, BenchSection, Table
-from palpate.estimation.hertz import hertz_force
-from palpate.estimation.layer import dimitriadis_bracket, dimitriadis_coefficients
+from palpate.estimation.contact.hertz import hertz_force
+from palpate.estimation.contact.layer import dimitriadis_bracket, dimitriadis_coefficients
 from palpate.sim.fem.law import curve_from_table
 from palpate.sim.fem.problem import LayerProblem
 from palpate.sim.fem.solver import solve_indentation

@@ -2,9 +2,9 @@
 
 A scene's ``rigid: true`` sample (a stored pose on the bench, a trial with ``rigid: true``) is a
 rigid reference: a trial there fits the compliance between the stage encoder and the sensor's
-clamp (``estimation.compliance``) instead of a modulus. The trials on references run first; per
+clamp (``estimation.fits.compliance``) instead of a modulus. The trials on references run first; per
 tube on the robot (the bench-top stage: one value), the envelope of their intervals is the
-calibrated compliance (``estimation.compliance.pooled``), set in the robot configuration
+calibrated compliance (``estimation.fits.compliance.pooled``), set in the robot configuration
 (``tubes[].compliance_mm_per_n``, ``calibration.stage_compliance_mm_per_n``) for the
 campaign's other trials, and printed as the YAML lines to store (:func:`config_lines`).
 """
@@ -17,8 +17,8 @@ from typing import Protocol
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import MM, StackConfig
-from palpate.config.stage import STAGE, rig_key
-from palpate.estimation.compliance import ComplianceFit, pooled
+from palpate.estimation.beam.stage import STAGE, rig_key
+from palpate.estimation.fits.compliance import ComplianceFit, pooled
 
 
 class Calibrating(Protocol):

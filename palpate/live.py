@@ -12,12 +12,12 @@ only while a client listens:
 - ``/joint_states`` and ``/fbg/strains`` (JSON): the stage translation and roll, the state, the
   used gratings' strains, the contact event, the ventilator's breath hold (frame status bit 6);
 - ``/tip/force`` (JSON): the axial load and the beam's end shortening from the strains (the
-  estimator's beam state of that tick, ``estimation.beamstate``); the load is the tip force
+  estimator's beam state of that tick, ``estimation.beam.states``); the load is the tip force
   grating's where the sensor has one;
 - ``/tf`` (``foxglove.FrameTransforms``): ``base`` -> ``tube_tip`` -> ``sensor_tip`` from the
   tube's forward kinematics (``robot.kinematics``);
 - ``/scene`` (``foxglove.SceneUpdate``): the tube's centreline (straight part and arc) and the
-  sensor beam, bent as the elastica at the tick's end shortening (``estimation.elastica``), in
+  sensor beam, bent as the elastica at the tick's end shortening (``estimation.beam.elastica``), in
   the tube's bend plane (the gratings' own plane is not measured: a drawing, not a fit);
 - on ``palpate map --live``, after each probe: ``/map/grid`` and ``/map/probes``
   (``foxglove.PointCloud``, frame ``sample``): the map over the patch (modulus, sd of log E,
@@ -42,16 +42,15 @@ from numpy.typing import NDArray
 from palpate.argtypes import port_number
 from palpate.config.loader import InputError
 from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
-from palpate.config.stage import Stage
-from palpate.estimation.beamstate import infer_states
-from palpate.estimation.elastica import post_buckling
-from palpate.estimation.section import Section, sensor_section
+from palpate.estimation.beam.elastica import post_buckling
+from palpate.estimation.beam.section import Section, grating_intervals, sensor_section
+from palpate.estimation.beam.stage import Stage
+from palpate.estimation.beam.states import infer_states
 from palpate.robot.guards import Observation
 from palpate.robot.indentation import State
 from palpate.robot.kinematics import forward
 from palpate.robot.records.cdr import Transform
 from palpate.robot.records.ros2 import tip_transforms
-from palpate.sensor.strain import grating_intervals
 
 log = logging.getLogger(__name__)
 
@@ -151,7 +150,8 @@ class LiveView:
         self._closed = False
 
     def trial(self, stage: Stage) -> Publisher:
-        """The publisher of one trial on ``stage`` (``palpate.config.stage``): on the bench its
+        """The publisher of one trial on ``stage`` (``palpate.estimation.beam.stage``): on the
+        bench its
         exposed length is fixed, on a tube it follows the translation."""
         feed = _Feed(self, stage.tube, stage)
         return feed.publish

@@ -1,9 +1,12 @@
 """The layers of docs/architecture.md, read from every module's imports (ast, so imports inside
 functions count too): which package may import which, and no two packages importing each other.
 
-wire imports nothing of ours; config only config; estimation only estimation and config; sensor
-wire, estimation, config; robot wire, estimation, sensor, config; sim wire, estimation, config
-(never sensor, robot or palpate); palpate, the application, anything. Tests are not a layer.
+wire, store (the cache of solved tables) and maps (probes and the map of them) import nothing
+of ours; config only config; estimation only estimation, config and store; design (the sensor's
+search) estimation and config; sensor wire, estimation, config; robot wire, maps, estimation,
+sensor, config; sim wire, store, estimation, config (never sensor, robot or palpate); palpate, the
+application, anything. Every layer is a folder of ``palpate/`` (the card's ones also linked at the
+root). Tests are not a layer.
 """
 
 from __future__ import annotations
@@ -19,12 +22,18 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 ALLOWED: dict[str, frozenset[str]] = {
     "wire": frozenset({"wire"}),
+    "store": frozenset({"store"}),
+    "maps": frozenset({"maps"}),
     "config": frozenset({"config"}),
-    "estimation": frozenset({"estimation", "config"}),
+    "estimation": frozenset({"estimation", "config", "store"}),
+    "design": frozenset({"design", "estimation", "config"}),
     "sensor": frozenset({"sensor", "wire", "estimation", "config"}),
-    "robot": frozenset({"robot", "wire", "estimation", "sensor", "config"}),
-    "sim": frozenset({"sim", "wire", "estimation", "config"}),
-    "palpate": frozenset({"palpate", "wire", "config", "estimation", "sensor", "robot", "sim"}),
+    "robot": frozenset({"robot", "wire", "maps", "estimation", "sensor", "config"}),
+    "sim": frozenset({"sim", "wire", "store", "estimation", "config"}),
+    "palpate": frozenset(
+        {"palpate", "wire", "store", "maps", "config", "estimation", "design", "sensor", "robot"}
+        | {"sim"}
+    ),
 }
 PACKAGES = frozenset(ALLOWED)
 
@@ -35,12 +44,27 @@ def parsed(path: Path) -> ast.Module:
     return ast.parse(path.read_text(encoding="utf-8"), str(path))
 
 
+LAYERS = frozenset(ALLOWED) - {"palpate"}
+
+
 def module_name(path: Path, root: Path = ROOT) -> str:
+    """A file's module in the layers' terms (``palpate/sim/world.py`` is ``sim.world``)."""
     parts = path.relative_to(root).with_suffix("").parts
-    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+    return layer_name(".".join(parts[:-1] if parts[-1] == "__init__" else parts))
 
 
-LAYERS = frozenset({"wire", "config", "estimation", "sensor", "robot", "sim"})
+def folder(package: str, root: Path = ROOT) -> Path:
+    """Where a package's files are: a layer under ``palpate/``, the application at the root."""
+    return root / "palpate" / package if package in LAYERS else root / package
+
+
+def files_of(package: str, root: Path = ROOT) -> list[Path]:
+    """The package's modules (the application's without its layers' folders)."""
+    return sorted(
+        path
+        for path in folder(package, root).rglob("*.py")
+        if package != "palpate" or path.relative_to(root / "palpate").parts[0] not in LAYERS
+    )
 
 
 def layer_name(name: str) -> str:
@@ -76,7 +100,7 @@ def imported_modules(path: Path, root: Path = ROOT) -> Iterator[tuple[int, str]]
 def our_imports(root: Path = ROOT) -> Iterator[tuple[str, str, str]]:
     """(importing package, imported package, "file:line module") for imports between ours."""
     for package in sorted(PACKAGES):
-        for path in sorted((root / package).rglob("*.py")):
+        for path in files_of(package, root):
             for line, name in imported_modules(path, root):
                 top = name.partition(".")[0]
                 if top in PACKAGES:
@@ -120,7 +144,7 @@ def subpackages(root: Path = ROOT) -> frozenset[str]:
     return frozenset(
         module_name(init, root)
         for package in PACKAGES
-        for init in (root / package).rglob("__init__.py")
+        for init in folder(package, root).rglob("__init__.py")
     )
 
 
@@ -139,7 +163,7 @@ def subpackage_graph(root: Path = ROOT) -> dict[str, set[str]]:
     packages = subpackages(root)
     graph: dict[str, set[str]] = {p: set() for p in packages}
     for package in PACKAGES:
-        for path in (root / package).rglob("*.py"):
+        for path in files_of(package, root):
             source = package_of(module_name(path, root), packages)
             for _, name in imported_modules(path, root):
                 if name.partition(".")[0] not in PACKAGES:
@@ -183,9 +207,9 @@ def test_no_two_subpackages_import_each_other() -> None:
 
 def test_the_check_sees_every_kind_of_import(tmp_path: Path) -> None:
     """Imports inside functions and relative imports are found; a cycle is found."""
-    pkg = tmp_path / "robot" / "teleop"
+    pkg = tmp_path / "palpate" / "robot" / "teleop"
     pkg.mkdir(parents=True)
-    (tmp_path / "robot" / "__init__.py").write_text("", encoding="utf-8")
+    (tmp_path / "palpate" / "robot" / "__init__.py").write_text("", encoding="utf-8")
     (pkg / "__init__.py").write_text("from . import model\n", encoding="utf-8")
     (pkg / "model.py").write_text(
         "import math\n\ndef f():\n"
@@ -212,7 +236,7 @@ def oversized(root: Path = ROOT) -> list[str]:
     24: every module fits on a few screens, every function on one)."""
     found = []
     for package in sorted(PACKAGES):
-        for path in sorted((root / package).rglob("*.py")):
+        for path in files_of(package, root):
             text = path.read_text(encoding="utf-8")
             where = path.relative_to(root)
             if text.count("\n") > MAX_MODULE_LINES:
@@ -231,8 +255,10 @@ def test_modules_and_functions_fit_on_a_screen() -> None:
 
 def test_the_size_check_sees_a_long_function(tmp_path: Path) -> None:
     body = "\n".join(f"    x{i} = {i}" for i in range(MAX_FUNCTION_LINES + 1))
-    (tmp_path / "wire").mkdir()
-    (tmp_path / "wire" / "big.py").write_text(f"def big() -> None:\n{body}\n", encoding="utf-8")
+    (tmp_path / "palpate" / "wire").mkdir(parents=True)
+    (tmp_path / "palpate" / "wire" / "big.py").write_text(
+        f"def big() -> None:\n{body}\n", encoding="utf-8"
+    )
     assert [f.split(" ")[1] for f in oversized(tmp_path)] == ["big:"]
 
 
@@ -270,7 +296,7 @@ def palpate_room(module: str) -> str:
 def palpate_room_breaks(root: Path = ROOT) -> list[str]:
     """Imports from one room of ``palpate`` into a room it may not use ("file:line module")."""
     bad = []
-    for path in sorted((root / "palpate").rglob("*.py")):
+    for path in files_of("palpate", root):
         source = palpate_room(module_name(path, root))
         front = path.relative_to(root).as_posix() == FRONT_DOOR
         for line, name in imported_modules(path, root):

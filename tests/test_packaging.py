@@ -33,7 +33,10 @@ def test_the_wheel_holds_the_product_and_no_benchmark(tmp_path: Path) -> None:
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
     assert tops == {"palpate"}
     assert not [n for n in names if "benchmark" in n or "fuzz" in n]
-    for data in ("palpate/config/robot.yaml", "palpate/estimation/finite_strain/departure.npz"):
+    for data in (
+        "palpate/config/robot.yaml",
+        "palpate/estimation/contact/finite_strain/departure.npz",
+    ):
         assert data in names
     assert any(n.startswith("palpate/sim/fem/tables/") for n in names)
     assert "palpate/robot/trial/session.py" in names

@@ -20,8 +20,8 @@ from palpate.config.loader import InputError
 from palpate.config.optics import MM
 from palpate.config.scene import ORIENTATION_ROLL_DEG, SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.estimation.elastica import fast
-from palpate.estimation.stiffness import SampleSummary, summarize
+from palpate.estimation.beam.elastica import fast
+from palpate.estimation.fits.stiffness import SampleSummary, summarize
 from palpate.live import LiveView
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec, run_sim_trial
 

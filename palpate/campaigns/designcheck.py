@@ -2,7 +2,7 @@
 campaign on phantoms across the modulus range, and how far its estimates land from the truth.
 
 ``palpate design`` (:mod:`palpate.commands.design`) proposes the design with
-``estimation.design`` and prints; this module builds the scene (:func:`design_scene`), runs its
+``design`` and prints; this module builds the scene (:func:`design_scene`), runs its
 ``campaign_trials`` (:func:`run_check`) and summarises the errors per estimation method
 (:func:`error_summary`).
 """
@@ -23,9 +23,9 @@ from palpate.config.loader import InputError
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig, TipGratingConfig
-from palpate.estimation.design import DesignEvaluation
-from palpate.estimation.design.tipgrating import TipGratingChoice
-from palpate.estimation.design.weight import linear_mass
+from palpate.design import DesignEvaluation
+from palpate.design.tipgrating import TipGratingChoice
+from palpate.design.weight import linear_mass
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}

@@ -18,13 +18,13 @@ from typing import Any, TypeVar
 
 from palpate.campaigns.runs import set_aside
 from palpate.config.schema import StackConfig
-from palpate.estimation.compliance import ComplianceFit
+from palpate.estimation.fits.compliance import ComplianceFit
+from palpate.estimation.fits.southwell import SouthwellFit
+from palpate.estimation.fits.stiffness import StiffnessEstimate
 from palpate.estimation.jointfit import JointFit
 from palpate.estimation.jointfit.pooling import Terms
-from palpate.estimation.misalignment import Lean
+from palpate.estimation.pose.misalignment import Lean
 from palpate.estimation.relaxation import RelaxationFit
-from palpate.estimation.southwell import SouthwellFit
-from palpate.estimation.stiffness import StiffnessEstimate
 from palpate.robot.indentation import TrialMarks
 from palpate.robot.probe_result import ProbeResult, Touch
 from palpate.robot.records.log import TrialLog, TrialLogError, read_log

@@ -6,7 +6,7 @@ on the emulated bus, the board's frames, the state machine, the estimator), on t
 at the campaign's first exposed length, with the sample moved under the tip: the world sees the
 sample's inclusion from the probe's point (``sim.sample_law.fe_world``; a map scene interpolates
 the 3-D factor between solved distances, ``fidelity.inclusion_offsets: interpolated``). The plan
-(``estimation.maps.sampling``) picks each next point from the probes so far; the lab time adds
+(``maps.sampling``) picks each next point from the probes so far; the lab time adds
 each trial's simulated time and the x-y stage's travel at ``campaign.stage_speed_mm_per_s``.
 Probes are appended to ``probes.jsonl`` as they finish, so a killed survey resumes where it
 stopped (every plan is a function of the probes before it)::
@@ -39,7 +39,7 @@ from palpate.campaigns.surveyloop import (
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.estimation.maps import Probe
+from palpate.maps import Probe
 from palpate.robot.trial.outcome import probe_of
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 from palpate.simulation.world import TrialSpec

@@ -1,5 +1,5 @@
 """A map survey's loop, one for the bench and the simulator (issue 40; docs/maps.md): the plan
-(``estimation.maps.sampling``) picks each next point from the probes so far, a probe (a whole
+(``maps.sampling``) picks each next point from the probes so far, a probe (a whole
 trial at that point: ``palpate.campaigns.survey`` in simulation, ``palpate.commands.benchmap``
 on the bench's x-y stage) answers it, the probes are appended to ``probes.jsonl`` as they finish (a
 killed survey resumes where it stopped: every plan is a function of the probes before it), and
@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from palpate.estimation.maps import (
+from palpate.maps import (
     MapError,
     MapSummary,
     Patch,
@@ -31,8 +31,8 @@ from palpate.estimation.maps import (
     plan_for,
     summarise,
 )
-from palpate.estimation.maps.gp import LENGTH_SCALE_MAX
-from palpate.estimation.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
+from palpate.maps.gp import LENGTH_SCALE_MAX
+from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
 from palpate.robot.records.ros2 import nanoseconds
 
 if TYPE_CHECKING:

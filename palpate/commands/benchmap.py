@@ -30,11 +30,11 @@ from palpate.campaigns.surveyloop import (
 )
 from palpate.config.bench import LoadedBench
 from palpate.config.schema import StackConfig
-from palpate.estimation.maps import Probe
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial
 from palpate.lab.trial import PLANNED, BenchOutcome, run_bench_trial
 from palpate.live import LiveView
+from palpate.maps import Probe
 from palpate.robot.trial.outcome import probe_of
 from palpate.robot.xystage import StageMoveError
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from palpate.campaigns.pooled import pooled_by_sample, pooled_fields
-from palpate.estimation.stiffness import summarize
+from palpate.estimation.fits.stiffness import summarize
 from palpate.estimation.verdict import STATUSES
 from palpate.lab.trial import SKIPPED, BenchOutcome
 

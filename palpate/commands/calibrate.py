@@ -15,7 +15,7 @@ One command, by what it is given:
 - trial logs (``.jsonl``) of trials on a rigid reference (a scene's ``rigid: true`` sample, a
   bench trial with ``rigid: true``): the compliance between the stage encoder and the sensor's
   clamp, per tube (the stage on the bench-top), with the robot configuration lines to store it
-  (``estimation/compliance.py``; the estimate subtracts it and an uncalibrated one is
+  (``estimation/fits/compliance.py``; the estimate subtracts it and an uncalibrated one is
   profiled over its plausible range).
 """
 
@@ -30,8 +30,8 @@ from palpate.calibration import calibrate, config_lines
 from palpate.config import load_stack
 from palpate.config.loader import InputError
 from palpate.config.schema import MM, StackConfig
-from palpate.config.stage import rig_key
-from palpate.estimation.compliance import ComplianceFit
+from palpate.estimation.beam.stage import rig_key
+from palpate.estimation.fits.compliance import ComplianceFit
 from palpate.reports.replay import replay
 from palpate.robot.records.log import read_log
 from palpate.sensor.calibration import (

@@ -1,7 +1,7 @@
 """Design a sensor for a tissue modulus range, then try it on simulated phantoms across the range.
 
 ``palpate design --modulus-range 1:10 --unit kPa`` proposes the fiber, wires, tip radius and
-exposed length (``estimation.design``), prints the predicted indentation at buckling at both
+exposed length (``design``), prints the predicted indentation at buckling at both
 ends of the range with every check's margin, then runs a short simulated bench campaign with
 the proposed sensor on phantoms spread over the range (``--no-sim`` skips it). The first line
 says whether the proposal is usable (``palpate.campaigns.designcheck.design_verdict``: every
@@ -18,8 +18,8 @@ import json
 from pathlib import Path
 
 from palpate.commands.design_inputs import register
-from palpate.estimation.design.tipgrating import TipGratingChoice
-from palpate.estimation.design.weight import WeightCheck
+from palpate.design.tipgrating import TipGratingChoice
+from palpate.design.weight import WeightCheck
 from palpate.reports.design import print_report
 from palpate.services.design import DesignRequest, evaluate, sag_text
 

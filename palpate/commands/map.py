@@ -24,9 +24,9 @@ from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, 
 from palpate.campaigns.survey import SurveyResult, run_survey
 from palpate.config import InputError, load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.estimation.maps import STRATEGIES, Probe
 from palpate.exitcodes import EXIT_OK
 from palpate.live import add_live_argument, live_view
+from palpate.maps import STRATEGIES, Probe
 from palpate.progress import progress_bar
 from palpate.reports.mapresults import map_lines, write_map_results
 

@@ -31,8 +31,8 @@ from palpate.config.bench import load_bench
 from palpate.config.loader import InputError
 from palpate.config.scene import CampaignConfig, SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.config.stage import Stage
 from palpate.config.targets import save_target
+from palpate.estimation.beam.stage import Stage
 from palpate.lab.hardware import open_hardware, run_on_hardware
 from palpate.live import LiveView, Publisher, add_live_argument, live_view
 from palpate.robot.indentation import State

@@ -118,7 +118,7 @@ class CampaignConfig:
     max_travel_past_contact_mm: float = field(default=2.5, metadata=limits(gt=0, le=50))
     contact: Literal["event", "fbg", "tip"] = "event"
     # paper: the strain norm past detector_threshold_ue; cusum: the first mode's CUSUM; tip: the
-    # tip grating's load stops rising (estimation.detect_plateau; a sagging mN beam, docs/invivo.md)
+    # tip grating's load stops rising (estimation.detect.plateau; a sagging mN beam, docs/invivo.md)
     detector: Literal["paper", "cusum", "tip"] = "paper"
     detector_threshold_ue: float = field(default=300.0, metadata=limits(gt=0, le=10000))
     outlier_above_kpa: float = field(default=3000.0, metadata=limits(gt=0))
@@ -137,7 +137,7 @@ class CampaignConfig:
     probe: bool | Literal["measure"] | None = None
     misalignment_tolerance_deg: float = field(default=2.0, metadata=limits(gt=0, le=45))
     # The surface's motion along the axis a trial tolerates between the first touch and the
-    # release, measured from the tip grating (estimation/motion.py: breathing, the heart); a
+    # release, measured from the tip grating (estimation/pose/motion.py: breathing, the heart); a
     # trial that moved more is not ok. null: not checked.
     motion_tolerance_mm: float | None = field(default=None, metadata=limits(gt=0, le=50))
     # "board": wait at the stand-off for the ventilator's breath hold (frame status bit 6, the

@@ -351,7 +351,7 @@ class StackConfig:
         ``tube`` (None: the bench-top stage), and whether it is calibrated (else the
         uncalibrated range); a tip grating's element (``sensor.tip_grating.compliance_mm_per_n``)
         is added, travel that is not indentation either. A tube's calibrated value is the tube's
-        own: a rigid reference's fit takes the element out (``estimation.compliance.less``)."""
+        own: a rigid reference's fit takes the element out (``estimation.fits.compliance.less``)."""
         value = (
             self.calibration.stage_compliance_mm_per_n
             if tube is None

@@ -39,8 +39,8 @@ from typing import Literal
 
 import numpy as np
 
-from .corrections import CHI_MAX, ContactLaw, LayerLaw, Material
-from .finite_strain.table import Tip
+from .contact.finite_strain.table import Tip
+from .contact.law import CHI_MAX, ContactLaw, LayerLaw, Material
 
 E_STEP = 0.02
 CHI_STEP = 0.02

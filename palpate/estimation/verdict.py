@@ -35,7 +35,7 @@ from .belief import Hypothesis
 from .jointfit import JointFit
 from .jointfit.beliefcheck import CONTRADICTED
 from .jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
-from .misalignment import Lean
+from .pose.misalignment import Lean
 from .relaxation import RelaxationFit
 
 Status = Literal["ok", "suspect", "none"]
@@ -88,7 +88,7 @@ class TrialFacts:
         compliance_calibrated: the rig's compliance was calibrated (else profiled over a range).
         orientation_verified: the misalignment was measured (probing's fitted normal) or set
             by the operator (no probing); False when probing could not measure a normal.
-        lean: the load's lean measured from the strains (``estimation.misalignment``).
+        lean: the load's lean measured from the strains (``estimation.pose.misalignment``).
         misalignment_sigma: the measured normal's 1-sigma angle (rad), None if not measured.
         relaxation: the relaxation fit of a trial that held (``estimation.relaxation``).
         designed_range: the moduli (Pa) the sensor was designed for, None: not stated.
@@ -97,7 +97,7 @@ class TrialFacts:
             without one (a bow fitted against the strains' own load is not independent).
         probe_reason: what probing said when it measured no normal, None if not known.
         motion: the surface's displacement along the axis between the first touch and the
-            release (m, ``estimation.motion``), None if not measured.
+            release (m, ``estimation.pose.motion``), None if not measured.
         motion_tolerance: the campaign's tolerance on it (m), None: not checked.
     """
 
@@ -128,7 +128,7 @@ EARLY_BUCKLING = 0.5
 BOW_LIMIT = 0.01
 """The bow w0/L past which the shortening read as a straight beam's is not trusted: the bow's
 share of the shortening, 2 z0 z L, is first order in the bending and left out
-(``estimation.southwell``); docs/lung.md measures it (w0/L 4-5 %: -9 to -27 %)."""
+(``estimation.fits.southwell``); docs/lung.md measures it (w0/L 4-5 %: -9 to -27 %)."""
 
 
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:

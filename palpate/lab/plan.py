@@ -19,8 +19,8 @@ from palpate.config.bench import BenchTrialConfig, LoadedBench
 from palpate.config.loader import ConfigError, InputError
 from palpate.config.sample import AssumedConfig
 from palpate.config.schema import MM, TubeConfig
-from palpate.config.stage import Stage
 from palpate.config.targets import TargetConfig, TargetsFile, load_targets
+from palpate.estimation.beam.stage import Stage
 from palpate.robot.drive import JointLimitError, JointState, RollerGearDrive
 from palpate.robot.indentation import TrialPlan
 from palpate.robot.trial.setup import trial_plan

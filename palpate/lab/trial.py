@@ -23,16 +23,16 @@ from palpate.calibration import calibrate, with_compliance
 from palpate.config.bench import LoadedBench
 from palpate.config.sample import UNKNOWN, AssumedConfig
 from palpate.config.schema import MM, StackConfig
-from palpate.estimation.compliance import ComplianceFit
-from palpate.estimation.section import Section
+from palpate.estimation.beam.section import Section
+from palpate.estimation.fits.compliance import ComplianceFit
+from palpate.estimation.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from palpate.estimation.trial.inputs import belief_fields, probe_inputs
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
 from palpate.live import LiveView, Publisher
 from palpate.robot.dynamixel.stats import BusStats
 from palpate.robot.indentation import PLANNED_ENDS
 from palpate.robot.rig import ServoFbgRig
-from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
-from palpate.robot.trial.inputs import belief_fields, probe_inputs
 from palpate.robot.trial.outcome import Outcome, outcome_fields
 from palpate.robot.trial.record import header_common
 from palpate.robot.trial.run import TrialResult

@@ -27,11 +27,11 @@ from matplotlib.lines import Line2D
 
 from palpate.config.loader import InputError
 from palpate.estimation.belief import Hypothesis
+from palpate.estimation.trial.inputs import header_sensor
+from palpate.estimation.trial.relaxed import HOLD_STATE, RECORD_STATES
+from palpate.estimation.trial.states import record_states
 from palpate.reports.replay import known_moduli
 from palpate.robot.records.log import TrialLog, read_log
-from palpate.robot.trial.inputs import header_sensor
-from palpate.robot.trial.relaxed import HOLD_STATE, RECORD_STATES
-from palpate.robot.trial.states import record_states
 
 STATUS_COLOURS = {"ok": "tab:green", "suspect": "tab:orange", "none": "0.6"}
 

@@ -7,9 +7,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from palpate.campaigns.designcheck import UNITS
-from palpate.estimation.design import DesignConstraints
-from palpate.estimation.design.lumen import Lumen, Span
-from palpate.estimation.design.results import CHECKS
+from palpate.design import DesignConstraints
+from palpate.design.lumen import Lumen, Span
+from palpate.design.results import CHECKS
 
 LIMIT_NAMES = {
     "force": "force resolution",

@@ -31,7 +31,7 @@ from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,u
 from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
 
 from palpate.campaigns.survey import SurveyResult
-from palpate.estimation.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
+from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
 from palpate.robot.records.ros2 import HEADER, SEP, TIME, header, nanoseconds
 
 CLOUD = "sensor_msgs/msg/PointCloud2"

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from palpate.campaigns.surveyloop import SurveyResult
-from palpate.estimation.maps import MapSummary
+from palpate.maps import MapSummary
 
 
 def write_map_results(

@@ -26,8 +26,8 @@ from typing import Any
 
 from palpate.config.optics import MM
 from palpate.config.schema import StackConfig
-from palpate.estimation.section import Section
-from palpate.robot.trial.estimate import estimate_from_marks
+from palpate.estimation.beam.section import Section
+from palpate.estimation.trial.estimate import estimate_from_marks
 from palpate.simulation.trial import TrialOutcome
 
 CONTACT_ERRORS_MM: tuple[float, ...] = (0.0, 0.1, -0.1, 0.3, -0.3)

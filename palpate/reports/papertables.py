@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from palpate.estimation.stiffness import summarize
+from palpate.estimation.fits.stiffness import summarize
 from palpate.simulation.trial import TrialOutcome
 
 

@@ -11,7 +11,7 @@ from palpate.calibration import calibrate
 from palpate.campaigns.campaign import median_abs_relative_error, summarize_campaign
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.config.stage import rig_key
+from palpate.estimation.beam.stage import rig_key
 from palpate.reports import verdicts
 from palpate.reports.campaign_table import kpa_fields, sample_records
 from palpate.simulation.trial import TrialOutcome

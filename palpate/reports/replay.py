@@ -3,7 +3,7 @@ the trial's estimates exactly (``palpate replay``, and the fault campaign's data
 
 Both estimates are re-run: the paper's from the marks, and the joint fit (with its verdict and
 the beam's bow, or the compliance on a rigid reference) from the samples with the inputs the
-header records (``robot.trial.inputs``). A log written by an older estimator (inputs version
+header records (``estimation.trial.inputs``). A log written by an older estimator (inputs version
 1, or no inputs at all) replays with what it has: the joint fit is re-run with its point
 values and shown, the report says so (``note``), and only the paper's estimate is compared.
 """
@@ -20,10 +20,8 @@ import numpy as np
 
 from palpate.config.loader import from_mapping
 from palpate.config.schema import SensorConfig, StackConfig, TubeConfig
-from palpate.estimation.section import Section
-from palpate.robot.records.log import TrialLog, TrialLogError, read_log
-from palpate.robot.records.logschema import logged_number
-from palpate.robot.trial.estimate import (
+from palpate.estimation.beam.section import Section
+from palpate.estimation.trial.estimate import (
     EstimatorInputs,
     estimate_from_marks,
     exposed_length_at,
@@ -31,7 +29,9 @@ from palpate.robot.trial.estimate import (
     tip_load_at_buckling,
     verdict_for,
 )
-from palpate.robot.trial.inputs import VERSION, probe_inputs
+from palpate.estimation.trial.inputs import VERSION, probe_inputs
+from palpate.robot.records.log import TrialLog, TrialLogError, read_log
+from palpate.robot.records.logschema import logged_number
 from palpate.robot.trial.record import estimator_keys
 
 MAX_PROBLEMS = 5  # bad lines named in the message (all are counted)

@@ -40,7 +40,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from ..estimation.detect_buckling import BucklingDetector
+from ..estimation.detect.buckling import BucklingDetector
 from .guards import STATE_TIMEOUT, Guards, Observation, limit_violation
 from .plan import (
     PLANNED_ENDS,

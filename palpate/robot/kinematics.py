@@ -35,7 +35,7 @@ import transforms3d
 from numpy.typing import NDArray
 
 from ..config.schema import TubeConfig
-from ..estimation.surface import SurfaceGeometry
+from ..estimation.pose.surface import SurfaceGeometry
 
 Vector = NDArray[np.float64]
 

@@ -1,7 +1,7 @@
 """The surface that probing's touches show, and how far a pose may be from its normal.
 
-:func:`touch_surface` fits the touches' tip centres (``estimation.surface``, or a sphere of the
-radius the operator believes, ``estimation.surface_belief``); :func:`scaled_sigma` is the
+:func:`touch_surface` fits the touches' tip centres (``estimation.pose.surface``, or a sphere of the
+radius the operator believes, ``estimation.pose.surface_belief``); :func:`scaled_sigma` is the
 fitted normal's 1-sigma as the touches' own scatter allows; :func:`allowed_residual` the angle a
 probed pose may have from it.
 """
@@ -13,9 +13,9 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..estimation.corrections import MAX_MISALIGNMENT
-from ..estimation.surface import SurfaceFit, fit_surface
-from ..estimation.surface_belief import fit_sphere_of_radius
+from ..estimation.contact.law import MAX_MISALIGNMENT
+from ..estimation.pose.surface import SurfaceFit, fit_surface
+from ..estimation.pose.surface_belief import fit_sphere_of_radius
 
 FloatArray = NDArray[np.float64]
 

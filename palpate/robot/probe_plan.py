@@ -16,7 +16,7 @@ tube, give or take ``max_tilt`` about their line; with three or more, the fitted
 take three times its normal's uncertainty about the touches' centroid.
 :meth:`ProbeGeometry.sweep_needs` turns that into the advance behind the surface on every ray a
 roll sweeps. :meth:`ProbeGeometry.replan` fits the plane (or, with five touches or more that a
-plane cannot explain, the sphere: ``estimation.surface``) and asks the inverse kinematics of
+plane cannot explain, the sphere: ``estimation.pose.surface``) and asks the inverse kinematics of
 the trial's tube for the roll and advance that meet it orthogonally, near where the plan aimed
 (the first touch); reachable only within the angle and position tolerances.
 """
@@ -31,9 +31,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..config.schema import TubeConfig
-from ..estimation.beamstate import axial_strain
-from ..estimation.corrections import MAX_MISALIGNMENT
-from ..estimation.surface import SurfaceFit, SurfaceGeometry, fit_plane
+from ..estimation.beam.states import axial_strain
+from ..estimation.contact.law import MAX_MISALIGNMENT
+from ..estimation.pose.surface import SurfaceFit, SurfaceGeometry, fit_plane
 from . import kinematics
 from .indentation import TrialPlan
 from .probe_fit import NORMAL_SIGMAS, allowed_residual, scaled_sigma, touch_surface
@@ -72,7 +72,7 @@ class ProbeSettings:
             drive's limits); past it the trial ends ``unreachable`` (inf: no budget).
         surface_radius: the radius (min, max; m) the operator believes a convex sample's
             surface has: the touches are fitted by a sphere of that radius
-            (``estimation.surface_belief``); None: a plane, or a sphere where the touches show
+            (``estimation.pose.surface_belief``); None: a plane, or a sphere where the touches show
             one (the tilt across a tube's cone is not observable on a sphere of unknown radius).
     """
 
@@ -108,9 +108,9 @@ class ProbeGeometry:
         loads: Callable[[FloatArray, FloatArray], FloatArray] | None = None,
     ) -> None:
         """``bending_mode``: the gratings' onset bending shape at an exposed length (m)
-        (``estimation.beamstate.onset_mode``), to take the beam's bow out of its load tick by
+        (``estimation.beam.states.onset_mode``), to take the beam's bow out of its load tick by
         tick; ``loads``: the axial strain P/EA of a record (advances (N,) m, strains (N, G))
-        by the full non-linear beam state (``estimation.beamstate.infer_states``), for the fit
+        by the full non-linear beam state (``estimation.beam.states.infer_states``), for the fit
         of a touch (the onset shape is a few microstrain off once the bow has grown)."""
         self.tube = tube
         self.tip_radius = tip_radius
@@ -351,7 +351,7 @@ def _reason(ik: kinematics.IKSolution, settings: ProbeSettings, normal_sigma: fl
 
 def _curved_hint(ik: kinematics.IKSolution, fit: SurfaceFit, settings: ProbeSettings) -> str:
     """What else the touches may be: one tube's touches on a convex sphere fit a plane to a few
-    micrometres, tilted across the tube's cone (``estimation.surface_belief``)."""
+    micrometres, tilted across the tube's cone (``estimation.pose.surface_belief``)."""
     if ik.reachable or fit.model != "plane" or settings.surface_radius is not None:
         return ""
     return (

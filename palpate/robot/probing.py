@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from ..estimation.surface import load_crossing
+from ..estimation.pose.surface import load_crossing
 from .indentation import REZERO_SETTLE_TICKS, Command, Observation, TrialPlan
 from .probe_plan import ProbeGeometry, ProbeSettings
 from .probe_result import ProbeResult, Touch
@@ -206,7 +206,7 @@ class ProbeRoutine:
 
     def _crossing(self) -> tuple[float, float]:
         """Where the seek's load began and where it reached the threshold: the Hertz power
-        fitted to the whole seek (``estimation.surface.load_crossing``), on the loads of the
+        fitted to the whole seek (``estimation.pose.surface.load_crossing``), on the loads of the
         full beam state when the geometry has them; the last tick's advance (twice) when the
         fit fails."""
         xs = [x for x, _ in self._ramp]

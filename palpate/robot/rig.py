@@ -23,7 +23,7 @@ from typing import Literal
 import numpy as np
 
 from ..config.schema import DEFAULT_CONTROL_RATE_HZ, StackConfig
-from ..estimation.beamstate import axial_strain
+from ..estimation.beam.states import axial_strain
 from ..sensor.clock import Clock
 from ..sensor.reader import FrameReader, SensorPortError
 from ..sensor.strain import StrainChain
@@ -42,7 +42,7 @@ class RigSettings:
     tick: float = 1.0 / DEFAULT_CONTROL_RATE_HZ  # s, control period (the one place it is kept)
     contact: ContactMode = "event"
     fbg_contact_strain: float = 20e-6  # compressive axial strain P/EA that means contact (FBG)
-    # The gratings' onset bending shape (estimation.beamstate.onset_mode) at the exposed length:
+    # The gratings' onset bending shape (estimation.beam.states.onset_mode) at the exposed length:
     # FBG contact reads the axial strain with the bow of a not-quite-straight beam taken out.
     # None: the mean strain (right for a straight beam only).
     fbg_bending_mode: tuple[float, ...] | None = None

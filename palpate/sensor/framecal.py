@@ -5,7 +5,8 @@ strain. Without a separate strain standard, the sensor itself supplies the strai
 rigid reference on the bench-top stage (fixed exposed length L), every bit of stage advance past
 contact x0 goes into the beam's end shortening e = u - x0 (a compliance of the stage only shifts
 x0 once the beam has buckled, the load staying near P_cr), and the elastica gives each grating's
-mean strain at that shortening (``estimation.beam.Beam.grating_strains``, bending and the axial
+mean strain at that shortening (``estimation.beam.model.Beam.grating_strains``, bending and the
+axial
 -P/EA). The frames carry both sides: the stage encoder (u) and the peak wavelengths (the shift
 from the first ``rest_frames`` frames, taken at rest).
 
@@ -28,13 +29,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..config.schema import StackConfig
-from ..estimation.beam import Beam
-from ..estimation.section import sensor_section
+from ..estimation.beam.model import Beam
+from ..estimation.beam.section import grating_intervals, sensor_section
 from ..wire.dynamixel import TICKS_PER_REV
 from ..wire.frameblock import FrameBlock, decode_block
 from .calibration import CalibrationFit, fit_strain_coefficient
 from .parser import layout_from_config
-from .strain import grating_intervals
 
 FloatArray = NDArray[np.float64]
 

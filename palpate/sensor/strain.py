@@ -26,7 +26,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..config.schema import FbgConfig, SensorConfig
+from ..config.schema import FbgConfig
 
 FloatArray = NDArray[np.float64]
 TemperatureMode = Literal["none", "measured", "reference"]
@@ -171,15 +171,3 @@ class StrainChain:
 def strain_noise(sigma_pm: float, k_pm_per_ue: float = 0.424) -> float:
     """Strain noise (dimensionless) from FBG wavelength noise ``sigma_pm``: sigma / k'_eps."""
     return sigma_pm / k_pm_per_ue * 1e-6
-
-
-def grating_intervals(sensor: SensorConfig, exposed_length: float | None = None) -> FloatArray:
-    """Arc-length intervals (m) of the used gratings, shape (N, 2), ``s = L - distance_from_tip``.
-
-    Rows follow ``sensor.used_gratings``; each row is ``(s_start, s_end)`` with start < end.
-    A grating (partly) inside the tube, s < 0, is kept: the caller decides what that means.
-    """
-    L = sensor.exposed_length if exposed_length is None else exposed_length
-    centres = L - np.asarray(sensor.grating_centres_from_tip(), dtype=np.float64)
-    half = sensor.grating_length / 2
-    return np.stack([centres - half, centres + half], axis=1)

@@ -46,20 +46,20 @@ from palpate.config.loader import InputError, write_yaml
 from palpate.config.optics import MM
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.estimation.design import (
+from palpate.design import (
     DesignConstraints,
     DesignResult,
     DesignSpace,
     design_sensor,
 )
-from palpate.estimation.design.lumen import LAW_DEPTH_RATIO, Lumen, span_range
-from palpate.estimation.design.tipgrating import (
+from palpate.design.lumen import LAW_DEPTH_RATIO, Lumen, span_range
+from palpate.design.tipgrating import (
     TipGratingChoice,
     choose_tip_grating,
     tip_grating_for_resolution,
 )
-from palpate.estimation.design.weight import SAG_LIMIT, WeightCheck, weight_check
-from palpate.estimation.section import composite_section
+from palpate.design.weight import SAG_LIMIT, WeightCheck, weight_check
+from palpate.estimation.beam.section import composite_section
 from palpate.progress import progress_bar
 from palpate.reports.design import CheckRun, payload
 from palpate.reports.lumen import LumenReport

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..estimation.beam import Beam
+from ..estimation.beam.model import Beam
 from .contact_table import GridPhysics, grating_strains
 from .equilibrium import TissueLaw, solve_contact
 from .equilibrium.law import FloatArray

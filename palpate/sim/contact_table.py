@@ -21,8 +21,8 @@ from typing import NamedTuple, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from ..estimation.beam import Beam
-from ..estimation.elastica import post_buckling
+from ..estimation.beam.elastica import post_buckling
+from ..estimation.beam.model import Beam
 from .equilibrium import ContactEffects, TissueLaw, solve_contact
 from .oblique import ObliqueContact, slip_law, slip_strains
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..estimation.elastica.constants import P_CRIT
+from ..estimation.beam.elastica.constants import P_CRIT
 
 Vector = NDArray[np.float64]
 STANDARD_GRAVITY = 9.80665  # m/s^2

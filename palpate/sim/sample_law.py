@@ -7,7 +7,8 @@ keys map onto them (the one place that does).
   sphere on a layer of the sample's thickness and lateral radius on a rigid base, ``bonded`` or
   sliding, ``material`` linear or neo-Hookean, the tip-surface ``friction`` mapped to the FE's
   contact condition by :func:`contact_condition`. Independent of the estimator: nothing on this
-  path imports ``estimation.hertz`` or ``estimation.corrections`` (tests/sim/test_fem_imports.py).
+  path imports ``estimation.contact.hertz`` or ``estimation.contact.law``
+  (tests/sim/test_fem_imports.py).
   A half-space (``thickness_mm: null``, or ``finite_thickness: false``) is a block 200 R deep
   and 200 R wide (within 0.4 % of Sneddon's half-space to delta = R, docs/tissue-fe.md). The
   FE is always a sphere at finite depth, so ``large_indentation`` does not apply to it.

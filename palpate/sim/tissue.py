@@ -25,7 +25,8 @@ model (Eq. 13), so that the simulated stiffness estimate carries a real model er
                      b0 =  (0.6387 - 1.0277 nu + 1.5164 nu^2)/(1 - nu)
   non-bonded layer:  a0 = -0.347 (3 - 2 nu)/(1 - nu),   b0 = 0.056 (5 - 2 nu)/(1 - nu)
                      (as published; used here: a0 = -1.1676, b0 = 0.4161 at every nu, from
-                     the frictionless base's kernel, ``estimation.layer.layer_coefficients``)
+                     the frictionless base's kernel,
+                     ``estimation.contact.layer.layer_coefficients``)
 
   ``chi = sqrt(R delta)/h`` in the paper, which is ``a/h`` for Hertz; we use ``a/h`` with the
   contact radius of the active law so the correction composes with Sneddon (an approximation:
@@ -49,8 +50,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..estimation.layer import dimitriadis_bracket, layer_coefficients
-from ..estimation.sneddon import sneddon_bracket, sneddon_bracket_at, sneddon_y, sneddon_y_at
+from ..estimation.contact.layer import dimitriadis_bracket, layer_coefficients
+from ..estimation.contact.sneddon import (
+    sneddon_bracket,
+    sneddon_bracket_at,
+    sneddon_y,
+    sneddon_y_at,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -114,7 +120,7 @@ class TissueModel:
 
     def layer_coefficients(self) -> tuple[float, float, float, float]:
         """The Dimitriadis bracket coefficients (k1, k2, k3, k4) of chi^1..chi^4
-        (``estimation.layer.layer_coefficients``: the non-bonded ones from the
+        (``estimation.contact.layer.layer_coefficients``: the non-bonded ones from the
         frictionless base's kernel, not Dimitriadis' nu-dependent fit)."""
         return layer_coefficients(self.poisson, self.bonded)
 

@@ -34,8 +34,8 @@ import numpy as np
 
 from ..config.scene import FidelityConfig
 from ..config.schema import FbgConfig, SensorConfig
-from ..estimation.section import Section
-from ..estimation.surface import SurfaceGeometry
+from ..estimation.beam.section import Section
+from ..estimation.pose.surface import SurfaceGeometry
 from ..wire.frame import Status
 from .board import BoardSample
 from .breathing import Breath

@@ -3,7 +3,7 @@
 The estimator is told the sample as the operator believes it (the scene's ``assumed:``, else
 the sample's own values), the rig's calibrated compliance, the campaign's limits and the
 misalignment the controller knows (probing's measure, else the plan's IK residual); never the
-simulator's switches or the world's truth (``robot.trial.estimate`` runs the estimators).
+simulator's switches or the world's truth (``estimation.trial.estimate`` runs the estimators).
 """
 
 from __future__ import annotations
@@ -15,10 +15,10 @@ from typing import Any
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.config.stage import Stage
+from palpate.estimation.beam.stage import Stage
+from palpate.estimation.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
+from palpate.estimation.trial.inputs import belief_fields
 from palpate.robot.probe_result import ProbeResult
-from palpate.robot.trial.estimate import EstimatorInputs, TrialEstimate, estimate_trial
-from palpate.robot.trial.inputs import belief_fields
 from palpate.robot.trial.outcome import Outcome, outcome_fields
 from palpate.robot.trial.run import TrialResult
 from palpate.robot.trial.setup import sensor_section

@@ -22,7 +22,7 @@ from typing import Any, Literal, Protocol
 from palpate.config.sample import AssumedConfig
 from palpate.config.scene import CampaignConfig, FidelityConfig, SceneConfig
 from palpate.config.schema import ServoBusConfig, StackConfig
-from palpate.config.stage import Stage
+from palpate.estimation.beam.stage import Stage
 from palpate.live import LiveView
 from palpate.robot.drive import DriveController
 from palpate.robot.dynamixel.driver import DynamixelBus

@@ -21,7 +21,7 @@ from palpate.config.loader import InputError
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import FidelityConfig, SceneConfig
 from palpate.config.schema import StackConfig, TubeConfig
-from palpate.config.stage import Stage
+from palpate.estimation.beam.stage import Stage
 from palpate.robot import kinematics
 from palpate.robot.drive import TRANSLATION, RollerGearDrive
 from palpate.robot.dynamixel.units import rad_from_ticks

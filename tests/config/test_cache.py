@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from palpate.config.cache import cached_arrays
+from palpate.store.cache import cached_arrays
 
 
 def test_arrays_are_built_once_and_read_back_exactly(

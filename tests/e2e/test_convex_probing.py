@@ -12,7 +12,7 @@ import pytest
 from palpate.config import load, load_stack, resolve
 from palpate.config.sample import UNKNOWN, AssumedConfig
 from palpate.config.scene import SceneConfig
-from palpate.robot.trial.inputs import belief_fields
+from palpate.estimation.trial.inputs import belief_fields
 from palpate.simulation.result import estimator_inputs
 from palpate.simulation.trial import TrialSpec, run_sim_trial, trial_geometry, trial_sample
 

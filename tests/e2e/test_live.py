@@ -19,7 +19,7 @@ from websockets.sync.client import connect
 from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.estimation.section import sensor_section
+from palpate.estimation.beam.section import sensor_section
 from palpate.live import HOST, TOPICS, LiveView
 from palpate.simulation.trial import TrialSpec, run_sim_trial
 

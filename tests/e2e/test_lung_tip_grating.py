@@ -14,8 +14,8 @@ import pytest
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
+from palpate.estimation.trial.states import LOADING_STATES
 from palpate.reports.replay import replay
-from palpate.robot.trial.states import LOADING_STATES
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 
 pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out

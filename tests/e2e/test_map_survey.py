@@ -14,7 +14,7 @@ from palpate.campaigns.survey import PROBES_FILE, moved_scene, read_probes, run_
 from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.estimation.maps import Probe
+from palpate.maps import Probe
 from palpate.robot.records.recording import read_recording
 from palpate.sim.fem3d.offsets import MapWorld
 from palpate.sim.sample_law import fe_world

@@ -14,7 +14,7 @@ import pytest
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import ServoBusConfig
-from palpate.estimation.section import euler_load
+from palpate.estimation.beam.section import euler_load
 from palpate.robot.trial.setup import sensor_section
 from palpate.sim.board import BoardEmulator, BoardFaults
 from palpate.sim.clock import VirtualClock

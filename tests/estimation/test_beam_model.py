@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.estimation.beam import Beam
-from palpate.estimation.elastica import E_OVER_L_MAX, E_OVER_L_PEAK, post_buckling
-from palpate.estimation.section import composite_section, euler_load
+from palpate.estimation.beam.elastica import E_OVER_L_MAX, E_OVER_L_PEAK, post_buckling
+from palpate.estimation.beam.model import Beam
+from palpate.estimation.beam.section import composite_section, euler_load
 
 SECTION = composite_section(0.115e-3, 67e9, 0.1e-3, 55e9, 4)
 L = 0.042

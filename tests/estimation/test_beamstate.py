@@ -1,13 +1,14 @@
-"""Axial load and shortening from grating strains with a free axial load (estimation.beamstate)."""
+"""Axial load and shortening from grating strains with a free axial load
+(estimation.beam.states)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from palpate.estimation.beam import Beam
-from palpate.estimation.beamstate import infer_states
-from palpate.estimation.section import composite_section
+from palpate.estimation.beam.model import Beam
+from palpate.estimation.beam.section import composite_section
+from palpate.estimation.beam.states import infer_states
 
 SECTION = composite_section(0.115e-3, 67e9, 0.1e-3, 55e9, 4)
 CENTRES_FROM_TIP = np.array([10e-3, 18e-3, 26e-3])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from palpate.estimation.belief import CHI_STEP, E_STEP, Belief
-from palpate.estimation.corrections import CHI_MAX, ContactLaw
+from palpate.estimation.contact.law import CHI_MAX, ContactLaw
 
 R = 3.5e-3
 

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from palpate.estimation.belief import Belief
-from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.contact.law import ContactLaw
 from palpate.estimation.jointfit import joint_fit
 from palpate.estimation.jointfit.beliefcheck import CONTRADICTED, alternatives
 from palpate.estimation.verdict import TrialFacts, judge

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.estimation.elastica import P_CRIT
-from palpate.estimation.elastica.constants import X1
-from palpate.estimation.section import composite_section, euler_load
+from palpate.estimation.beam.elastica import P_CRIT
+from palpate.estimation.beam.elastica.constants import X1
+from palpate.estimation.beam.section import composite_section, euler_load
 
 PAPER = {
     "fiber_radius": 0.115e-3,

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from palpate.estimation.corrections import (
+from palpate.estimation.contact.hertz import hertz_force
+from palpate.estimation.contact.law import (
     ContactLaw,
     shape_values,
     validity_warnings,
 )
-from palpate.estimation.hertz import hertz_force
-from palpate.estimation.layer import (
+from palpate.estimation.contact.layer import (
     BONDED_B0_PER_MOMENT,
     SLIDING_A0,
     SLIDING_B0,
@@ -23,7 +23,7 @@ from palpate.estimation.layer import (
     layer_coefficients,
     layer_kernel,
 )
-from palpate.estimation.sneddon import sneddon_y, sneddon_y_at
+from palpate.estimation.contact.sneddon import sneddon_y, sneddon_y_at
 from palpate.sim.tissue import TissueModel
 
 R = 3.5e-3

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.design import (
+from palpate.design import (
     CHECKS,
     DesignConstraints,
     DesignSpace,
@@ -17,10 +17,10 @@ from palpate.estimation.design import (
     hertz_depth,
     imperfection_state,
 )
-from palpate.estimation.elastica import fast
-from palpate.estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING
-from palpate.estimation.hertz import hertz_force
-from palpate.estimation.section import composite_section, euler_load
+from palpate.estimation.beam.elastica import fast
+from palpate.estimation.beam.elastica.constants import MODE_REACTION, MODE_SHORTENING
+from palpate.estimation.beam.section import composite_section, euler_load
+from palpate.estimation.contact.hertz import hertz_force
 
 KPA = 1e3
 PAPER = SensorDesign(
@@ -188,7 +188,7 @@ def test_bad_inputs_raise() -> None:
 
 
 def test_the_tip_grating_is_the_most_sensitive_whose_range_carries_twice_p_cr() -> None:
-    from palpate.estimation.design.tipgrating import choose_tip_grating
+    from palpate.design.tipgrating import choose_tip_grating
 
     lung = choose_tip_grating(18e-3, 1.0)  # the 1-20 kPa design: P_cr 18 mN, 1 pm of noise
     assert lung.sensitivity_pm_per_mn == 8.0
@@ -202,8 +202,8 @@ def test_the_tip_grating_is_the_most_sensitive_whose_range_carries_twice_p_cr() 
 
 
 def test_the_weight_check_is_the_cantilevers_sag_and_its_tip_budget() -> None:
-    from palpate.estimation.design.weight import SAG_LIMIT, STANDARD_GRAVITY, weight_check
-    from palpate.estimation.section import composite_section
+    from palpate.design.weight import SAG_LIMIT, STANDARD_GRAVITY, weight_check
+    from palpate.estimation.beam.section import composite_section
 
     EI = composite_section(40e-6, 67e9, 25e-6, 55e9, 2).EI  # the 1-20 kPa design's beam
     L = 28.5e-3
@@ -220,7 +220,7 @@ def test_the_weight_check_is_the_cantilevers_sag_and_its_tip_budget() -> None:
 
 def test_a_beam_softer_across_the_fibers_plane_fails_the_plane_check() -> None:
     """A beam buckles about its softest axis: the gratings see only their own plane's bending."""
-    from palpate.estimation.section import across_rigidity, composite_section
+    from palpate.estimation.beam.section import across_rigidity, composite_section
 
     paper = composite_section(115e-6, 67e9, 100e-6, 55e9, 4)
     assert across_rigidity(115e-6, 67e9, 100e-6, 55e9, 4) / paper.EI == pytest.approx(

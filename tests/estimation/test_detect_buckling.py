@@ -6,15 +6,16 @@ import numpy as np
 import pytest
 
 from palpate.config.schema import SensorConfig
-from palpate.estimation.detect_buckling import (
+from palpate.estimation.beam.elastica.constants import MODE_SLOPE_INTEGRAL, X1
+from palpate.estimation.beam.section import grating_intervals
+from palpate.estimation.detect.buckling import (
     CusumDetector,
     NormThreshold,
     cusum,
     first_mode_pattern,
     first_mode_strains,
 )
-from palpate.estimation.elastica.constants import MODE_SLOPE_INTEGRAL, X1
-from palpate.sensor.strain import grating_intervals, strain_noise
+from palpate.sensor.strain import strain_noise
 
 L = 0.042
 DY = 0.153e-3
@@ -134,9 +135,9 @@ def test_detector_errors() -> None:
 
 
 def test_first_mode_agrees_with_the_elastica_and_the_strain_fit_inverts_it() -> None:
-    """Cross-check against ``estimation.beam`` (the full elastica) near onset."""
-    beam_mod = pytest.importorskip("palpate.estimation.beam")
-    from palpate.estimation.strain_fit import fit_strains
+    """Cross-check against ``estimation.beam.model`` (the full elastica) near onset."""
+    beam_mod = pytest.importorskip("palpate.estimation.beam.model")
+    from palpate.estimation.fits.strain_fit import fit_strains
 
     EI, EA = 1.18e-4, 9696.0
     beam = beam_mod.Beam(EI, EA, DY, L)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from palpate.estimation.detect_contact import baseline_deviation, ratio_of_variances
+from palpate.estimation.detect.contact import baseline_deviation, ratio_of_variances
 
 X0 = 1.0e-3
 

@@ -1,4 +1,4 @@
-"""Buckling from the tip grating's load (``estimation.detect_plateau``): the beam is a force
+"""Buckling from the tip grating's load (``estimation.detect.plateau``): the beam is a force
 limiter, so the load stops rising when it buckles; a sagging beam's bending does not fool it."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from palpate.estimation.detect_plateau import LoadPlateau
+from palpate.estimation.detect.plateau import LoadPlateau
 
 STEP = 2e-6  # m of advance a sample: 0.5 mm/s at 250 Hz
 P_CR = 4e-3  # N, the 2.8 mm channel's beam

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_bvp, solve_ivp
 
-from palpate.estimation.elastica import (
+from palpate.estimation.beam.elastica import (
     E_OVER_L_MAX,
     E_OVER_L_PEAK,
     E_OVER_L_TIP_NORMAL,
@@ -16,7 +16,7 @@ from palpate.estimation.elastica import (
     P_PEAK,
     post_buckling,
 )
-from palpate.estimation.elastica.constants import X1
+from palpate.estimation.beam.elastica.constants import X1
 
 
 def _rhs(p: float, r: float):  # type: ignore[no-untyped-def]

@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.estimation.elastica import E_OVER_L_MAX, post_buckling, shooting
-from palpate.estimation.elastica.fast import surrogate
+from palpate.estimation.beam.elastica import E_OVER_L_MAX, post_buckling, shooting
+from palpate.estimation.beam.elastica.fast import surrogate
 
 GRID = np.unique(
     np.concatenate(

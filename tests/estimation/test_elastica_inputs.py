@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.elastica import (
+from palpate.estimation.beam.elastica import (
     E_OVER_L_MAX,
     ElasticaConvergenceError,
     accurate,
     post_buckling,
     shooting,
 )
-from palpate.estimation.elastica.closed_form import wavenumber
+from palpate.estimation.beam.elastica.closed_form import wavenumber
 
 
 @pytest.mark.parametrize("method", ["accurate", "fast", "shooting"])

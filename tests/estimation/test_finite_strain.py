@@ -1,4 +1,4 @@
-"""The neo-Hookean departure (``estimation.finite_strain``): its parts against closed forms,
+"""The neo-Hookean departure (``estimation.contact.finite_strain``): its parts against closed forms,
 the shipped rows against a fresh solve, and the whole against the world's finite elements (an
 independent method: the FE solves the nonlinear problem, the departure is second-order
 elasticity on the exact linear layer's fields)."""
@@ -12,15 +12,15 @@ import numpy as np
 import pytest
 
 from benchmarks.finite_strain import fe_departure
-from palpate.estimation.corrections import ContactLaw, shape_values
-from palpate.estimation.finite_strain.departure import _density, cubic_energy, departure_row
-from palpate.estimation.finite_strain.fields import Grid, pressure_transform, surface
-from palpate.estimation.finite_strain.table import (
+from palpate.estimation.contact.finite_strain.departure import _density, cubic_energy, departure_row
+from palpate.estimation.contact.finite_strain.fields import Grid, pressure_transform, surface
+from palpate.estimation.contact.finite_strain.table import (
     INVERSE_THICKNESS,
     POISSON,
     departure_curve,
     load_rows,
 )
+from palpate.estimation.contact.law import ContactLaw, shape_values
 
 
 def _neo_hookean(H: tuple[float, ...], nu: float) -> float:
@@ -115,7 +115,7 @@ def test_curve_rejects_bad_input() -> None:
 
 
 def test_deep_the_neo_hookean_law_widens_and_past_its_rows_is_flagged() -> None:
-    from palpate.estimation.corrections import validity_warnings
+    from palpate.estimation.contact.law import validity_warnings
     from palpate.estimation.jointfit.modelform import FINITE_STRAIN, model_form
 
     neo = ContactLaw(1.3e-3, 0.45, 10e-3, True, material="neo-hookean", tip="sticking")

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.estimation.hertz import (
+from palpate.estimation.contact.hertz import (
     contact_radius,
     hertz_force,
     hertz_modulus,

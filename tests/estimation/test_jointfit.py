@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.contact.law import ContactLaw
 from palpate.estimation.jointfit import JointFit, joint_fit
 from palpate.estimation.jointfit.grid import closed_form, grid_fits
 from palpate.estimation.jointfit.profile import profiles

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from palpate.estimation.belief import Belief
-from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.contact.law import ContactLaw
 from palpate.estimation.jointfit import joint_fit
 from palpate.estimation.jointfit.envelope import BEFORE_WARNING
 

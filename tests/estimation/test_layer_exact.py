@@ -9,16 +9,16 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from palpate.estimation.corrections import ContactLaw
-from palpate.estimation.layer import (
+from palpate.estimation.contact.law import ContactLaw
+from palpate.estimation.contact.layer import (
     SLIDING_A0,
     dimitriadis_bracket,
     dimitriadis_coefficients,
     layer_kernel,
 )
-from palpate.estimation.layer_exact import LayerSolveError, kernel_transform, solve_contact
-from palpate.estimation.layer_table import layer_factor, paraboloid_bracket
-from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
+from palpate.estimation.contact.layer_exact import LayerSolveError, kernel_transform, solve_contact
+from palpate.estimation.contact.layer_table import layer_factor, paraboloid_bracket
+from palpate.estimation.contact.sneddon import sneddon_bracket, sneddon_y
 from palpate.sim.fem.generate import SHIPPED
 from palpate.sim.fem.table import SHIPPED_DIR, read_table
 

@@ -1,4 +1,4 @@
-"""The inclusion's extent, a disc seen through the tip's contact (``estimation.maps.extent``), on
+"""The inclusion's extent, a disc seen through the tip's contact (``maps.extent``), on
 synthetic probes: unit tests of its arithmetic. Its accuracy on the finite-element world, where
 the disc errs outward, is judged through whole surveys in docs/maps.md."""
 
@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.maps import Patch, Probe, StiffnessMap, plan_for, summarise
-from palpate.estimation.maps.extent import ExtentError, contact_points, fit_extent, overlap
-from palpate.estimation.maps.probes import Z95
+from palpate.maps import Patch, Probe, StiffnessMap, plan_for, summarise
+from palpate.maps.extent import ExtentError, contact_points, fit_extent, overlap
+from palpate.maps.probes import Z95
 
 PATCH = Patch.from_mm((-10.0, -10.0, 10.0, 10.0))
 E0 = 314e3

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.maps import (
+from palpate.maps import (
     Active,
     MapError,
     Patch,
@@ -18,8 +18,8 @@ from palpate.estimation.maps import (
     raster_points,
     summarise,
 )
-from palpate.estimation.maps.probes import SIGMA_FLOOR, SUSPECT_INFLATION, Z95
-from palpate.estimation.maps.region import log_threshold
+from palpate.maps.probes import SIGMA_FLOOR, SUSPECT_INFLATION, Z95
+from palpate.maps.region import log_threshold
 
 PATCH = Patch.from_mm((-10.0, -10.0, 10.0, 10.0))
 E0 = 314e3

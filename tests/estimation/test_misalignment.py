@@ -9,10 +9,16 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.beamstate import onset_mode
+from palpate.estimation.beam.section import euler_load
+from palpate.estimation.beam.states import onset_mode
 from palpate.estimation.jointfit import JointFit
-from palpate.estimation.misalignment import DETECT_CHI2, Lean, capacity, lateral_shape, measure_lean
-from palpate.estimation.section import euler_load
+from palpate.estimation.pose.misalignment import (
+    DETECT_CHI2,
+    Lean,
+    capacity,
+    lateral_shape,
+    measure_lean,
+)
 from palpate.estimation.verdict import TrialFacts, judge
 
 EI, EA, DY = 1.18e-4, 9.7e3, 1.53e-4  # the shipped sensor's section (N m^2, N, m)
@@ -108,7 +114,7 @@ def test_ok_requires_a_verified_orientation() -> None:
 
 
 def test_a_slide_names_the_angle_its_path_shows_even_without_a_number() -> None:
-    """The verdict reads the slipping tip's misalignment (``estimation.slip_path``); a trial
+    """The verdict reads the slipping tip's misalignment (``estimation.pose.slip_path``); a trial
     with no modulus (its load never reached the pinned beam's) says it slid as well."""
     slid = Lean(True, "", math.radians(2.0), math.radians(1.0), 200, 0.5, 2e4,
                 math.radians(12.2), math.radians(0.5))  # fmt: skip

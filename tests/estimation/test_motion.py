@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from palpate.estimation.jointfit import JointFit
-from palpate.estimation.motion import surface_motion
+from palpate.estimation.pose.motion import surface_motion
 from palpate.estimation.verdict import MOTION_SHARE, TrialFacts, judge
 
 K = 30.0  # N/m^1.5: a soft layer's Hertz-like law

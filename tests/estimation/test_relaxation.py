@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.contact.law import ContactLaw
 from palpate.estimation.relaxation import RelaxationRecord, fit_relaxation, memory_basis
 from palpate.sim.viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid, force_history
 

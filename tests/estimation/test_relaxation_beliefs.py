@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from palpate.estimation.belief import Belief
-from palpate.estimation.corrections import ContactLaw
+from palpate.estimation.contact.law import ContactLaw
 from palpate.estimation.jointfit import JointFit
 from palpate.estimation.jointfit.beliefcheck import CONTRADICTED
 from palpate.estimation.relaxation import (

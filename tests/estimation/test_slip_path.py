@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.slip_path import bow_shortening, measure_slip_path
+from palpate.estimation.pose.slip_path import bow_shortening, measure_slip_path
 
 EI, EA, DY, L = 1.18e-4, 9.7e3, 1.53e-4, 42e-3  # the paper's sensor (N m^2, N, m, m)
 FROM_TIP = np.array([[16.5e-3, 19.5e-3], [24.5e-3, 27.5e-3], [32.5e-3, 35.5e-3]])

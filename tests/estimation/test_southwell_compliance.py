@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.compliance import ComplianceFit, fit_compliance, pooled
-from palpate.estimation.elastica.constants import MODE_SHORTENING
-from palpate.estimation.southwell import southwell
+from palpate.estimation.beam.elastica.constants import MODE_SHORTENING
+from palpate.estimation.fits.compliance import ComplianceFit, fit_compliance, pooled
+from palpate.estimation.fits.southwell import southwell
 
 L = 42e-3
 P_CR = 1.35
@@ -87,7 +87,7 @@ def test_no_load_is_no_calibration_and_pooled_takes_the_envelope() -> None:
 
 
 def test_a_known_compliance_in_series_comes_out_of_the_fit_and_its_interval() -> None:
-    from palpate.estimation.compliance import ComplianceFit, less
+    from palpate.estimation.fits.compliance import ComplianceFit, less
 
     fit = ComplianceFit(True, "ok", 1e-4, 0.9e-4, 1.1e-4, 0.01, 50)
     tube = less(fit, 2e-5)  # a tip grating's element, 0.02 mm/N

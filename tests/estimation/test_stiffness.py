@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.estimation.hertz import hertz_modulus
-from palpate.estimation.section import euler_load
-from palpate.estimation.stiffness import (
+from palpate.estimation.beam.section import euler_load
+from palpate.estimation.contact.hertz import hertz_modulus
+from palpate.estimation.fits.stiffness import (
     EULER_FIXED_PINNED,
     PAPER_OUTLIER_ABOVE,
     StiffnessEstimate,

@@ -1,4 +1,4 @@
-"""Surface geometry and its fits to touched points (estimation.surface)."""
+"""Surface geometry and its fits to touched points (estimation.pose.surface)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.surface import (
+from palpate.estimation.pose.surface import (
     SurfaceGeometry,
     fit_plane,
     fit_sphere,

@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.surface import fit_plane
-from palpate.estimation.surface_belief import fit_sphere_of_radius, sphere_of_radius
+from palpate.estimation.pose.surface import fit_plane
+from palpate.estimation.pose.surface_belief import fit_sphere_of_radius, sphere_of_radius
 
 APEX_TO_CONTACT = 66e-3  # m, as on this robot's tubes (docs/orientation.md)
 SIGMA = 3e-6  # m, a touch's noise along its ray

@@ -12,7 +12,7 @@ import pytest
 
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.estimation.surface import SurfaceGeometry
+from palpate.estimation.pose.surface import SurfaceGeometry
 from palpate.robot.probe_plan import _distance_to_line, _model
 from palpate.robot.probing import ProbeRoutine, Touch
 from palpate.robot.trial.setup import prober_for, trial_plan

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from palpate.estimation.surface import SurfaceFit
+from palpate.estimation.pose.surface import SurfaceFit
 from palpate.robot.probe_fit import allowed_residual
 from palpate.robot.probe_fit import scaled_sigma as _scaled_sigma
 

@@ -13,11 +13,11 @@ import pytest
 from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
+from palpate.estimation.trial.inputs import header_sensor
+from palpate.estimation.trial.states import record_states
 from palpate.robot.records.export import export
 from palpate.robot.records.log import TrialLog, read_log
 from palpate.robot.records.recording import Recording, read_recording
-from palpate.robot.trial.inputs import header_sensor
-from palpate.robot.trial.states import record_states
 from palpate.robot.trial.tipforce import axial_loads
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 

@@ -1,9 +1,9 @@
-"""The relaxation fit's contact bracket from the joint fit (``robot.trial.relaxed``)."""
+"""The relaxation fit's contact bracket from the joint fit (``estimation.trial.relaxed``)."""
 
 from __future__ import annotations
 
 from palpate.estimation.jointfit import JointFit
-from palpate.robot.trial.relaxed import contact_bracket
+from palpate.estimation.trial.relaxed import contact_bracket
 
 
 def test_the_bracket_holds_an_x0_refined_past_the_grids_interval() -> None:

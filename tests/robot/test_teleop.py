@@ -11,7 +11,7 @@ import pytest
 from palpate.commands.teleop_screen import render
 from palpate.config.schema import DEFAULT_TUBES, DriveConfig
 from palpate.config.targets import load_targets, save_target
-from palpate.estimation.detect_buckling import NormThreshold
+from palpate.estimation.detect.buckling import NormThreshold
 from palpate.robot.indentation import (
     Guards,
     IndentationMachine,

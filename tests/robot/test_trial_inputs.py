@@ -9,7 +9,7 @@ import pytest
 from palpate.config.loader import ConfigError, from_mapping
 from palpate.config.sample import AssumedConfig
 from palpate.config.schema import StackConfig
-from palpate.robot.trial.inputs import EstimatorInputs, belief_fields
+from palpate.estimation.trial.inputs import EstimatorInputs, belief_fields
 
 TRUTH = {"thickness": 6e-3, "bonded": False, "poisson": 0.45}
 
@@ -132,7 +132,7 @@ def test_rows_whose_gratings_are_off_the_beam_are_left_out_of_the_fit() -> None:
     import numpy as np
 
     from palpate.config import load_stack, resolve
-    from palpate.robot.trial.estimate import MIN_POINTS, fit_record
+    from palpate.estimation.trial.estimate import MIN_POINTS, fit_record
     from palpate.robot.trial.setup import sensor_section
 
     stack = load_stack(resolve("robot-lung-lumen-2.8.yaml"))

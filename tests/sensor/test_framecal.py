@@ -8,10 +8,9 @@ import numpy as np
 import pytest
 
 from palpate.config.schema import MM, StackConfig
-from palpate.estimation.beam import Beam
-from palpate.estimation.section import sensor_section
+from palpate.estimation.beam.model import Beam
+from palpate.estimation.beam.section import grating_intervals, sensor_section
 from palpate.sensor.framecal import calibrate_frames, read_frames
-from palpate.sensor.strain import grating_intervals
 from palpate.wire.dynamixel import TICKS_PER_REV
 from palpate.wire.frameblock import FrameBlock, encode_block
 

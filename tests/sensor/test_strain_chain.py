@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from palpate.config.schema import FbgConfig, SensorConfig
+from palpate.estimation.beam.section import grating_intervals
 from palpate.sensor.strain import (
     StrainChain,
     capture_baseline,
-    grating_intervals,
     strain_noise,
     wavelength_to_strain,
 )

@@ -10,7 +10,7 @@ import pytest
 from palpate.config.loader import ConfigError, from_mapping
 from palpate.config.scene import FidelityConfig
 from palpate.config.schema import FbgConfig, StackConfig, TipGratingConfig
-from palpate.estimation.detect_contact import difference_sigma
+from palpate.estimation.detect.contact import difference_sigma
 from palpate.sensor.reader import FrameReader
 from palpate.sensor.tipforce import TipForceChain
 from palpate.sim.board import BoardEmulator, BoardSample

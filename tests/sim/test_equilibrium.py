@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from palpate.estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
+from palpate.estimation.beam.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
 from palpate.sim.equilibrium import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,
@@ -255,7 +255,7 @@ def test_equilibrium_property(E: float, u: float, fx: ContactEffects, layered: b
 
 
 def test_with_the_real_beam() -> None:
-    beam_mod = pytest.importorskip("palpate.estimation.beam")
+    beam_mod = pytest.importorskip("palpate.estimation.beam.model")
     beam = beam_mod.Beam(EI=EI, EA=EA, fiber_offset=1.5e-4, length=0.045)
     tissue = TissueModel(modulus=5e5)
     s = solve_contact(U, beam, tissue)
@@ -325,7 +325,7 @@ def test_recalled_evaluations_change_no_bit(
 ) -> None:
     """The solver recalls its last law evaluations for its outputs; evaluating every call
     afresh must give the same arrays bit for bit (pre-onset, mixed and post-onset grids)."""
-    beam_mod = pytest.importorskip("palpate.estimation.beam")
+    beam_mod = pytest.importorskip("palpate.estimation.beam.model")
     beam = beam_mod.Beam(EI=EI, EA=EA, fiber_offset=1.5e-4, length=0.042)
     tissue = TISSUES[1]
     u = GRIDS[grid]

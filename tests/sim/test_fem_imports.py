@@ -23,11 +23,11 @@ WORLD = [
 ]
 WORLD += sorted((ROOT / "sim" / "equilibrium").glob("*.py"))
 LAWS = (
-    "estimation.hertz",
-    "estimation.corrections",
-    "estimation.sneddon",
-    "estimation.layer_table",
-    "estimation.layer_exact",
+    "estimation.contact.hertz",
+    "estimation.contact.law",
+    "estimation.contact.sneddon",
+    "estimation.contact.layer_table",
+    "estimation.contact.layer_exact",
     "estimation.jointfit",
     "estimation.relaxation",
     "sim.tissue",
@@ -35,7 +35,8 @@ LAWS = (
 
 
 def ours(name: str) -> str:
-    """An import's name within the stack: ``palpate.estimation.hertz`` -> ``estimation.hertz``
+    """An import's name within the stack: ``palpate.estimation.contact.hertz`` ->
+    ``estimation.contact.hertz``
     (the layers are installed under ``palpate``)."""
     return name.removeprefix("palpate.")
 
@@ -121,7 +122,7 @@ print(" ".join(sorted(m.removeprefix("palpate.") for m in sys.modules
 """
 
 SECTION = """
-from palpate.estimation.section import composite_section
+from palpate.estimation.beam.section import composite_section
 def section(sensor):
     return composite_section(sensor.fiber_radius, sensor.fiber_modulus, sensor.wire_radius,
                              sensor.wire_modulus, sensor.wire_count)
@@ -130,7 +131,8 @@ def section(sensor):
 
 def test_the_world_on_the_fe_level_never_loads_the_estimators_laws(tmp_path: Path) -> None:
     """The world's FE path (sample -> law -> tabulated and stepped equilibrium, grating strains)
-    runs in a fresh interpreter without ever importing estimation.hertz or .corrections: what
+    runs in a fresh interpreter without ever importing estimation.contact.hertz or .corrections:
+    what
     is never loaded is never called. (The beam mechanics of estimation are allowed.)"""
     (tmp_path / "robot_free_section.py").write_text(SECTION)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
@@ -139,5 +141,5 @@ def test_the_world_on_the_fe_level_never_loads_the_estimators_laws(tmp_path: Pat
     )
     assert out.returncode == 0, out.stderr
     loaded = set(out.stdout.split())
-    assert "estimation.beam" in loaded  # the scan sees the estimation modules that do load
+    assert "estimation.beam.model" in loaded  # the scan sees the estimation modules that do load
     assert not loaded & set(LAWS)

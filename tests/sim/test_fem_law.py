@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
 
-from palpate.estimation.hertz import hertz_force
+from palpate.estimation.contact.hertz import hertz_force
 from palpate.sim.fem.generate import SHIPPED
 from palpate.sim.fem.law import FeTissueLaw, pchip_slopes
 from palpate.sim.fem.table import load_table

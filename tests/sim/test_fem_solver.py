@@ -12,9 +12,9 @@ import math
 import numpy as np
 import pytest
 
-from palpate.estimation.hertz import hertz_force
-from palpate.estimation.layer import dimitriadis_coefficients
-from palpate.estimation.sneddon import sneddon_bracket, sneddon_y
+from palpate.estimation.contact.hertz import hertz_force
+from palpate.estimation.contact.layer import dimitriadis_coefficients
+from palpate.estimation.contact.sneddon import sneddon_bracket, sneddon_y
 from palpate.sim.fem.problem import LayerProblem
 from palpate.sim.fem.solver import SolverOptions, solve_indentation
 

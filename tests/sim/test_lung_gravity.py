@@ -13,7 +13,7 @@ from scipy.integrate import cumulative_trapezoid
 from palpate.campaigns.campaign import campaign_trials
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
-from palpate.estimation.elastica.constants import P_CRIT
+from palpate.estimation.beam.elastica.constants import P_CRIT
 from palpate.robot import kinematics
 from palpate.robot.trial.setup import sensor_section
 from palpate.sim.gravity import BeamWeight, sensing_axis

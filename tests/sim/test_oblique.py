@@ -10,7 +10,7 @@ import pytest
 
 from palpate.config import load_stack
 from palpate.config.scene import FidelityConfig
-from palpate.estimation.section import sensor_section
+from palpate.estimation.beam.section import sensor_section
 from palpate.sim.contact_table import GridPhysics, equilibrium_on_grid
 from palpate.sim.equilibrium import ContactEffects
 from palpate.sim.gravity import BeamWeight, offset_to_mode, sensing_axis

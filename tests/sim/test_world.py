@@ -9,8 +9,8 @@ import pytest
 
 from palpate.config import load_stack
 from palpate.config.scene import FidelityConfig
-from palpate.estimation.beam import Beam
-from palpate.estimation.section import sensor_section
+from palpate.estimation.beam.model import Beam
+from palpate.estimation.beam.section import sensor_section
 from palpate.sim.contact_table import ContactTable, equilibrium_on_grid
 from palpate.sim.equilibrium import solve_contact
 from palpate.sim.tissue import TissueModel

@@ -4,11 +4,11 @@ The paper's estimate (Eqs. 13-14) uses two instants, contact and buckling, so an
 contact event goes straight into the indentation (E ~ delta^-1.5: 0.1 mm on 0.8 mm is 20 %). As
 AFM tools do, we treat the contact position x0 as a free parameter and fit the whole loading
 record instead: for every sample i (stage advance u_i, axial load P_i and beam shortening e_i
-from the strains, ``estimation.beamstate``)::
+from the strains, ``estimation.beam.states``)::
 
     delta_i = u_i - x0 - e_i,        P_i = P0 + E f(delta_i)        (f = 0 for delta_i <= 0)
 
-with f the corrected contact law (``estimation.corrections.ContactLaw``). Samples before
+with f the corrected contact law (``estimation.contact.law.ContactLaw``). Samples before
 contact (f = 0) pin the baseline P0; loading samples give the curve's shape (which places x0)
 and its scale (E).
 

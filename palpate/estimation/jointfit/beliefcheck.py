@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..belief import Belief
-from ..corrections import ContactLaw
+from ..contact.law import ContactLaw
 from .envelope import other_forms
 from .grid import GridFit, grid_fits
 from .pooling import FORM, STATED, Curve

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..belief import Hypothesis
-from ..corrections import ContactLaw, validity_warnings
+from ..contact.law import ContactLaw, validity_warnings
 from .modelform import model_form, widened
 from .noise import Noise
 from .profile import Candidate, Profile, family_profiles

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..belief import Belief, Hypothesis
-from ..corrections import ContactLaw
+from ..contact.law import ContactLaw
 from .beliefcheck import contradictions, law_curves
 from .envelope import Found, envelope, profile_hypotheses
 from .noise import (
@@ -59,7 +59,7 @@ def joint_fit(
             is known of the sample and the rig's compliance, with ranges profiled over).
         sigma_force, sigma_shortening: (N,) or scalar standard deviations of P (N, > 0), e (m).
         encoder_resolution: one encoder count q of stage advance (m): q^2/12 of depth variance.
-        contact_guess: a first guess of x0 (m), e.g. ``estimation.detect_contact``'s: one more
+        contact_guess: a first guess of x0 (m), e.g. ``estimation.detect.contact``'s: one more
             point of the scan, which covers the whole record regardless.
         search: how far before the record's first stage position x0 may lie (m, >= 0).
         confidence: the interval's level, in (0, 1); f_scale: the robust loss's soft threshold,

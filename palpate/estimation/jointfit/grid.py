@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ..corrections import ContactLaw, shape_values
+from ..contact.law import ContactLaw, shape_values
 
 FloatArray = NDArray[np.float64]
 GridFit = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
@@ -72,7 +72,7 @@ def grid_fits(
       0.8 ms instead of 0.03 ms). Median joint fit per bench trial: whole (K, N) matrices
       16 ms, blocks of 16384 depths 8.7 ms, of 4096 12 ms (numpy's per-call overhead);
     - the laws share one evaluation of the half-space part
-      (``estimation.corrections.shape_values``).
+      (``estimation.contact.law.shape_values``).
     The sums run in depth order instead of record order: the same fit up to rounding.
 
     Laws that differ in tip, Poisson ratio or half-space law go in one call per group: each

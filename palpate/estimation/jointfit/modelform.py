@@ -1,7 +1,7 @@
 """Step 5 of the joint fit: the model-form uncertainty, a documented bound on what the
 estimator's closed forms leave out, added to E's interval.
 
-The force law (Sneddon's sphere times the Dimitriadis bracket, ``estimation.corrections``) is
+The force law (Sneddon's sphere times the Dimitriadis bracket, ``estimation.contact.law``) is
 exact for none of the tissues the sensor meets. What the literature says about its accuracy:
 
 - thin layer (Dimitriadis et al. 2002, Biophys. J. 82:2798, and the exact linear-elastic layer
@@ -9,7 +9,7 @@ exact for none of the tissues the sensor meets. What the literature says about i
   chi = sqrt(R delta)/h; truncated, it departs from the exact layer by about 1 % at chi = 0.2 and
   by several % at chi = 0.5 (bonded, nu -> 0.5; see docs/tissue-fe.md): a relative error of about
   ``LAYER_SERIES * chi^2`` (0.25: 1 % at 0.2, 6 % at 0.5);
-- depth (Hertz's range): Hertz holds for delta/R <= 0.1 (``estimation.hertz``); Sneddon's
+- depth (Hertz's range): Hertz holds for delta/R <= 0.1 (``estimation.contact.hertz``); Sneddon's
   sphere removes the geometric part of the error beyond (-0.1 delta/R to first order), but it is
   still linear elasticity, and soft tissue and gels stiffen at finite strain (neo-Hookean and
   second-order elastic solutions depart from the linear ones at first order in delta/R: Lin et
@@ -17,7 +17,8 @@ exact for none of the tissues the sensor meets. What the literature says about i
   error of about ``FINITE_STRAIN * delta/R`` (0.1: 1 % at Hertz's limit, 3 % at delta/R = 0.3).
 
 - a neo-Hookean law (``ContactLaw.material``) carries the finite-strain departure D to second
-  order (``estimation.finite_strain``): the correction moves the estimate, not the bound. The
+  order (``estimation.contact.finite_strain``): the correction moves the estimate, not the bound.
+  The
   material is the operator's belief, and tissue's second-order behaviour (Mooney-Rivlin,
   Ogden, Fung) departs from the neo-Hookean one at the same order as the correction itself, so
   the literature's ``FINITE_STRAIN * strain`` stays; it is raised where the correction's own
@@ -25,7 +26,7 @@ exact for none of the tissues the sensor meets. What the literature says about i
   second order is within 0.2 % of the world's finite elements to delta/h = 0.2 with a
   frictionless tip, 0.44 % at 0.3: docs/layer-law.md), plus ``FINITE_STRAIN (delta/R - 0.3)``
   past delta/R = 0.3, where it is checked (1-3 % off at 0.6); a sticking tip's departure
-  bridges two limits (``estimation.finite_strain.departure``): half their spread in
+  bridges two limits (``estimation.contact.finite_strain.departure``): half their spread in
   quadrature.
 
 The two are independent and combine in quadrature, at the deepest indentation of the record
@@ -43,8 +44,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..corrections import ContactLaw
-from ..finite_strain.table import stick_spread_curve
+from ..contact.finite_strain.table import stick_spread_curve
+from ..contact.law import ContactLaw
 
 LAYER_SERIES = 0.25
 FINITE_STRAIN = 0.1

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..corrections import ContactLaw
+from ..contact.law import ContactLaw
 from .grid import GridFit, grid_fits
 
 FloatArray = NDArray[np.float64]

@@ -25,9 +25,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..beam.elastica._scipy import least_squares
 from ..belief import Hypothesis
-from ..corrections import ContactLaw
-from ..elastica._scipy import least_squares
+from ..contact.law import ContactLaw
 from .record import Record
 from .result import FitFailed
 from .scan import SCAN_POINTS, SCAN_STEP, Start

@@ -2,7 +2,7 @@
 
 The search window is the whole record: from ``search`` before its first stage position (the
 record may start in contact) to its deepest ``depth_base`` (contact at the very end). A first
-guess (``estimation.detect_contact``) only adds a grid point: a late or missing guess cannot
+guess (``estimation.detect.contact``) only adds a grid point: a late or missing guess cannot
 confine the fit. E and P0 are linear, so at each x0 of a grid at most SCAN_STEP apart (at
 least SCAN_POINTS, at most MAX_SCAN_POINTS points) they have a closed form
 (``grid.grid_fits``, weights 1/sigma_P^2): the global basin without local-minimum trouble. The

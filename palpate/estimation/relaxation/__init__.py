@@ -3,11 +3,11 @@
 A buckled beam is nearly a constant-force spring, so holding the stage after buckling is a creep
 test the gratings see: the tissue creeps, the beam straightens a little, and the strains give
 the load P (or a tip grating's) and the beam's end shortening e at every tick
-(``estimation.beamstate``). With the contact position x0, the depth is ``delta = u - x0 - e -
+(``estimation.beam.states``). With the contact position x0, the depth is ``delta = u - x0 - e -
 c P`` as in the joint fit.
 
 Model (quasi-linear viscoelasticity, the form-free way). With f the elastic contact law's shape
-(``estimation.corrections.ContactLaw.shape``, F = E f), a relaxation modulus written as a
+(``estimation.contact.law.ContactLaw.shape``, F = E f), a relaxation modulus written as a
 spectrum of fixed time constants tau_k (a generalised Maxwell body)::
 
     P_i - P0 = E_inf f(delta_i) + sum_k c_k h_k(t_i),

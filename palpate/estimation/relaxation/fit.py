@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..corrections import ContactLaw
+from ..contact.law import ContactLaw
 from ..jointfit.pooling import chi2_quantile
 from .result import FloatArray, RelaxationFit, RelaxationRecord
 from .spectrum import (

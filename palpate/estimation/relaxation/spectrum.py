@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import nnls  # type: ignore[import-untyped,unused-ignore]
 
-from ..corrections import ContactLaw
+from ..contact.law import ContactLaw
 from ..jointfit.noise import lag1
 from .result import RelaxationRecord
 

@@ -178,7 +178,7 @@ SECTION = {
     "I_fiber": req(number(ge=0)),
     "I_wires": req(number(ge=0)),
 }
-ESTIMATOR = {  # robot.trial.estimate.EstimatorInputs
+ESTIMATOR = {  # estimation.trial.estimate.EstimatorInputs
     "kind": req(one_of("bench", "robot")),
     "exposed_length": req(LENGTH),
     "flush_translation": req(POSITION),

@@ -7,7 +7,7 @@ keeps what the JSON log keeps. The file is written unchunked (every message a re
 own, readable up to the last byte written) and closed with MCAP's summary and footer; the
 header record is the recording's metadata ``palpate.trial`` (its keys, values as JSON). When
 the trial ends the tip force is derived from every sample's strains (the estimator's beam
-states, ``robot.trial.states``) and written as ``/tip/wrench``, and on the robot each sample's
+states, ``estimation.trial.states``) and written as ``/tip/wrench``, and on the robot each sample's
 tip pose as ``/tf``.
 
 :func:`robot.records.export.export` converts an existing log; :func:`read_recording` reads one

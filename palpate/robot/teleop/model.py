@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 from ...config.schema import DriveConfig, TubeConfig
 from ...config.targets import TargetConfig
-from ...estimation.detect_buckling import BucklingDetector
+from ...estimation.detect.buckling import BucklingDetector
 from .. import kinematics
 from ..drive import JointState, RollerGearDrive
 from ..indentation import (

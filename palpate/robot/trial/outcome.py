@@ -17,20 +17,20 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ...estimation.compliance import ComplianceFit
+from ...estimation.fits.compliance import ComplianceFit
+from ...estimation.fits.southwell import SouthwellFit
+from ...estimation.fits.stiffness import StiffnessEstimate
 from ...estimation.jointfit import JointFit
-from ...estimation.misalignment import Lean
+from ...estimation.pose.misalignment import Lean
 from ...estimation.relaxation import RelaxationFit
-from ...estimation.southwell import SouthwellFit
-from ...estimation.stiffness import StiffnessEstimate
+from ...estimation.trial.estimate import TrialEstimate
 from ...estimation.verdict import Verdict
 from ..plan import TrialMarks
-from .estimate import TrialEstimate
 from .record import estimate_row
 from .run import TrialResult
 
 if TYPE_CHECKING:  # the maps' package imports scikit-learn: not at a trial's start-up
-    from ...estimation.maps.probes import Probe
+    from ...maps.probes import Probe
 
 
 @dataclass(kw_only=True)
@@ -60,7 +60,7 @@ class Outcome:
     lean: Lean | None = None
     relaxation: RelaxationFit | None = None
     relaxed_verdict: Verdict | None = None
-    motion: float | None = None  # m, the surface's along the axis (estimation.motion)
+    motion: float | None = None  # m, the surface's along the axis (estimation.pose.motion)
 
     @property
     def status(self) -> str:
@@ -113,7 +113,7 @@ def probe_of(
     when it succeeded, the verdict's status and reasons (the trial's end when it has none), the
     lab time it took (s, with the stage's travel to it) and, given the sensor's ``tip_radius``
     (m), the contact's radius at the fit's deepest point, sqrt(R delta)."""
-    from ...estimation.maps.probes import Probe
+    from ...maps.probes import Probe
 
     jf, v = o.joint, o.verdict
     ok = jf is not None and jf.success and jf.modulus is not None

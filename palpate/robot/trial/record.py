@@ -5,7 +5,7 @@ The simulator and the bench write the same keys here, so ``palpate replay`` read
 the same way (see :mod:`robot.records.log` for the file format). Every key the estimator adds is
 written here, and read back here (:func:`recorded_verdict`), tolerant of logs that predate it:
 
-- header ``estimator``: the joint fit's inputs (``robot.trial.inputs.EstimatorInputs``, with
+- header ``estimator``: the joint fit's inputs (``estimation.trial.inputs.EstimatorInputs``, with
   ``version``; version 2 added the belief's ranges, the compliance and the verdict's limits);
 - estimate ``joint``: the joint fit (``JointFit.as_dict``); ``verdict``: ``{status, reasons}``
   (ok, suspect or none); ``southwell``: the beam's bow fitted from the record. A log without
@@ -20,19 +20,19 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any, Protocol
 
 from ...config.schema import SensorConfig, TubeConfig
-from ...estimation.compliance import ComplianceFit
+from ...estimation.beam.section import Section
+from ...estimation.fits.compliance import ComplianceFit
+from ...estimation.fits.southwell import SouthwellFit
+from ...estimation.fits.stiffness import StiffnessEstimate
 from ...estimation.jointfit import JointFit
-from ...estimation.misalignment import Lean
+from ...estimation.pose.misalignment import Lean
 from ...estimation.relaxation import RelaxationFit
-from ...estimation.section import Section
-from ...estimation.southwell import SouthwellFit
-from ...estimation.stiffness import StiffnessEstimate
 from ...estimation.verdict import Verdict
 from ..indentation import TrialPlan
 
 if TYPE_CHECKING:  # types only: estimate.py is above this module
-    from .estimate import TrialEstimate
-    from .inputs import EstimatorInputs
+    from ...estimation.trial.estimate import TrialEstimate
+    from ...estimation.trial.inputs import EstimatorInputs
 
 UNITS = "SI (m, N, Pa, rad, s); strains dimensionless"
 

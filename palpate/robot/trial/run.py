@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
-from ...estimation.detect_buckling import BucklingDetector
+from ...estimation.detect.buckling import BucklingDetector
 from ...sensor.clock import Clock
 from ..indentation import (
     PLANNED_ENDS,
@@ -67,7 +67,7 @@ class TrialResult:
     duration: float  # simulated or wall seconds on the rig's clock
     transitions: list[Transition] = field(default_factory=list)
     # (state after the tick, advance m, strains) per tick, as in the log's sample records: the
-    # whole-record estimators (``robot.trial.estimate``) read it without a log
+    # whole-record estimators (``estimation.trial.estimate``) read it without a log
     record: list[tuple[str, float, tuple[float, ...]]] = field(default_factory=list)
     times: list[float] = field(default_factory=list)  # each record row's time (s, the rig's clock)
     # each row's tip-grating load (N; NaN where the rig had none), empty without a tip grating

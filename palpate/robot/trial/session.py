@@ -24,12 +24,12 @@ from typing import Any, Protocol
 
 from ...config.scene import CampaignConfig
 from ...config.schema import StackConfig
+from ...estimation.trial.estimate import TrialEstimate
 from ...sensor.clock import Clock
 from ...sensor.strain import StrainChain
 from ..guards import Observation
 from ..indentation import Prober, State, TrialPlan
 from ..records.log import TrialLogWriter
-from .estimate import TrialEstimate
 from .record import estimate_record
 from .run import Rig, TrialResult, end_record, run_trial
 from .setup import detector_for, guards_for

@@ -17,13 +17,13 @@ from numpy.typing import NDArray
 
 from ...config.scene import CampaignConfig
 from ...config.schema import MM, StackConfig, TubeConfig
-from ...estimation.beamstate import infer_states, onset_mode
-from ...estimation.detect_buckling import BucklingDetector, CusumDetector, NormThreshold
-from ...estimation.detect_plateau import LoadPlateau
-from ...estimation.elastica.constants import P_CRIT
-from ...estimation.section import Section
-from ...estimation.section import sensor_section as section_of
-from ...sensor.strain import StrainChain, grating_intervals
+from ...estimation.beam.elastica.constants import P_CRIT
+from ...estimation.beam.section import Section, grating_intervals
+from ...estimation.beam.section import sensor_section as section_of
+from ...estimation.beam.states import infer_states, onset_mode
+from ...estimation.detect.buckling import BucklingDetector, CusumDetector, NormThreshold
+from ...estimation.detect.plateau import LoadPlateau
+from ...sensor.strain import StrainChain
 from ...wire.dynamixel import TICKS_PER_REV
 from ..indentation import STATE_TIMEOUT, Guards, Prober, TrialPlan
 from ..probing import ProbeGeometry, ProbeRoutine, ProbeSettings, probe_budget
@@ -164,7 +164,7 @@ def rig_settings(
     """The rig's settings for a campaign at a control period ``tick`` (s), the one place a trial
     keeps it. ``sync_to_clock`` only for emulators on a virtual clock. With ``exposed_length``
     (m) FBG contact reads the axial strain with the beam's onset bow taken out
-    (``estimation.beamstate.axial_strain``)."""
+    (``estimation.beam.states.axial_strain``)."""
     mode = None
     if exposed_length is not None:
         fiber_offset = sensor_section(stack).fiber_offset

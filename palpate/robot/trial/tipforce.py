@@ -1,19 +1,18 @@
 """The tip force a trial's recording derives at its close (``/tip/wrench``): the tip grating's
 load where the sensor has one, else the axial load of the estimator's beam states. Handed to
 ``robot.records`` (the log writer and the export) as a function: the records serialise, this
-module computes. And the tip grating's load at a record's buckling mark (the verdict's)."""
+module computes."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from ...estimation.trial.inputs import header_sensor
+from ...estimation.trial.states import RowLoads, on_beam, record_lengths, states_at
 from ..records.recording import McapRecorder
-from .inputs import header_sensor
-from .states import RowLoads, on_beam, record_lengths, states_at
 
 
 def axial_loads(recorder: McapRecorder, known: RowLoads | None = None) -> list[float] | None:
@@ -22,7 +21,7 @@ def axial_loads(recorder: McapRecorder, known: RowLoads | None = None) -> list[f
     beam state (strains incomplete, or the sensor not yet out of the tube: such rows are never
     handed to the beam model); None when the header lacks the sensor, the section or the
     estimator's inputs. ``known``: loads the trial's estimate already inferred, by row
-    (``robot.trial.states.row_loads``); only the other rows are inferred here (each row's
+    (``estimation.trial.states.row_loads``); only the other rows are inferred here (each row's
     state is its own least-squares fit: a row inferred in another batch differs in the last
     bits of its Gauss-Newton stop, below 1e-12 relative)."""
     tips = [x.tip_force for x in recorder.samples]
@@ -64,16 +63,3 @@ def _whole(strains: list[Any], gratings: int) -> bool:
     return len(strains) == gratings and all(
         isinstance(v, int | float) and math.isfinite(v) for v in strains
     )
-
-
-def tip_load_at_buckling(
-    rows: Sequence[tuple[str, float, Sequence[float]]],
-    tip_forces: Sequence[float | None] | None,
-) -> float | None:
-    """The tip grating's load (N) at the first row past the buckling mark, None without one."""
-    if not tip_forces or len(tip_forces) != len(rows):
-        return None
-    for (state, _, _), f in zip(rows, tip_forces, strict=True):
-        if state == "buckled":
-            return None if f is None or not math.isfinite(f) else float(f)
-    return None

@@ -5,7 +5,7 @@ shortening ``e`` and, when the tube tip is compliant, tube-tip deflection ``P / 
 
     u = delta + e + P / k_tube,        F_tissue(delta) = P_beam(e) = P
 
-The beam law is an ``estimation.beam.Beam`` (pre-buckling ``EA e / L``, then the extensible
+The beam law is an ``estimation.beam.model.Beam`` (pre-buckling ``EA e / L``, then the extensible
 clamped-pinned elastica) or an :class:`AxialLaw` built around any ``force(e)`` callable.
 
 How it is solved (and why). ``u(e)`` is increasing on the rising branch, but near the buckling

@@ -1,7 +1,8 @@
 """What the equilibrium solver is given: the beam's axial law, the tissue's law and the contact
 world's effects.
 
-The beam law is an ``estimation.beam.Beam`` (anything shaped like :class:`BeamLike`), wrapped by
+The beam law is an ``estimation.beam.model.Beam`` (anything shaped like :class:`BeamLike`), wrapped
+by
 :func:`axial_law`, or an :class:`AxialLaw` built around any ``force(e)`` callable; the tissue is
 anything shaped like :class:`TissueLaw` (the closed forms of ``sim.tissue``, the finite-element
 tables of ``sim.fem``, a rigid block); :class:`ContactEffects` switches on the tube tip's
@@ -46,7 +47,7 @@ class TissueLaw(Protocol):
 
 
 class BeamLike(Protocol):
-    """What the solver needs from ``estimation.beam.Beam``."""
+    """What the solver needs from ``estimation.beam.model.Beam``."""
 
     @property
     def EA(self) -> float: ...
@@ -75,7 +76,7 @@ class AxialLaw:
         max_shortening: the largest ``e`` (m) the law accepts; ``None`` means
             ``DEFAULT_MAX_E_OVER_L * length``.
         reaction_sign: the sign ``lateral_force`` gives R in the buckling direction (+1, or -1
-            for ``estimation.beam.Beam``, which reports R in paper Eq. 7's sign, <= 0); the
+            for ``estimation.beam.model.Beam``, which reports R in paper Eq. 7's sign, <= 0); the
             imperfection's reaction is given the same sign.
     """
 
@@ -97,7 +98,7 @@ class AxialLaw:
 
 
 def axial_law(beam: BeamLike | AxialLaw) -> AxialLaw:
-    """Wrap an ``estimation.beam.Beam`` (or pass an AxialLaw through).
+    """Wrap an ``estimation.beam.model.Beam`` (or pass an AxialLaw through).
 
     Takes ``beam.max_shortening()`` when the beam has it, and R's sign from Beam's convention
     (paper Eq. 7: R <= 0 in the buckling direction)."""

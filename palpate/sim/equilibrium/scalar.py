@@ -3,7 +3,7 @@
 Why a twin: numpy costs ~1 us per operation even on 0-d arrays, so the array path takes
 0.2-2 ms for one position; in plain floats the same two stages take ~15-60 us with Hertz
 tissue and a closed-form beam law, up to ~0.3 ms with Sneddon + thin layer + imperfection
-(dominated by the tissue inverse inside the bracketing steps); with ``estimation.beam.Beam``
+(dominated by the tissue inverse inside the bracketing steps); with ``estimation.beam.model.Beam``
 its elastica evaluations on 0-d arrays dominate past the onset (~1 ms). The trial itself
 tabulates the equilibrium on grids (:mod:`sim.contact_table`), so this path serves callers of
 one position.
@@ -20,7 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
+from ...estimation.beam.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
 from .law import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,

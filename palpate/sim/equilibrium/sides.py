@@ -35,7 +35,7 @@ from typing import Generic, TypeVar
 
 import numpy as np
 
-from ...estimation.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
+from ...estimation.beam.elastica.constants import MODE_REACTION, MODE_SHORTENING, P_CRIT
 from .law import (
     DEFAULT_MAX_E_OVER_L,
     AxialLaw,

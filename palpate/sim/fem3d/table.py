@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ...config.cache import cache_dir, parameter_record, record_key, write_npz
+from ...store.cache import cache_dir, parameter_record, record_key, write_npz
 from .problem import InclusionProblem
 
 FloatArray = NDArray[np.float64]

@@ -1,0 +1,2 @@
+"""Pose and geometry: the surface and its normal (``surface``, ``surface_belief``), the sensor's
+lean on it (``misalignment``, ``slip_path``) and the surface's motion (``motion``)."""
