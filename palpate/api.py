@@ -17,7 +17,6 @@ call; examples/ holds whole scripts.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -118,27 +117,18 @@ def simulate(
     >>> [trial.as_dict()["verdict"] for trial in report.trials]
     ['ok', 'ok']
     """
-    from palpate.campaigns.campaign import run_campaign
-    from palpate.reports.payload import campaign_report, run_folder_files
+    from palpate.services import campaign
 
     stack = robot if robot is not None else load_robot(scene.robot)
-    specs = trials(scene, seed=seed, robot=stack)[:limit]
-    folder = None if out is None else Path(out)
-    log_dir = None if folder is None else folder / "logs"
-    if log_dir is not None:
-        log_dir.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
-    outcomes = run_campaign(specs, scene, stack, log_dir=log_dir, workers=workers)
-    run = {
-        "run_dir": None if folder is None else str(folder),
-        "log_dir": None if log_dir is None else str(log_dir),
-        "transport": scene.transport,
-        "seed": seed,
-    }
-    report = campaign_report(scene, stack, outcomes, run=run, wall=time.perf_counter() - t0)
-    if folder is not None:
-        run_folder_files(report, folder)
-    return report
+    executor = "serial" if workers <= 1 else "process"
+    request = campaign.CampaignRequest(
+        (), seed=seed, workers=workers, executor=executor, limit=limit, plots=False
+    )
+    c = campaign.prepared(scene, stack, request)
+    if out is not None:
+        campaign.in_folder(c, Path(out))
+    campaign.run([c], request)
+    return campaign.finish(c, request).report
 
 
 def simulate_trial(

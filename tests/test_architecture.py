@@ -2,11 +2,11 @@
 functions count too): which package may import which, and no two packages importing each other.
 
 wire, store (the cache of solved tables) and maps (probes and the map of them) import nothing
-of ours; config only config; estimation only estimation, config and store; design (the sensor's
-search) estimation and config; sensor wire, estimation, config; robot wire, maps, estimation,
-sensor, config; sim wire, store, estimation, config (never sensor, robot or palpate); palpate, the
-application, anything. Every layer is a folder of ``palpate/`` (the card's ones also linked at the
-root). Tests are not a layer.
+of ours; config only config; estimation only estimation, config and store; sensor_design (the
+sensor's design search) estimation and config; sensor wire, estimation, config; robot wire, maps,
+estimation, sensor, config; sim wire, store, estimation, config (never sensor, robot or palpate);
+palpate, the application, anything. Every layer is a folder of ``palpate/`` (the card's ones
+also linked at the root). Tests are not a layer.
 """
 
 from __future__ import annotations
@@ -26,13 +26,13 @@ ALLOWED: dict[str, frozenset[str]] = {
     "maps": frozenset({"maps"}),
     "config": frozenset({"config"}),
     "estimation": frozenset({"estimation", "config", "store"}),
-    "design": frozenset({"design", "estimation", "config"}),
+    "sensor_design": frozenset({"sensor_design", "estimation", "config"}),
     "sensor": frozenset({"sensor", "wire", "estimation", "config"}),
     "robot": frozenset({"robot", "wire", "maps", "estimation", "sensor", "config"}),
     "sim": frozenset({"sim", "wire", "store", "estimation", "config"}),
     "palpate": frozenset(
-        {"palpate", "wire", "store", "maps", "config", "estimation", "design", "sensor", "robot"}
-        | {"sim"}
+        {"palpate", "wire", "store", "maps", "config", "estimation", "sensor_design", "sensor"}
+        | {"robot", "sim"}
     ),
 }
 PACKAGES = frozenset(ALLOWED)
@@ -308,6 +308,16 @@ def palpate_room_breaks(root: Path = ROOT) -> list[str]:
             if target != source and target not in PALPATE_ROOMS[source]:
                 bad.append(f"{path.relative_to(root)}:{line} {name} ({source} -> {target})")
     return bad
+
+
+def test_no_package_hides_a_name_of_the_api() -> None:
+    """``palpate.<name>`` is the API's function: a sub-package of that name would replace it on
+    the package once imported (``palpate.design`` did)."""
+    import palpate
+
+    folders = {init.parent.name for init in (ROOT / "palpate").glob("*/__init__.py")}
+    modules = {p.stem for p in (ROOT / "palpate").glob("*.py")}
+    assert not (folders | modules) & set(palpate.__all__)
 
 
 def test_every_module_of_palpate_lives_in_a_known_room() -> None:

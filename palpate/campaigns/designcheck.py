@@ -23,9 +23,9 @@ from palpate.config.loader import InputError
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig, TipGratingConfig
-from palpate.design import DesignEvaluation
-from palpate.design.tipgrating import TipGratingChoice
-from palpate.design.weight import linear_mass
+from palpate.sensor_design import DesignEvaluation
+from palpate.sensor_design.tipgrating import TipGratingChoice
+from palpate.sensor_design.weight import linear_mass
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}

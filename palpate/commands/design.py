@@ -18,9 +18,9 @@ import json
 from pathlib import Path
 
 from palpate.commands.design_inputs import register
-from palpate.design.tipgrating import TipGratingChoice
-from palpate.design.weight import WeightCheck
 from palpate.reports.design import print_report
+from palpate.sensor_design.tipgrating import TipGratingChoice
+from palpate.sensor_design.weight import WeightCheck
 from palpate.services.design import DesignRequest, evaluate, sag_text
 
 EXIT_NO_DESIGN = 2

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from palpate.campaigns.designcheck import METHODS, UNITS, error_summary, relative_error
-from palpate.design import DesignConstraints, DesignEvaluation, DesignResult
+from palpate.sensor_design import DesignConstraints, DesignEvaluation, DesignResult
 from palpate.simulation.trial import TrialOutcome
 
 

@@ -7,9 +7,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from palpate.campaigns.designcheck import UNITS
-from palpate.design import DesignConstraints
-from palpate.design.lumen import Lumen, Span
-from palpate.design.results import CHECKS
+from palpate.sensor_design import DesignConstraints
+from palpate.sensor_design.lumen import Lumen, Span
+from palpate.sensor_design.results import CHECKS
 
 LIMIT_NAMES = {
     "force": "force resolution",

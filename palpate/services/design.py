@@ -46,24 +46,24 @@ from palpate.config.loader import InputError, write_yaml
 from palpate.config.optics import MM
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.design import (
-    DesignConstraints,
-    DesignResult,
-    DesignSpace,
-    design_sensor,
-)
-from palpate.design.lumen import LAW_DEPTH_RATIO, Lumen, span_range
-from palpate.design.tipgrating import (
-    TipGratingChoice,
-    choose_tip_grating,
-    tip_grating_for_resolution,
-)
-from palpate.design.weight import SAG_LIMIT, WeightCheck, weight_check
 from palpate.estimation.beam.section import composite_section
 from palpate.progress import progress_bar
 from palpate.reports.design import CheckRun, payload
 from palpate.reports.lumen import LumenReport
 from palpate.sensor.strain import strain_noise
+from palpate.sensor_design import (
+    DesignConstraints,
+    DesignResult,
+    DesignSpace,
+    design_sensor,
+)
+from palpate.sensor_design.lumen import LAW_DEPTH_RATIO, Lumen, span_range
+from palpate.sensor_design.tipgrating import (
+    TipGratingChoice,
+    choose_tip_grating,
+    tip_grating_for_resolution,
+)
+from palpate.sensor_design.weight import SAG_LIMIT, WeightCheck, weight_check
 from palpate.simulation.trial import TrialOutcome
 from palpate.wire.dynamixel import TICKS_PER_REV
 

@@ -7,7 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from palpate.design import (
+from palpate.estimation.beam.elastica import fast
+from palpate.estimation.beam.elastica.constants import MODE_REACTION, MODE_SHORTENING
+from palpate.estimation.beam.section import composite_section, euler_load
+from palpate.estimation.contact.hertz import hertz_force
+from palpate.sensor_design import (
     CHECKS,
     DesignConstraints,
     DesignSpace,
@@ -17,10 +21,6 @@ from palpate.design import (
     hertz_depth,
     imperfection_state,
 )
-from palpate.estimation.beam.elastica import fast
-from palpate.estimation.beam.elastica.constants import MODE_REACTION, MODE_SHORTENING
-from palpate.estimation.beam.section import composite_section, euler_load
-from palpate.estimation.contact.hertz import hertz_force
 
 KPA = 1e3
 PAPER = SensorDesign(
@@ -188,7 +188,7 @@ def test_bad_inputs_raise() -> None:
 
 
 def test_the_tip_grating_is_the_most_sensitive_whose_range_carries_twice_p_cr() -> None:
-    from palpate.design.tipgrating import choose_tip_grating
+    from palpate.sensor_design.tipgrating import choose_tip_grating
 
     lung = choose_tip_grating(18e-3, 1.0)  # the 1-20 kPa design: P_cr 18 mN, 1 pm of noise
     assert lung.sensitivity_pm_per_mn == 8.0
@@ -202,8 +202,8 @@ def test_the_tip_grating_is_the_most_sensitive_whose_range_carries_twice_p_cr() 
 
 
 def test_the_weight_check_is_the_cantilevers_sag_and_its_tip_budget() -> None:
-    from palpate.design.weight import SAG_LIMIT, STANDARD_GRAVITY, weight_check
     from palpate.estimation.beam.section import composite_section
+    from palpate.sensor_design.weight import SAG_LIMIT, STANDARD_GRAVITY, weight_check
 
     EI = composite_section(40e-6, 67e9, 25e-6, 55e9, 2).EI  # the 1-20 kPa design's beam
     L = 28.5e-3

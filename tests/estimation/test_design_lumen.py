@@ -7,9 +7,9 @@ import math
 
 import pytest
 
-from palpate.design import DesignConstraints, DesignSpace, design_sensor
-from palpate.design.lumen import Lumen, bundle, span_range
-from palpate.design.tipgrating import tip_grating_for_resolution
+from palpate.sensor_design import DesignConstraints, DesignSpace, design_sensor
+from palpate.sensor_design.lumen import Lumen, bundle, span_range
+from palpate.sensor_design.tipgrating import tip_grating_for_resolution
 
 KPA = 1e3
 # a coarse grid of hardware keeps each search short; the lumen adds its largest tip
@@ -103,7 +103,7 @@ def test_a_published_resolution_sets_the_tip_gratings_sensitivity() -> None:
 
 
 def test_the_binding_checks_are_those_whose_relaxing_alone_lets_a_candidate_pass() -> None:
-    from palpate.design.search import binding_checks
+    from palpate.sensor_design.search import binding_checks
 
     c = DesignConstraints(max_depth_ratio=1.0, tip_force_resolution=0.05e-3)
     space = Lumen(2.8e-3).space(SPACE)
@@ -119,8 +119,8 @@ def test_the_binding_checks_are_those_whose_relaxing_alone_lets_a_candidate_pass
 
 
 def test_held_across_a_sensor_must_carry_its_own_weight() -> None:
-    from palpate.design import evaluate_design
-    from palpate.design.weight import SAG_LIMIT, weight_check
+    from palpate.sensor_design import evaluate_design
+    from palpate.sensor_design.weight import SAG_LIMIT, weight_check
 
     c = DesignConstraints(max_depth_ratio=1.0, held_across=True)
     space = Lumen(2.8e-3).space(SPACE)

@@ -12,7 +12,7 @@ range. :func:`span_range` answers with the widest range one sensor can, from the
 modulus any sensor through the channel reaches, the checks that stop it on either side, and a
 second sensor for the rest:
 
-    >>> from palpate.design import DesignConstraints, DesignSpace
+    >>> from palpate.sensor_design import DesignConstraints, DesignSpace
     >>> lumen = Lumen(2.8e-3)
     >>> span = span_range((1e3, 20e3), DesignConstraints(max_depth_ratio=1.0,
     ...                   tip_force_resolution=0.05e-3), lumen.space(DesignSpace()))
