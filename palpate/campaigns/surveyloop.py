@@ -1,6 +1,6 @@
 """A map survey's loop, one for the bench and the simulator (issue 40; docs/maps.md): the plan
 (``maps.sampling``) picks each next point from the probes so far, a probe (a whole
-trial at that point: ``palpate.campaigns.survey`` in simulation, ``palpate.commands.benchmap``
+trial at that point: ``palpate.campaigns.survey`` in simulation, ``palpate.services.benchmap``
 on the bench's x-y stage) answers it, the probes are appended to ``probes.jsonl`` as they finish (a
 killed survey resumes where it stopped: every plan is a function of the probes before it), and
 the map summarises them::

@@ -12,27 +12,18 @@ import argparse
 import dataclasses
 import json
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from palpate.calibration import calibrate, config_lines
-from palpate.commands.benchsamples import bench_samples
+from palpate.calibration import config_lines
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.estimation.verdict import STATUSES
-from palpate.lab.hardware import open_hardware, port_problem, run_on_hardware
+from palpate.lab.hardware import port_problem, run_on_hardware
 from palpate.lab.plan import describe_map, plan_session
-from palpate.lab.trial import (
-    SKIPPED,
-    BenchOutcome,
-    BenchTrial,
-    Session,
-    run_bench_trials,
-)
-from palpate.live import add_live_argument, live_view
+from palpate.lab.trial import SKIPPED, BenchOutcome, BenchTrial
+from palpate.live import add_live_argument
 from palpate.reports.results import CampaignResults
-from palpate.sensor.clock import Clock
-from palpate.sensor.reader import SerialLike
+from palpate.services.lab import SessionResults, run_map_session, session_results, with_ports
 
 if TYPE_CHECKING:  # the maps import scikit-learn: only when a bench file maps
     from palpate.campaigns.surveyloop import SurveyResult
@@ -56,88 +47,8 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--board-port", help="overrides board.port of the bench file")
 
 
-def run_session(
-    loaded: LoadedBench, trials: list[BenchTrial], log_dir: Path, **options: Any
-) -> list[BenchOutcome]:
-    """Open the bench (ports from the file unless given) and run ``trials``; torque is off and
-    the ports closed on return, whatever happened: :func:`run_map_session` without a map
-    (``options``: its keywords). Tests pass the emulators' ptys and a virtual clock (with
-    ``sync_to_clock``)."""
-    outcomes, _ = run_map_session(loaded, trials, None, log_dir, **options)
-    return outcomes
-
-
-def run_map_session(
-    loaded: LoadedBench,
-    trials: list[BenchTrial],
-    survey: BenchTrial | None,
-    log_dir: Path,
-    *,
-    servo_port: str | Any | None = None,
-    board_port: str | SerialLike | None = None,
-    clock: Clock | None = None,
-    sync_to_clock: bool = False,
-    progress: Callable[[BenchOutcome], None] | None = None,
-    live: int | None = None,
-) -> tuple[list[BenchOutcome], SurveyResult | None]:
-    """Open the bench (ports from the file unless given: the emulators' ptys in tests, with a
-    virtual clock and ``sync_to_clock``; ``live``: the live view's port, ``--live``), run
-    ``trials``, then, with a ``survey`` (the trial each probe repeats,
-    ``palpate.commands.benchmap.plan_bench_map``), the bench file's map on the x-y stage with the
-    compliance the trials calibrated: the trials' outcomes and the map (None without one, or
-    when a trial before it ended the session)."""
-    key = str(loaded.path)
-    with (
-        open_hardware(
-            loaded.stack,
-            servo_port=servo_port,
-            board_port=board_port,
-            clock=clock,
-            servo_key=f"servos.port in {key}",
-            board_key=f"board.port in {key}",
-        ) as hw,
-        live_view(live, loaded.stack) as view,
-    ):
-        session = Session(loaded.stack)
-        outcomes = run_bench_trials(
-            hw,
-            trials,
-            loaded,
-            log_dir,
-            sync_to_clock=sync_to_clock,
-            progress=progress,
-            live=view,
-            session=session,
-        )
-        if survey is None or any(o.state == SKIPPED for o in outcomes):
-            return outcomes, None
-        from palpate.commands.benchmap import run_bench_map
-
-        result = run_bench_map(
-            hw,
-            survey,
-            loaded,
-            session.stack,
-            log_dir,
-            sync_to_clock=sync_to_clock,
-            progress=progress,
-            live=view,
-        )
-        return outcomes, result
-
-
-def _with_ports(loaded: LoadedBench, servo: str | None, board: str | None) -> LoadedBench:
-    """``loaded`` with the servo and board ports replaced where given."""
-    stack = loaded.stack
-    if servo is not None:
-        stack = dataclasses.replace(stack, servos=dataclasses.replace(stack.servos, port=servo))
-    if board is not None:
-        stack = dataclasses.replace(stack, board=dataclasses.replace(stack.board, port=board))
-    return dataclasses.replace(loaded, stack=stack)
-
-
 def run(args: argparse.Namespace) -> int:
-    loaded = _with_ports(load_bench(args.config), args.servo_port, args.board_port)
+    loaded = with_ports(load_bench(args.config), args.servo_port, args.board_port)
     trials, survey = plan_session(loaded, args.target)
     if args.dry_run:
         return _dry_run(loaded, trials, args.json, survey)
@@ -167,58 +78,27 @@ def run(args: argparse.Namespace) -> int:
         return 0
 
     code = run_on_hardware("trial", body)
-    return code or _report(args, loaded, log_dir, outcomes, surveyed[0], results)
+    if code:
+        return code
+    return _report(args, loaded, session_results(loaded, log_dir, outcomes, surveyed[0], results))
 
 
-def _report(
-    args: argparse.Namespace,
-    loaded: LoadedBench,
-    log_dir: Path,
-    outcomes: list[BenchOutcome],
-    mapped: SurveyResult | None,
-    results: CampaignResults,
-) -> int:
-    """The session's results (files, then stdout); exit 0 when every trial and probe is done."""
-    samples = bench_samples(outcomes, loaded.bench.campaign.outlier_above)  # the trials, not probes
-    found = calibrate(
-        (o.trial.stage.rig_key, o.calibration) for o in outcomes if o.calibration is not None
-    )
-    probes = [] if mapped is None else [o for o in mapped.outcomes if o is not None]
-    outcomes = outcomes + probes  # every trial's row; the samples' statistics leave probes out
-    trial_rows = [o.as_dict() for o in outcomes]
-    payload: dict[str, Any] = {
-        "bench": str(loaded.path),
-        "log_dir": str(log_dir),
-        "trials": trial_rows,
-        "samples": samples,
-        "calibration": {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()},
-    }
-    if mapped is not None:
-        payload["map"] = _map_results(mapped, loaded, log_dir)
-    files = results.finish(trial_rows, samples, payload) if outcomes else []
+def _report(args: argparse.Namespace, loaded: LoadedBench, done: SessionResults) -> int:
+    """The session's results (files written by the service, then stdout); exit 0 when every
+    trial and probe is done."""
     if args.json:
-        print(json.dumps(payload, indent=2))
+        print(json.dumps(done.payload, indent=2))
     else:
-        _print_summary(outcomes, samples, found, loaded.bench.robot, files)
-        if mapped is not None:
+        robot = loaded.bench.robot
+        _print_summary(done.outcomes, done.samples, done.calibration, robot, done.files)
+        if done.mapped is not None:
             from palpate.reports.mapresults import map_lines
 
             m = loaded.bench.map
             assert m is not None
-            print("\n".join(map_lines(mapped, log_dir, f"map at {m.target}", m.strategy)))
-    return 0 if all(o.state == "done" for o in outcomes) else 1
-
-
-def _map_results(mapped: SurveyResult, loaded: LoadedBench, log_dir: Path) -> dict[str, Any]:
-    """The map's files in the session folder (``map.json``, ``.mcap``, ``.png``); its payload."""
-    from palpate.reports.mapresults import write_map_results
-
-    m = loaded.bench.map
-    assert m is not None
-    info = {"target": m.target, "strategy": m.strategy, "max_probes": m.max_probes}
-    return write_map_results(
-        mapped, log_dir, info, threshold=m.threshold, title=f"map at {m.target}", plots=True
-    )
+            lines = map_lines(done.mapped, done.log_dir, f"map at {m.target}", m.strategy)
+            print("\n".join(lines))
+    return 0 if all(o.state == "done" for o in done.outcomes) else 1
 
 
 def _print_summary(

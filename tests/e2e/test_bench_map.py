@@ -11,13 +11,13 @@ from pathlib import Path
 
 import pytest
 
-from palpate.commands.trial import run_map_session
 from palpate.config import ConfigError, load, resolve
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.config.scene import SceneConfig
 from palpate.lab.hardware import Hardware, open_hardware
 from palpate.lab.plan import plan_bench_map, plan_session
 from palpate.robot.xystage import STAGE_SERVOS, StageMoveError
+from palpate.services.lab import run_map_session
 from palpate.sim.clock import VirtualClock
 from palpate.simulation.twin import SimulatedBench, stations_for
 

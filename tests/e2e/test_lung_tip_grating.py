@@ -91,10 +91,10 @@ def test_a_bench_rehearsal_on_the_twin_reads_the_tip_grating(tmp_path: Path) -> 
     the session on the ptys reads its load from the tip grating and estimates it."""
     import dataclasses
 
-    from palpate.commands.trial import run_session
     from palpate.config.bench import load_bench
     from palpate.config.loader import write_yaml
     from palpate.lab.trial import plan_bench_trials
+    from palpate.services.lab import run_session
     from palpate.sim.clock import VirtualClock
     from palpate.simulation.twin import SimulatedBench, surface_at
 

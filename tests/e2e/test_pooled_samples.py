@@ -38,9 +38,9 @@ def test_the_bench_campaign_pools_a_samples_five_lengths(
 def test_a_bench_sample_without_a_stated_modulus_gets_its_pooled_answer(tmp_path: Path) -> None:
     """On the bench the modulus is what a lab wants to learn: a sample pressed twice with no
     ``modulus_kpa`` still gets its row, its trials pooled (the emulators on a virtual clock)."""
-    from palpate.commands.benchsamples import bench_samples
     from palpate.config.bench import load_bench
     from palpate.lab.trial import plan_bench_trials
+    from palpate.services.benchsamples import bench_samples
     from palpate.sim.clock import VirtualClock
     from tests.e2e.test_trial_cli import bench_file, run_on, simulated
 

@@ -19,7 +19,6 @@ import pytest
 import serial
 
 from palpate.cli import main
-from palpate.commands.trial import run_session
 from palpate.config import load, resolve
 from palpate.config.bench import LoadedBench, load_bench
 from palpate.config.loader import ConfigError
@@ -29,6 +28,7 @@ from palpate.lab.trial import SKIPPED, BenchOutcome, plan_bench_trials
 from palpate.reports.replay import replay
 from palpate.robot.motors import ServoTransportError
 from palpate.robot.records.log import read_log
+from palpate.services.lab import run_session
 from palpate.sim.clock import VirtualClock
 from palpate.simulation.twin import SimulatedBench, stations_for, surface_at
 
