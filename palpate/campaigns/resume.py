@@ -26,6 +26,7 @@ from palpate.estimation.jointfit.pooling import Terms
 from palpate.estimation.pose.misalignment import Lean
 from palpate.estimation.relaxation import RelaxationFit
 from palpate.robot.indentation import TrialMarks
+from palpate.robot.plan import State
 from palpate.robot.probe_result import ProbeResult, Touch
 from palpate.robot.records.log import TrialLog, TrialLogError, read_log
 from palpate.robot.trial.record import recorded_verdict
@@ -85,7 +86,7 @@ def _outcome(
     duration = end["duration"]
     return TrialOutcome(
         spec=spec,
-        state=str(end["state"]),
+        state=State(end["state"]),
         reason=str(end["reason"]),
         estimate=_paper(estimate),
         exposed_length_at_buckling=length,

@@ -32,6 +32,7 @@ from palpate.lab.plan import BenchTrial, plan_bench_trials
 from palpate.live import LiveView, Publisher
 from palpate.robot.dynamixel.stats import BusStats
 from palpate.robot.indentation import PLANNED_ENDS
+from palpate.robot.plan import State
 from palpate.robot.rig import ServoFbgRig
 from palpate.robot.trial.outcome import Outcome, outcome_fields
 from palpate.robot.trial.record import header_common
@@ -55,7 +56,7 @@ __all__ = [
     "run_bench_trials",
 ]
 
-SKIPPED = "skipped"
+SKIPPED = State.SKIPPED
 PLANNED = frozenset(s.value for s in PLANNED_ENDS)  # trial ends that keep torque on
 
 

@@ -12,7 +12,10 @@ from .guards import Observation
 from .probe_result import ProbeResult
 
 
-class State(enum.Enum):
+class State(enum.StrEnum):
+    """The machine's states; a trial's ending is one of them (a ``StrEnum``: it equals its value,
+    ``State.DONE == "done"``, and a log or JSON writes the value)."""
+
     IDLE = "idle"
     HOMING = "homing"
     POSITIONING = "positioning"
@@ -28,6 +31,7 @@ class State(enum.Enum):
     FAULT = "fault"
     ABORTED = "aborted"
     UNREACHABLE = "unreachable"
+    SKIPPED = "skipped"  # never entered: the bench session's ending for a trial it did not start
 
 
 TERMINAL = frozenset({State.DONE, State.FAULT, State.ABORTED, State.UNREACHABLE})

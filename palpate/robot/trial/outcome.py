@@ -25,7 +25,7 @@ from ...estimation.pose.misalignment import Lean
 from ...estimation.relaxation import RelaxationFit
 from ...estimation.trial.estimate import TrialEstimate
 from ...estimation.verdict import Verdict
-from ..plan import TrialMarks
+from ..plan import State, TrialMarks
 from .record import estimate_row
 from .run import TrialResult
 
@@ -38,7 +38,7 @@ class Outcome:
     """A finished trial (keyword fields: its context's come first in the subclasses).
 
     Attributes:
-        state, reason: how it ended (``robot.plan.State``'s value) and why.
+        state, reason: how it ended (a terminal ``robot.plan.State``, or ``SKIPPED``) and why.
         log_path: its log (None: none written); marks: encoder at contact and at buckling.
         estimate: the paper's single point (Eqs. 13-14); exposed_length_at_buckling: L (m).
         joint: the joint fit (the headline estimate); verdict: ok, suspect or none, with
@@ -46,7 +46,7 @@ class Outcome:
             compliance instead; lean: the load's lean; relaxation and relaxed_verdict: a hold's.
     """
 
-    state: str
+    state: State
     reason: str
     log_path: str | None = None
     marks: TrialMarks | None = None
@@ -88,7 +88,7 @@ def outcome_fields(
 ) -> dict[str, Any]:
     """The :class:`Outcome` fields of a trial the session ran (keywords for its subclasses)."""
     return {
-        "state": result.state.value,
+        "state": result.state,
         "reason": result.reason,
         "log_path": log_path,
         "marks": result.marks,
