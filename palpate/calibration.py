@@ -17,7 +17,7 @@ from typing import Protocol
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import MM, StackConfig
-from palpate.estimation.beam.stage import STAGE, rig_key
+from palpate.estimation.beam.stage import STAGE
 from palpate.estimation.fits.compliance import ComplianceFit, pooled
 
 
@@ -71,7 +71,7 @@ def calibrated(scene: SceneConfig, stack: StackConfig, outcomes: Sequence[object
         spec = getattr(o, "spec", None)
         fit = getattr(o, "calibration", None)
         if spec is not None:
-            trials.append((rig_key(spec.kind, spec.tube), fit))
+            trials.append((spec.stage.rig_key, fit))
     found = calibrate(trials)
     return with_compliance(stack, found) if found else stack
 

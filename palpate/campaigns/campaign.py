@@ -19,11 +19,12 @@ from palpate.campaigns.executors import SerialExecutor, process_pool
 from palpate.config.loader import InputError
 from palpate.config.optics import MM
 from palpate.config.scene import ORIENTATION_ROLL_DEG, SceneConfig
-from palpate.config.schema import StackConfig
+from palpate.config.schema import StackConfig, TubeConfig
 from palpate.estimation.beam.elastica import fast
 from palpate.estimation.fits.stiffness import SampleSummary, summarize
 from palpate.live import LiveView
 from palpate.simulation.trial import Transport, TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 
 def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> list[TrialSpec]:
@@ -32,13 +33,15 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
     specs: list[TrialSpec] = []
     references = reported_references(scene, seed)
 
-    def add(sample_name: str, tube: str, orientation: str, length_mm: float, rep: int) -> None:
+    def add(sample: str, tube: TubeConfig, orientation: str, length_mm: float, rep: int) -> None:
         for speed in c.speeds_mm_per_s():
-            at(sample_name, tube, orientation, length_mm, rep, speed)
+            at(sample, tube, orientation, length_mm, rep, speed)
 
-    def at(name: str, tube: str, orientation: str, length_mm: float, rep: int, v: float) -> None:
+    def at(
+        name: str, tube: TubeConfig, orientation: str, length: float, rep: int, v: float
+    ) -> None:
         s = next(x for x in scene.samples if x.name == name)
-        parts = [name, tube, orientation, f"L{length_mm:g}"]
+        parts = [name, tube.name, orientation, f"L{length:g}"]
         if c.indent_speeds_mm_per_s:
             parts.append(f"v{v:g}")
         if c.repeats > 1:
@@ -53,7 +56,7 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
                 tube=tube,
                 orientation=orientation,
                 roll=math.radians(ORIENTATION_ROLL_DEG[orientation]),
-                exposed_length=length_mm * MM,  # the id names it in mm
+                exposed_length=length * MM,  # the id names it in mm
                 seed=seed * 1_000_003 + len(specs),
                 reference=references[s.name],
                 indent_speed=v * MM if c.indent_speeds_mm_per_s else None,
@@ -64,14 +67,14 @@ def campaign_trials(scene: SceneConfig, stack: StackConfig, seed: int = 0) -> li
         for rep in range(c.repeats):
             if not c.on_tubes:
                 for length_mm in c.exposed_lengths_mm:
-                    add(sample.name, "straight", "downward", length_mm, rep)
+                    add(sample.name, BENCH_COLUMN, "downward", length_mm, rep)
                 continue
             for tube_name in c.tubes:
                 tube = stack.tube(tube_name)
                 # rolling a straight tube does not change where it points: one trial
                 orientations = c.orientations[:1] if tube.tip_angle_deg == 0 else c.orientations
                 for orientation in orientations:
-                    add(sample.name, tube_name, orientation, c.exposed_length_mm, rep)
+                    add(sample.name, tube, orientation, c.exposed_length_mm, rep)
     return specs
 
 

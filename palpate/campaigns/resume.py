@@ -65,7 +65,7 @@ def outcome_from_log(path: Path, spec: TrialSpec, stack: StackConfig) -> TrialOu
     estimate = next(log.of_kind("estimate"), None)
     if not log.complete or log.bad_lines or end is None or estimate is None:
         return None
-    if log.header.get("spec") != json.loads(json.dumps(dataclasses.asdict(spec))):
+    if log.header.get("spec") != json.loads(json.dumps(spec.record())):
         return None
     try:
         outcome = _outcome(spec, stack, end, estimate, str(path))

@@ -42,7 +42,7 @@ from palpate.config.schema import StackConfig
 from palpate.maps import Probe
 from palpate.robot.trial.outcome import probe_of
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
-from palpate.simulation.world import TrialSpec
+from palpate.simulation.world import BENCH_COLUMN, TrialSpec
 
 if TYPE_CHECKING:
     from palpate.live import LiveView
@@ -99,7 +99,7 @@ def probe_spec(
         sample=sample.name,
         modulus=sample.modulus,
         poisson=sample.poisson,
-        tube="straight",
+        tube=BENCH_COLUMN,
         orientation="downward",
         roll=0.0,
         exposed_length=length,

@@ -11,7 +11,6 @@ from palpate.calibration import calibrate
 from palpate.campaigns.campaign import median_abs_relative_error, summarize_campaign
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
-from palpate.estimation.beam.stage import rig_key
 from palpate.reports import verdicts
 from palpate.reports.campaign_table import kpa_fields, sample_records
 from palpate.simulation.trial import TrialOutcome
@@ -79,9 +78,7 @@ def campaign_report(
     }
     payload.update(verdicts.verdict_payload(outcomes, scene.campaign.classify_at))
     found = calibrate(
-        (rig_key(o.spec.kind, o.spec.tube), o.calibration)
-        for o in outcomes
-        if o.calibration is not None
+        (o.spec.stage.rig_key, o.calibration) for o in outcomes if o.calibration is not None
     )
     if found:
         payload["calibration"] = {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()}

@@ -49,7 +49,7 @@ class TrialOutcome(Outcome):
         return {
             "trial": self.spec.trial_id,
             "sample": self.spec.sample,
-            "tube": self.spec.tube,
+            "tube": self.spec.tube.name,
             "orientation": self.spec.orientation,
             "roll_deg": math.degrees(self.spec.roll),
             "exposed_length_mm": self.spec.exposed_length * 1e3,
@@ -108,7 +108,7 @@ def estimate_sim_trial(
 def trial_stage(spec: TrialSpec, stack: StackConfig, geo: TrialGeometry) -> Stage:
     """The trial's stage as it runs: the bench column, or the tube the inverse kinematics
     picked (``geo.tube``, which may be another than the spec names)."""
-    stage = spec.stage(stack)
+    stage = spec.stage
     return stage if stage.tube is None else Stage.on(stack.tube(geo.tube), stage.exposed)
 
 

@@ -337,7 +337,7 @@ def _header(
     return {
         "trial": spec.trial_id,
         "source": "simulation",
-        "spec": dataclasses.asdict(spec),
+        "spec": spec.record(),
         "scene": scene.name,
         **header_common(plan, sensor_section(stack), stack.sensor, tube, inputs.poisson, inputs),
     }

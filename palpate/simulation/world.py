@@ -35,19 +35,22 @@ from palpate.simulation.placement import place_sample
 from palpate.wire.dynamixel import TICKS_PER_REV
 
 BENCH_CONTACT_TRANSLATION = 10e-3  # m: where the bench stage touches the sample
+# the bench's column as a trial's tube: a straight stage ("straight" in the trials' ids)
+BENCH_COLUMN = TubeConfig(name="straight")
 VERTICAL = np.array([0.0, 0.0, -1.0])
 
 
 @dataclass(frozen=True)
 class TrialSpec:
-    """One trial of a campaign."""
+    """One trial of a campaign; ``tube`` is the robot's tube it runs on (on the bench,
+    :data:`BENCH_COLUMN`)."""
 
     trial_id: str
     kind: Literal["bench", "robot"]
     sample: str
     modulus: float  # Pa, the ground truth
     poisson: float
-    tube: str
+    tube: TubeConfig
     orientation: str
     roll: float  # rad
     exposed_length: float  # m at contact
@@ -55,9 +58,14 @@ class TrialSpec:
     reference: float | None = None  # Pa, the reported reference modulus; None: the truth
     indent_speed: float | None = None  # m/s; None: the campaign's indent_speed_mm_per_s
 
-    def stage(self, stack: StackConfig) -> Stage:
-        """The stage this trial advances on (the bench column or its tube in ``stack``)."""
-        return Stage.in_stack(self.kind, stack, self.tube, self.exposed_length)
+    @property
+    def stage(self) -> Stage:
+        """The stage this trial advances on: the bench column, or its tube."""
+        return Stage.of_tube(self.kind, self.tube, self.exposed_length)
+
+    def record(self) -> dict[str, Any]:
+        """The spec as a log's header writes it (its tube by name)."""
+        return {**dataclasses.asdict(self), "tube": self.tube.name}
 
     @property
     def reported(self) -> float:
@@ -102,7 +110,7 @@ def _robot_geometry(
     """Plan the trial where the campaign aims it (the IK on the surface the plan believes in:
     facing the tube at the target), and place the sample there as the scene says
     (:func:`palpate.simulation.placement.place_sample`: tilted, moved, curved)."""
-    tube = stack.tube(spec.tube)
+    tube = spec.tube
     nominal = kinematics.forward(tube, spec.roll, tube.flush_translation + spec.exposed_length)
     r_tip = stack.sensor.tip_radius
     target = nominal.sensor_tip + r_tip * nominal.tangent
@@ -143,13 +151,13 @@ def trial_geometry(
 ) -> TrialGeometry:
     """Where the sample is and how the robot reaches it; ValueError if it cannot. ``sample``:
     the scene's, for its pose (None: the plan's surface, facing the tube at the target)."""
-    if spec.stage(stack).tube is None:
+    if spec.stage.tube is None:
         return _bench_geometry(stack, spec, sample)
     return _robot_geometry(stack, spec, sample)
 
 
 def _pose_fn(stack: StackConfig, spec: TrialSpec, tube_name: str) -> Any:
-    stage = spec.stage(stack)
+    stage = spec.stage
     if stage.tube is None:
         length = stage.exposed
 
@@ -235,7 +243,7 @@ def trial_world(
         joints=servos.read,
         rng=np.random.default_rng(spec.seed),
         has_force=stack.board.has_force,
-        length_grows=spec.stage(stack).grows,
+        length_grows=spec.stage.grows,
         encoder_step=stack.drive.lead / TICKS_PER_REV,
         relaxation=relaxation(sample, scene.fidelity),
         friction=sample.friction,

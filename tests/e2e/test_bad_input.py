@@ -15,6 +15,7 @@ from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.simulation.trial import TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -23,7 +24,7 @@ BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
 @pytest.fixture(scope="module")
 def good_log(tmp_path_factory: pytest.TempPathFactory) -> list[dict[str, Any]]:
     """The records of one real trial's log."""
-    spec = TrialSpec("S8-b", "bench", "S8", 314.53e3, 0.45, "straight", "downward", 0.0, 44e-3, 3)
+    spec = TrialSpec("S8-b", "bench", "S8", 314.53e3, 0.45, BENCH_COLUMN, "downward", 0.0, 44e-3, 3)
     out = run_sim_trial(spec, BENCH, STACK, log_dir=tmp_path_factory.mktemp("log"))
     assert out.log_path is not None
     text = Path(out.log_path).read_text(encoding="utf-8")

@@ -33,7 +33,7 @@ def run_one(
     spec = next(
         s
         for s in campaign_trials(scene, stack, 0)
-        if s.sample == sample and s.tube == "bent15" and s.orientation == "downward"
+        if s.sample == sample and s.tube.name == "bent15" and s.orientation == "downward"
     )
     return run_sim_trial(spec, scene, stack, log_dir=tmp_path_factory.mktemp("logs"))
 
@@ -86,7 +86,7 @@ def test_free_breathing_without_a_gate_gives_no_ok_trial(
     every contact, and no trial that saw it move past the tolerance is ok."""
     scene = load(SceneConfig, resolve("scenes/invivo/free-breathing.yaml"))
     assert scene.campaign.gate == "none"
-    specs = [s for s in campaign_trials(scene, STACK, 0) if s.tube == "bent30"][::4]
+    specs = [s for s in campaign_trials(scene, STACK, 0) if s.tube.name == "bent30"][::4]
     logs = tmp_path_factory.mktemp("free")
     outcomes = [run_sim_trial(s, scene, STACK, log_dir=logs) for s in specs]
     assert len(outcomes) == 6

@@ -24,7 +24,16 @@ SAMPLE = "S8-R30-t10"
 def spec(tube: str = "bent30") -> TrialSpec:
     modulus = next(s.modulus for s in SCENE.samples if s.name == SAMPLE)
     return TrialSpec(
-        f"{SAMPLE}-{tube}", "robot", SAMPLE, modulus, 0.45, tube, "downward", 0.0, 42e-3, 2
+        f"{SAMPLE}-{tube}",
+        "robot",
+        SAMPLE,
+        modulus,
+        0.45,
+        STACK.tube(tube),
+        "downward",
+        0.0,
+        42e-3,
+        2,
     )
 
 

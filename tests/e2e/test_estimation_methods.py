@@ -13,6 +13,7 @@ from palpate.reports.methods import compare_methods
 from palpate.reports.replay import replay
 from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -22,8 +23,10 @@ BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
 def outcomes(tmp_path_factory: pytest.TempPathFactory) -> list[TrialOutcome]:
     logs = tmp_path_factory.mktemp("logs")
     specs = [
-        TrialSpec("S8-L44", "bench", "S8", 314.53e3, 0.45, "straight", "downward", 0.0, 44e-3, 3),
-        TrialSpec("S1-L42", "bench", "S1", 1023.67e3, 0.45, "straight", "downward", 0.0, 42e-3, 8),
+        TrialSpec("S8-L44", "bench", "S8", 314.53e3, 0.45, BENCH_COLUMN, "downward", 0.0, 44e-3, 3),
+        TrialSpec(
+            "S1-L42", "bench", "S1", 1023.67e3, 0.45, BENCH_COLUMN, "downward", 0.0, 42e-3, 8
+        ),
     ]
     return [run_sim_trial(s, BENCH, STACK, log_dir=logs) for s in specs]
 

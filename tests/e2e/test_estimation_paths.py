@@ -47,7 +47,7 @@ def test_a_rigid_reference_calibrates_the_compliance_before_the_other_trials(
 ) -> None:
     sc = scene("compliance")  # tube tips 10 N/mm; REF is rigid
     stack = load_stack(resolve(sc.robot))
-    specs = [s for s in campaign_trials(sc, stack) if s.tube == "straight"][:3]
+    specs = [s for s in campaign_trials(sc, stack) if s.tube.name == "straight"][:3]
     assert [s.sample for s in specs] == ["REF", "M150", "M350"]
     ref, *others = run_campaign(specs, sc, stack, log_dir=tmp_path, workers=1)
     assert ref.calibration is not None

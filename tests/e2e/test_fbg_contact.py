@@ -19,6 +19,7 @@ from palpate.config.scene import SceneConfig
 from palpate.robot.rig import RigSettings
 from palpate.robot.trial.setup import sensor_section
 from palpate.simulation.trial import TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -32,7 +33,7 @@ def _scene(contact: str) -> SceneConfig:
 
 def _spec(sample: str, modulus_kpa: float) -> TrialSpec:
     return TrialSpec(
-        f"{sample}-fbg", "bench", sample, modulus_kpa * 1e3, 0.45, "straight", "downward",
+        f"{sample}-fbg", "bench", sample, modulus_kpa * 1e3, 0.45, BENCH_COLUMN, "downward",
         0.0, 46e-3, 11,
     )  # fmt: skip
 

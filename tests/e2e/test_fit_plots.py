@@ -15,6 +15,7 @@ from palpate.config.scene import SceneConfig
 from palpate.reports.fitplot import estimates_with_intervals, record_fit
 from palpate.robot.records.log import read_log
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -24,7 +25,7 @@ PNG = b"\x89PNG\r\n\x1a\n"
 @pytest.fixture(scope="module")
 def outcome(tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
     spec = TrialSpec(
-        "S1-L42", "bench", "S1", 1023.67e3, 0.45, "straight", "downward", 0.0, 42e-3, 8
+        "S1-L42", "bench", "S1", 1023.67e3, 0.45, BENCH_COLUMN, "downward", 0.0, 42e-3, 8
     )
     return run_sim_trial(spec, BENCH, STACK, log_dir=tmp_path_factory.mktemp("logs"))
 

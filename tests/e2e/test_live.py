@@ -92,8 +92,8 @@ def test_a_client_on_localhost_gets_every_channel_during_a_trial(tmp_path: Path)
     with LiveView(0, STACK.sensor, sensor_section(STACK.sensor)) as view:
         client = Client(view.port)
         assert client.subscribed.wait(BOUND), client.advertised
-        spec = TrialSpec("S8-bent30-down", "robot", "S8", 314.53e3, 0.45, "bent30", "downward",
-                         0.0, 42e-3, 1)  # fmt: skip
+        spec = TrialSpec("S8-bent30-down", "robot", "S8", 314.53e3, 0.45, STACK.tube("bent30"),
+                         "downward", 0.0, 42e-3, 1)  # fmt: skip
         out = run_sim_trial(spec, ROBOT, STACK, log_dir=tmp_path, live=view)
         assert out.state in ("done", "unreachable"), out.reason
         # the trial publishes 25 times a second of wall time at most; let it go on publishing

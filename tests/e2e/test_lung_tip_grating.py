@@ -29,7 +29,7 @@ def fibrotic(tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
     spec = next(
         s
         for s in campaign_trials(LUNG, STACK, 0)
-        if s.sample == "F2" and s.tube == "bent30" and s.orientation == "sideways"
+        if s.sample == "F2" and s.tube.name == "bent30" and s.orientation == "sideways"
     )
     logs = tmp_path_factory.mktemp("logs")
     return run_sim_trial(spec, LUNG, STACK, transport="wire", log_dir=logs)
@@ -209,7 +209,7 @@ def test_probing_finds_a_tilted_soft_samples_normal_with_the_tip_grating() -> No
     spec = next(
         s
         for s in campaign_trials(tilted, STACK, 0)
-        if s.sample == "F2-t10" and s.tube == "bent30" and s.orientation == "downward"
+        if s.sample == "F2-t10" and s.tube.name == "bent30" and s.orientation == "downward"
     )
     out = run_sim_trial(spec, tilted, STACK)
     assert out.state == "done", out.reason

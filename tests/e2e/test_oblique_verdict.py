@@ -19,7 +19,8 @@ SCENE = load(SceneConfig, resolve("scenes/oblique/straight.yaml"))
 def spec(sample: str) -> TrialSpec:
     modulus = next(s.modulus for s in SCENE.samples if s.name == sample)
     return TrialSpec(
-        f"{sample}-straight", "robot", sample, modulus, 0.45, "straight", "downward", 0.0,
+        f"{sample}-straight", "robot", sample, modulus, 0.45,
+        STACK.tube("straight"), "downward", 0.0,
         42e-3, 2,
     )  # fmt: skip
 
@@ -73,7 +74,16 @@ def test_a_sample_that_is_not_there_ends_unreachable_with_torque_on() -> None:
     reason named), not a fault and not a state timeout; well within probing's budget."""
     modulus = next(s.modulus for s in OFFSET.samples if s.name == "S8-absent")
     spec = TrialSpec(
-        "absent", "robot", "S8-absent", modulus, 0.45, "bent30", "downward", 0.0, 42e-3, 2
+        "absent",
+        "robot",
+        "S8-absent",
+        modulus,
+        0.45,
+        STACK.tube("bent30"),
+        "downward",
+        0.0,
+        42e-3,
+        2,
     )
     out = run_sim_trial(spec, OFFSET, STACK)
     assert out.state == "unreachable", out.reason
@@ -99,7 +109,16 @@ def test_a_displaced_sample_is_found_and_indented_where_it_is() -> None:
     straight tube approaches where its touch found the surface."""
     modulus = next(s.modulus for s in OFFSET.samples if s.name == "S8-off5-t0")
     spec = TrialSpec(
-        "off5", "robot", "S8-off5-t0", modulus, 0.45, "straight", "downward", 0.0, 42e-3, 2
+        "off5",
+        "robot",
+        "S8-off5-t0",
+        modulus,
+        0.45,
+        STACK.tube("straight"),
+        "downward",
+        0.0,
+        42e-3,
+        2,
     )
     out = run_sim_trial(spec, OFFSET, STACK)
     assert out.state == "done", out.reason

@@ -29,7 +29,8 @@ def spec(
     roll = {"downward": 0.0, "sideways": math.pi / 2, "upward": math.pi}[orientation]
     modulus = next(s.modulus for s in TILTED.samples if s.name == sample)
     return TrialSpec(
-        f"{sample}-{tube}-{orientation}", "robot", sample, modulus, 0.45, tube, orientation,
+        f"{sample}-{tube}-{orientation}", "robot", sample, modulus, 0.45,
+        STACK.tube(tube), orientation,
         roll, 42e-3, seed,
     )  # fmt: skip
 

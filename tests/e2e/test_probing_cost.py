@@ -38,7 +38,8 @@ SUBSET = [
 def spec(sample: str, tube: str, scene: SceneConfig = TILTED, seed: int = 0) -> TrialSpec:
     modulus = next(s.modulus for s in scene.samples if s.name == sample)
     return TrialSpec(
-        f"{sample}-{tube}-downward", "robot", sample, modulus, 0.45, tube, "downward", 0.0,
+        f"{sample}-{tube}-downward", "robot", sample, modulus, 0.45,
+        STACK.tube(tube), "downward", 0.0,
         LENGTH, seed,
     )  # fmt: skip
 

@@ -28,7 +28,7 @@ def relaxing(tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
     spec = next(
         s
         for s in campaign_trials(LUNG, STACK, 0)
-        if s.sample == "N4" and s.tube == "bent15" and s.orientation == "sideways"
+        if s.sample == "N4" and s.tube.name == "bent15" and s.orientation == "sideways"
     )
     logs = tmp_path_factory.mktemp("logs")
     return run_sim_trial(spec, LUNG, STACK, log_dir=logs)

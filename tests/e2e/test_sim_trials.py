@@ -14,6 +14,7 @@ from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
 from palpate.robot.records.log import read_log
 from palpate.simulation.trial import TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -22,7 +23,7 @@ ROBOT = load(SceneConfig, resolve("scenes/robot.yaml"))
 
 def bench_spec(seed: int = 3) -> TrialSpec:
     return TrialSpec(
-        "S8-bench", "bench", "S8", 314.53e3, 0.45, "straight", "downward", 0.0, 44e-3, seed
+        "S8-bench", "bench", "S8", 314.53e3, 0.45, BENCH_COLUMN, "downward", 0.0, 44e-3, seed
     )
 
 
@@ -61,7 +62,16 @@ def test_seed_reproduces_and_changes_the_noise() -> None:
 
 def test_robot_trial_with_bent_tube_estimates_the_modulus(tmp_path: Path) -> None:
     spec = TrialSpec(
-        "S7-bent30-up", "robot", "S7", 1122.86e3, 0.45, "bent30", "upward", 3.14159, 42e-3, 5
+        "S7-bent30-up",
+        "robot",
+        "S7",
+        1122.86e3,
+        0.45,
+        STACK.tube("bent30"),
+        "upward",
+        3.14159,
+        42e-3,
+        5,
     )
     out = run_sim_trial(spec, ROBOT, STACK, log_dir=tmp_path)
     assert out.state == "done", out.reason

@@ -14,6 +14,7 @@ from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
 from palpate.reports.replay import replay
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 pytestmark = pytest.mark.slow  # a heavy module fixture: the quick subset leaves it out
 
@@ -28,7 +29,7 @@ def short_hold(scene: SceneConfig) -> SceneConfig:
 
 def spec(trial: str) -> TrialSpec:
     return TrialSpec(
-        trial, "bench", "G500", 500e3, 0.45, "straight", "downward", 0.0, 46e-3, 5,
+        trial, "bench", "G500", 500e3, 0.45, BENCH_COLUMN, "downward", 0.0, 46e-3, 5,
         indent_speed=2e-3,
     )  # fmt: skip
 

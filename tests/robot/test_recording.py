@@ -20,6 +20,7 @@ from palpate.robot.records.log import TrialLog, read_log
 from palpate.robot.records.recording import Recording, read_recording
 from palpate.robot.trial.tipforce import axial_loads
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 STACK = load_stack()
 BENCH = load(SceneConfig, resolve("scenes/bench.yaml"))
@@ -32,7 +33,9 @@ WRENCH_STAMPED = ["std_msgs/Header header", "geometry_msgs/Wrench wrench"]
 @pytest.fixture(scope="module")
 def trial(tmp_path_factory: pytest.TempPathFactory) -> tuple[TrialOutcome, TrialLog, Recording]:
     logs = tmp_path_factory.mktemp("logs")
-    spec = TrialSpec("S8-L44", "bench", "S8", 314.53e3, 0.45, "straight", "downward", 0.0, 44e-3, 3)
+    spec = TrialSpec(
+        "S8-L44", "bench", "S8", 314.53e3, 0.45, BENCH_COLUMN, "downward", 0.0, 44e-3, 3
+    )
     out = run_sim_trial(spec, BENCH, STACK, log_dir=logs)
     path = Path(str(out.log_path))
     return out, read_log(path), read_recording(path.with_suffix(".mcap"))
@@ -161,7 +164,7 @@ def test_a_robot_trial_records_the_tip_pose_as_the_forward_kinematics(tmp_path: 
 
     robot = load(Scene, resolve("scenes/robot.yaml"))
     spec = TrialSpec(
-        "S8-bent30", "robot", "S8", 314.53e3, 0.45, "bent30", "downward", 0.0, 42e-3, 2
+        "S8-bent30", "robot", "S8", 314.53e3, 0.45, STACK.tube("bent30"), "downward", 0.0, 42e-3, 2
     )
     out = run_sim_trial(spec, robot, STACK, log_dir=tmp_path)
     path = Path(str(out.log_path))

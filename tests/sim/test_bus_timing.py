@@ -20,6 +20,7 @@ from palpate.sim.dynamixel.direct import direct_transport
 from palpate.sim.dynamixel.timing import BusTiming
 from palpate.sim.inprocess import InProcessPort
 from palpate.simulation.trial import TrialSpec, bus_timing, run_sim_trial
+from palpate.simulation.world import BENCH_COLUMN
 
 CFG = ServoBusConfig(max_goal_step_deg=360.0, timeout_ms=500.0)
 
@@ -98,7 +99,7 @@ def test_a_trial_on_a_realistic_bus_runs_slower_in_simulated_time() -> None:
     timing = bus_timing(fidelity, stack.servos)
     assert timing == BusTiming(baudrate=stack.servos.baudrate, latency_timer_s=1e-3)
     assert bus_timing(scene.fidelity, stack.servos) is None
-    spec = TrialSpec("S8", "bench", "S8", 314.53e3, 0.45, "straight", "downward", 0.0, 44e-3, 3)
+    spec = TrialSpec("S8", "bench", "S8", 314.53e3, 0.45, BENCH_COLUMN, "downward", 0.0, 44e-3, 3)
     ideal = run_sim_trial(spec, scene, stack)
     slow = run_sim_trial(spec, timed, stack)
     assert ideal.state == slow.state == "done"

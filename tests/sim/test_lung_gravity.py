@@ -38,7 +38,7 @@ def in_plane_share(orientation: str, tube: str = "bent30") -> float:
     spec = next(
         s
         for s in campaign_trials(LUNG, STACK, 0)
-        if s.orientation == orientation and s.tube == tube
+        if s.orientation == orientation and s.tube.name == tube
     )
     pose = kinematics.forward(STACK.tube(tube), spec.roll, 0.0)
     return WEIGHT.across(sensing_axis(pose.tangent, spec.roll)).tip / WEIGHT.tip

@@ -16,7 +16,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ...config.schema import StackConfig, TubeConfig
+from ...config.schema import TubeConfig
 
 STAGE = "bench-stage"  # the bench column's rig key (palpate.calibration): its compliance
 Kind = Literal["bench", "robot"]
@@ -52,11 +52,6 @@ class Stage:
     def of_tube(cls, kind: str, tube: TubeConfig, exposed: float) -> Stage:
         """A trial's stage from its ``kind`` and the tube it names (unused on the bench)."""
         return cls.on(tube, exposed) if kind == "robot" else cls.column(exposed)
-
-    @classmethod
-    def in_stack(cls, kind: str, stack: StackConfig, tube: str, exposed: float) -> Stage:
-        """A campaign trial's stage: ``kind`` ("bench" or "robot") and its tube's name."""
-        return cls.on(stack.tube(tube), exposed) if kind == "robot" else cls.column(exposed)
 
     @property
     def kind(self) -> Kind:
