@@ -13,19 +13,11 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterable, Sequence
-from typing import Protocol
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import MM, StackConfig
 from palpate.estimation.beam.stage import STAGE
 from palpate.estimation.fits.compliance import ComplianceFit, pooled
-
-
-class Calibrating(Protocol):
-    """What a calibration trial's outcome carries (``palpate.simulation.trial.TrialOutcome``)."""
-
-    @property
-    def calibration(self) -> ComplianceFit | None: ...
 
 
 def is_reference(scene: SceneConfig, spec: object) -> bool:

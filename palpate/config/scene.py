@@ -174,10 +174,6 @@ class CampaignConfig:
         """Whether trials probe: ``probe`` itself, or for null, robot campaigns only."""
         return self.kind == "robot" if self.probe is None else self.probe
 
-    @property
-    def orientation_rolls_deg(self) -> tuple[float, ...]:
-        return tuple(ORIENTATION_ROLL_DEG[o] for o in self.orientations)
-
     # the SI views of the unit-suffixed fields (palpate.config.units)
     exposed_lengths = SITuple("exposed_lengths_mm", MM)
     exposed_length = SI("exposed_length_mm", MM)

@@ -4,7 +4,6 @@ run folder's ``results.json`` holds and what :func:`palpate.simulate` returns.""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from palpate.calibration import calibrate
@@ -83,11 +82,3 @@ def campaign_report(
     if found:
         payload["calibration"] = {k: [lo * 1e3, hi * 1e3] for k, (lo, hi) in found.items()}
     return CampaignReport(scene.name, list(outcomes), records, found, payload)
-
-
-def run_folder_files(report: CampaignReport, run_dir: Path) -> list[Path]:
-    """Write the report's results into its run folder (``palpate.reports.results``)."""
-    from palpate.reports.results import CampaignResults
-
-    payload = report.as_dict()
-    return CampaignResults(run_dir).finish(payload["trials"], report.samples, payload)
