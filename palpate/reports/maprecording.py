@@ -78,7 +78,7 @@ def write_map_recording(result: SurveyResult, path: Path, threshold: float | Non
     """The survey's map after each probe (module docstring) as MCAP at ``path``."""
     encode = serialize_dynamic(CLOUD, CLOUD_SCHEMA)[CLOUD]
     with open(path, "wb") as fh:
-        writer = Writer(fh, compression=CompressionType.NONE)
+        writer = Writer(fh, compression=CompressionType.ZSTD)
         writer.start(profile="ros2", library="palpate")
         schema = writer.register_schema(CLOUD, SchemaEncoding.ROS2, CLOUD_SCHEMA.encode())
         grid = writer.register_channel("/map/grid", MessageEncoding.CDR, schema)

@@ -1,11 +1,13 @@
 """MCAP recordings of trials, beside the JSON Lines log (which stays the replay source).
 
 A :class:`McapRecorder` takes every record its trial log writes (``robot.records.log``) and
-writes its ROS 2 messages (``robot.records.ros2``) to ``<log>.mcap`` as the trial runs, flushed
-when the log flushes (every record that is not a sample, every 0.1 s of samples), so a crash
-keeps what the JSON log keeps. The file is written unchunked (every message a record of its
-own, readable up to the last byte written) and closed with MCAP's summary and footer; the
-header record is the recording's metadata ``palpate.trial`` (its keys, values as JSON). When
+writes its ROS 2 messages (``robot.records.ros2``) to ``<log>.mcap`` as the trial runs. The file
+is chunked and indexed, as rosbag2 writes MCAP, so tools that read by index (Rerun, rosbag2's
+MCAP storage, Foxglove) open it: each chunk zstd-compressed with its message indexes behind
+it, and MCAP's summary (chunk indexes, statistics, channels) at the close. A chunk ends when
+the log flushes (every record that is not a sample, every 0.1 s of samples), so a crash keeps
+what the JSON log keeps: a killed trial's file reads up to its last whole chunk. The header's
+fields are the recording's metadata ``palpate.trial`` (its keys, values as JSON). When
 the trial ends the tip force is derived from every sample's strains (the estimator's beam
 states, ``estimation.trial.states``) and written as ``/tip/wrench``, and on the robot each sample's
 tip pose as ``/tf``.
@@ -47,6 +49,7 @@ from .ros2 import (
 )
 
 LIBRARY = "palpate"
+CHUNK_BYTES = 1 << 20  # a chunk's most (uncompressed): the log's flushes end chunks long before
 
 
 class Sample(NamedTuple):
@@ -68,7 +71,7 @@ class McapRecorder:
     def __init__(self, path: str | Path, header: dict[str, Any]) -> None:
         self.path = Path(path)
         self._fh: IO[bytes] | None = open(self.path, "wb")  # noqa: SIM115
-        self._writer = Writer(self._fh, use_chunking=False, compression=CompressionType.NONE)
+        self._writer = Writer(self._fh, chunk_size=CHUNK_BYTES, compression=CompressionType.ZSTD)
         self._writer.start(profile="ros2", library=LIBRARY)
         self._writer.add_metadata("palpate.trial", _metadata(header))
         self._channels: dict[str, int] = {}
@@ -119,9 +122,9 @@ class McapRecorder:
         )
 
     def flush(self) -> None:
-        """Hand the messages written so far to the OS (the log calls it when it flushes)."""
+        """End the chunk in progress and hand it to the OS (the log calls it when it flushes)."""
         if self._fh is not None:
-            self._fh.flush()
+            self._writer.flush()  # type: ignore[no-untyped-call,unused-ignore]
 
     def close(self, loads: Callable[[McapRecorder], list[float] | None] | None = None) -> None:
         """Write the derived tip force (``loads``: the axial load per sample, N; None or a
