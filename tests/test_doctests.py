@@ -15,6 +15,10 @@ LAYER_FRONTS = (
     "palpate.sensor",
     "palpate.sim",
     "palpate.wire",
+    "palpate.maps",
+    "palpate.sensor_design",
+    "palpate.estimation.reach",
+    "palpate.estimation.trial.finished",
     "palpate.reports.mapresults",
     "palpate.services.design",
 )

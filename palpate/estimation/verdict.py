@@ -29,20 +29,16 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
-
-from .belief import Hypothesis
 from .jointfit import JointFit
 from .jointfit.beliefcheck import CONTRADICTED
 from .jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
 from .pose.misalignment import Lean
+from .reach import Reach, too_soft
 from .relaxation import RelaxationFit
 
 Status = Literal["ok", "suspect", "none"]
 STATUSES: tuple[Status, ...] = ("ok", "suspect", "none")
 CORRECTED = ("corrected with", "correction applied")
-NO_BUCKLING = "no buckling"  # the state machine's reason when the travel window ran out
-DESIGN_HINT = "see `palpate design`"
 NORMAL_SIGMAS = 2.0  # a measured misalignment is within the tolerance when this many sigmas are
 IMPRECISE = 0.10
 """Relative half-width of the 95 % interval beyond which a number is not ``ok``. Where the
@@ -99,6 +95,8 @@ class TrialFacts:
         motion: the surface's displacement along the axis between the first touch and the
             release (m, ``estimation.pose.motion``), None if not measured.
         motion_tolerance: the campaign's tolerance on it (m), None: not checked.
+        poisson, compliance_max: the believed Poisson ratio and the rig's largest compliance
+            (m/N): with them a trial whose window ran out bounds the modulus (``reach``).
     """
 
     state: str = "done"
@@ -118,6 +116,8 @@ class TrialFacts:
     probe_reason: str | None = None
     motion: float | None = None
     motion_tolerance: float | None = None
+    poisson: float | None = None
+    compliance_max: float | None = None
 
 
 MOTION_SHARE = 0.04
@@ -134,7 +134,8 @@ share of the shortening, 2 z0 z L, is first order in the bending and left out
 def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict:
     """The verdict on ``fit`` (None: no fit was made) for a trial with ``facts``; ``tip_radius``
     (m) is the sensor's, for the depth buckling needs."""
-    soft = _too_soft(fit, facts, tip_radius)
+    reach = Reach(facts.travel_window, facts.critical_load, facts.poisson, facts.compliance_max)
+    soft = too_soft(fit, facts.reason, reach, tip_radius)
     if soft is not None:
         return _none(soft, facts)
     if fit is None or not fit.success or fit.modulus is None:
@@ -338,42 +339,6 @@ def _is_suspect(warning: str) -> bool:
     if warning.startswith((EDGE_WARNING, BEFORE_WARNING, CORRELATED_WARNING)):
         return True
     return not any(c in warning for c in CORRECTED)
-
-
-def _too_soft(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> str | None:
-    """The reason the tissue is too soft for the sensor, or None."""
-    window = facts.travel_window
-    if window is None:
-        return None
-    mm = window * 1e3
-    if facts.reason.startswith(NO_BUCKLING) and (fit is None or not fit.success):
-        return (
-            f"tissue too soft for this sensor: no buckling within the {mm:g} mm travel window; "
-            f"{DESIGN_HINT}"
-        )
-    needed = _depth_to_buckle(fit, facts, tip_radius)
-    if needed is None or needed <= window or fit is None or fit.modulus is None:
-        return None
-    return (
-        f"tissue too soft for this sensor: buckling needs more than the {mm:g} mm travel window "
-        f"({needed * 1e3:.1f} mm at {fit.modulus / 1e3:.0f} kPa); {DESIGN_HINT}"
-    )
-
-
-def _depth_to_buckle(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> float | None:
-    """Stage travel past contact (m) at which the fitted tissue pushes back P_cr: the
-    indentation there plus the rig's compliance times P_cr (None without a fit or P_cr)."""
-    p_cr = facts.critical_load
-    if fit is None or not fit.success or fit.modulus is None or fit.best is None or not p_cr:
-        return None
-    best = Hypothesis.described(fit.best, tip_radius)
-    law = best.law
-    depth = np.geomspace(1e-7, 0.02, 600)
-    force = np.maximum.accumulate(law.force(fit.modulus, depth))
-    k = int(np.searchsorted(force, p_cr))
-    if k >= depth.size:
-        return math.inf
-    return float(depth[k]) + best.compliance * p_cr
 
 
 def relaxed_verdict(

@@ -41,6 +41,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from ..estimation.detect.buckling import BucklingDetector
+from ..estimation.reach import NO_BUCKLING
 from .guards import STATE_TIMEOUT, Guards, Observation, limit_violation
 from .plan import (
     PLANNED_ENDS,
@@ -213,14 +214,6 @@ class IndentationMachine:
         self._entered = t
         self.on_transition(tr)
 
-    def _retract_goal(self) -> float:
-        """Home, or further back if the tissue was touched where the plan did not expect it:
-        never end a retraction still touching."""
-        p = self.plan
-        if self._first_touch is None:
-            return p.home_advance
-        return min(p.home_advance, self._first_touch - p.standoff)
-
     def _held(self, obs: Observation) -> Command | None:
         """Hold still while a :class:`RestCheck` runs (re-zeroing on its last tick)."""
         rezero = self._rest.hold(self.state in AT_REST)
@@ -318,7 +311,7 @@ class IndentationMachine:
     def _unreachable(self, obs: Observation, why: str) -> Command:
         self.marks.reason, self.ending = f"unreachable: {why}", State.UNREACHABLE
         self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
-        return Command(self._retract_goal(), obs.roll, self.plan.fast_speed)
+        return Command(self.plan.retract_goal(self._first_touch), obs.roll, self.plan.fast_speed)
 
     def _contact(self, obs: Observation) -> Command:
         self.detector.reset()
@@ -326,9 +319,9 @@ class IndentationMachine:
         return self._indent_goal(obs)
 
     def _indent_goal(self, obs: Observation) -> Command:
-        assert self.marks.x_contact is not None  # set on entering CONTACT
-        goal = self.marks.x_contact + self.guards.max_travel_past_contact
-        return Command(goal, self.plan.roll, self.plan.indent_speed)
+        assert self.marks.x_contact is not None  # set on entering CONTACT: the window ends short
+        window = self.guards.max_travel_past_contact - self.plan.position_tolerance  # of the guard
+        return Command(self.marks.x_contact + window, self.plan.roll, self.plan.indent_speed)
 
     def _indenting(self, obs: Observation) -> Command:
         if self.detector.update(obs.strains, obs.advance, obs.tip_force):
@@ -339,16 +332,23 @@ class IndentationMachine:
             return self._indent_goal(obs)
         cmd = self._indent_goal(obs)
         if obs.advance >= cmd.advance - self.plan.position_tolerance:
-            # The whole travel window is used up without buckling (a compliant tube tip, a
-            # stiff sample): stop now rather than press on the tissue until the state timeout.
+            # The whole travel window used up without buckling (tissue below the sensor's range,
+            # a compliant tube tip): an answer, not a fault (the verdict bounds the modulus).
             travel = self.guards.max_travel_past_contact * 1e3
-            self._fault(obs, f"no buckling: travel past contact reached the {travel:.2f} mm limit")
-            return self._hold(obs)
+            self.marks.reason = (
+                f"{NO_BUCKLING}: travel past contact reached the {travel:.2f} mm limit"
+            )
+            return self._complete(obs, self.marks.reason)
         return cmd
 
-    def _buckled(self, obs: Observation) -> Command:
+    def _post_goal(self, obs: Observation) -> float:
+        """The post-buckling record's end, never past the travel window (nor its guard)."""
         assert self.marks.x_buckling is not None
         goal = self.marks.x_buckling + self.plan.post_buckling_travel
+        return min(goal, self._indent_goal(obs).advance)
+
+    def _buckled(self, obs: Observation) -> Command:
+        goal = self._post_goal(obs)
         if obs.advance >= goal - self.plan.position_tolerance:
             if self.plan.hold_time <= 0:
                 return self._complete(obs, "post-buckling record complete")
@@ -357,20 +357,20 @@ class IndentationMachine:
         return Command(goal, self.plan.roll, self.plan.indent_speed)
 
     def _holding(self, obs: Observation) -> Command:
-        assert self.marks.x_buckling is not None
         if obs.t - self._entered >= self.plan.hold_time - 1e-9:  # the clock sums its ticks
             return self._complete(obs, f"hold of {self.plan.hold_time:g} s complete")
-        goal = self.marks.x_buckling + self.plan.post_buckling_travel
-        return Command(goal, self.plan.roll, self.plan.indent_speed)
+        return Command(self._post_goal(obs), self.plan.roll, self.plan.indent_speed)
 
     def _complete(self, obs: Observation, why: str) -> Command:
         self.marks.reason, self.ending = self.marks.reason or "completed", State.DONE
         self._go(State.RETRACTING, obs.t, why, obs.advance, obs.strains)
-        return Command(self._retract_goal(), self.plan.roll, self.plan.fast_speed)
+        return Command(
+            self.plan.retract_goal(self._first_touch), self.plan.roll, self.plan.fast_speed
+        )
 
     def _retracting(self, obs: Observation) -> Command:
         p = self.plan
-        goal = self._retract_goal()
+        goal = self.plan.retract_goal(self._first_touch)
         if abs(obs.advance - goal) <= p.position_tolerance:
             self._go(
                 self.ending, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains

@@ -59,6 +59,13 @@ class TrialPlan:
     gated: bool = False
     gate_fresh: float = 1.0
 
+    def retract_goal(self, first_touch: float | None) -> float:
+        """Home, or further back if the tissue was touched (at ``first_touch``, m) where the plan
+        did not expect it: never end a retraction still touching."""
+        if first_touch is None:
+            return self.home_advance
+        return min(self.home_advance, first_touch - self.standoff)
+
 
 @dataclass(frozen=True)
 class Command:

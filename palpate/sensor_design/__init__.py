@@ -42,6 +42,11 @@ Layout: ``space`` (what can be built and what must hold: :class:`DesignSpace`,
 vectorised over them: depths, strains, imperfection, the checks; :func:`evaluate_design` for one
 sensor), ``search`` (the grid and the leximin choice: :func:`design_sensor`), ``results``
 (:data:`CHECKS`, :class:`Check`, :class:`DesignEvaluation`, :class:`DesignResult`).
+
+The paper's sensor's depths at the ends of its range (m): 1.6 mm at 300 kPa, 0.68 mm at 1.1 MPa::
+
+    >>> [round(float(hertz_depth(1.35, e, 1.75e-3, 0.45)) * 1e3, 2) for e in (300e3, 1100e3)]
+    [1.61, 0.68]
 """
 
 from __future__ import annotations

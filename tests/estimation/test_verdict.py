@@ -5,7 +5,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import pytest
+
+from palpate.estimation.contact.hertz import hertz_force
 from palpate.estimation.jointfit import JointFit
+from palpate.estimation.reach import Reach, modulus_below
 from palpate.estimation.verdict import TrialFacts, Verdict, judge
 
 R = 3.5e-3
@@ -86,6 +90,31 @@ def test_tissue_too_soft_for_the_sensor_is_none_with_the_reason() -> None:
     assert v.status == "none"
     assert "buckling needs more than the 2.5 mm travel window" in v.reasons[0]
     assert judge(fit(300e3), FACTS, R).status == "ok"
+
+
+def test_a_window_run_out_bounds_the_modulus_from_above() -> None:
+    """The bound is the modulus at which Hertz pushes back exactly P_cr at the least
+    indentation the window leaves (window less compliance times P_cr), so any tissue that
+    pushed back less there is below it; the verdict states it; unknown nu or compliance, none."""
+    reach = Reach(window=2.5e-3, p_cr=1.35, poisson=0.45, compliance=0.2e-3)
+    bound = modulus_below(reach, R)
+    assert bound is not None
+    depth = 2.5e-3 - 0.2e-3 * 1.35
+    assert float(hertz_force(bound, depth, R, 0.45)) == pytest.approx(1.35, rel=1e-12)
+    assert float(hertz_force(0.99 * bound, depth, R, 0.45)) < 1.35
+    assert modulus_below(dataclasses.replace(reach, compliance=None), R) is None
+    assert modulus_below(dataclasses.replace(reach, compliance=1.0), R) is None  # takes it all
+    facts = TrialFacts(
+        "done",
+        "no buckling: travel past contact reached the 2.50 mm limit",
+        travel_window=2.5e-3,
+        critical_load=1.35,
+        poisson=0.45,
+        compliance_max=0.2e-3,
+    )
+    v = judge(JointFit(False, "no contact"), facts, R)
+    assert v.status == "none"
+    assert f"the tissue is below {bound / 1e3:.3g} kPa" in v.reasons[0]
 
 
 def test_an_interval_wider_than_ten_percent_either_side_is_not_ok() -> None:

@@ -57,6 +57,7 @@ class ScriptedRig:
     stream_gap: tuple[float, float] | None = None  # times (s) between which no frame comes
     strain_gain: float = 0.02  # strain per metre past buckling
     glitch_at: float | None = None  # advance where one tick reads a contact (the zero's noise)
+    slip: tuple[float, float] | None = None  # (advance, jump m): the stage slips once past it
     torque: bool = True
     commands: list[Command] = field(default_factory=list)
     _goal: Command | None = None
@@ -72,6 +73,8 @@ class ScriptedRig:
             step = self._goal.speed * dt
             self.advance += max(-step, min(step, self._goal.advance - self.advance))
             self.roll = self._goal.roll
+        if self.slip is not None and self.advance >= self.slip[0]:
+            self.advance, self.slip = self.advance + self.slip[1], None
         if self.fault_at is not None and self.advance >= self.fault_at and not self._fault:
             self._fault = True
             self.fault_at = None
@@ -160,14 +163,39 @@ def test_fiber_strain_guard_stops_and_retracts() -> None:
     assert rig.released == 1
 
 
-def test_travel_past_contact_guard() -> None:
+def test_a_travel_window_used_up_without_buckling_is_an_answer_not_a_fault() -> None:
+    """Tissue below the sensor's range: the stage indents to the window's end, short of the
+    guard, and retracts; the trial ends DONE, its reason naming the window (the verdict then
+    says the tissue is too soft, with the modulus it is below)."""
     rig = ScriptedRig(VirtualClock(), x_buckle=1.0)  # never buckles
+    result = run(rig, guards=Guards(max_travel_past_contact=0.5e-3))
+    assert result.state is State.DONE
+    assert result.reason.startswith("no buckling: travel past contact reached the 0.50 mm limit")
+    indent_goals = [c.advance for c in rig.commands if c.speed == TrialPlan.indent_speed]
+    assert indent_goals
+    assert max(indent_goals) < 10e-3 + 0.5e-3  # the window ends short of the guard
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)  # retracted home
+    assert rig.torque
+
+
+def test_the_travel_past_contact_guard_still_faults_a_stage_that_slips_past_it() -> None:
+    rig = ScriptedRig(VirtualClock(), x_buckle=1.0, slip=(10.3e-3, 0.4e-3))
     result = run(rig, guards=Guards(max_travel_past_contact=0.5e-3))
     assert result.state is State.FAULT
     assert "travel past contact" in result.reason
+    assert "over the limit" in result.reason
+
+
+def test_the_post_buckling_record_stops_at_the_window() -> None:
+    """Buckling just before the window's end: the post-buckling travel is cut at the window
+    (it used to run the stage into the guard, a fault, on soft samples)."""
+    rig = ScriptedRig(VirtualClock(), x_buckle=10.25e-3, strain_gain=2.0)
+    result = run(rig, guards=Guards(max_travel_past_contact=0.5e-3))
+    assert result.state is State.DONE, result.reason
+    assert result.marks.x_buckling is not None
+    assert result.marks.x_buckling + TrialPlan.post_buckling_travel > 10e-3 + 0.5e-3
     indent_goals = [c.advance for c in rig.commands if c.speed == TrialPlan.indent_speed]
-    assert indent_goals
-    assert max(indent_goals) <= 10e-3 + 0.5e-3 + 1e-5
+    assert max(indent_goals) < 10e-3 + 0.5e-3
 
 
 def test_no_contact_within_window_faults() -> None:

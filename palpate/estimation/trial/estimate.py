@@ -260,6 +260,8 @@ def verdict_for(
         misalignment=inputs.misalignment,
         misalignment_tolerance=inputs.misalignment_tolerance,
         compliance_calibrated=inputs.compliance_calibrated,
+        poisson=inputs.poisson,
+        compliance_max=inputs.compliance[1],
         orientation_verified=inputs.orientation_verified,
         lean=lean,
         misalignment_sigma=inputs.misalignment_sigma,
