@@ -6,7 +6,9 @@ an answer, not a fault). The tip then pushed back less than P_cr at the end of t
 the tissue was indented at least the window less the rig's largest compliance times P_cr (the
 compliance took the rest; the beam's shortening before buckling is microns). A sphere on a
 half-space pushes back least at a given depth (a layer over a base pushes back more), so Hertz
-at that least depth bounds the modulus from above::
+at that least depth bounds the modulus from above. The bound is the belief's: a rig softer than
+its largest believed compliance (a compliant tube tip nobody calibrated) takes more of the
+window, and the reason says so (``unless the rig gives more than ... mm/N``)::
 
     bound = modulus_below(Reach(window=2.5e-3, p_cr=1.35, poisson=0.45, compliance=0.0), 1.75e-3)
     too_soft(fit, reason, reach, tip_radius)   # the verdict's reason, or None
@@ -62,7 +64,12 @@ def too_soft(fit: JointFit | None, reason: str, reach: Reach, tip_radius: float)
         return None
     mm = reach.window * 1e3
     bound = modulus_below(reach, tip_radius) if reason.startswith(NO_BUCKLING) else None
-    below = "" if bound is None else f"; the tissue is below {bound / 1e3:.3g} kPa"
+    below = (
+        ""
+        if bound is None
+        else f"; the tissue is below {bound / 1e3:.3g} kPa"
+        + (f" unless the rig gives more than {(reach.compliance or 0.0) * 1e3:.2g} mm/N")
+    )
     if reason.startswith(NO_BUCKLING) and (fit is None or not fit.success):
         return (
             f"tissue too soft for this sensor: no buckling within the {mm:g} mm travel window"
