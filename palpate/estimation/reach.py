@@ -8,7 +8,8 @@ compliance took the rest; the beam's shortening before buckling is microns). A s
 half-space pushes back least at a given depth (a layer over a base pushes back more), so Hertz
 at that least depth bounds the modulus from above. The bound is the belief's: a rig softer than
 its largest believed compliance (a compliant tube tip nobody calibrated) takes more of the
-window, and the reason says so (``unless the rig gives more than ... mm/N``)::
+window, and the reason says so (``unless the rig gives more than ... mm/N``, or ``the rig taken
+rigid``)::
 
     bound = modulus_below(Reach(window=2.5e-3, p_cr=1.35, poisson=0.45, compliance=0.0), 1.75e-3)
     too_soft(fit, reason, reach, tip_radius)   # the verdict's reason, or None
@@ -65,10 +66,7 @@ def too_soft(fit: JointFit | None, reason: str, reach: Reach, tip_radius: float)
     mm = reach.window * 1e3
     bound = modulus_below(reach, tip_radius) if reason.startswith(NO_BUCKLING) else None
     below = (
-        ""
-        if bound is None
-        else f"; the tissue is below {bound / 1e3:.3g} kPa"
-        + (f" unless the rig gives more than {(reach.compliance or 0.0) * 1e3:.2g} mm/N")
+        "" if bound is None else f"; the tissue is below {bound / 1e3:.3g} kPa" + _assumed(reach)
     )
     if reason.startswith(NO_BUCKLING) and (fit is None or not fit.success):
         return (
@@ -82,6 +80,13 @@ def too_soft(fit: JointFit | None, reason: str, reach: Reach, tip_radius: float)
         f"tissue too soft for this sensor: buckling needs more than the {mm:g} mm travel window "
         f"({needed * 1e3:.1f} mm at {fit.modulus / 1e3:.0f} kPa){below}; {DESIGN_HINT}"
     )
+
+
+def _assumed(reach: Reach) -> str:
+    """The compliance a bound assumes, said."""
+    if not reach.compliance:
+        return " (the rig taken rigid)"
+    return f" unless the rig gives more than {reach.compliance * 1e3:.2g} mm/N"
 
 
 def depth_to_buckle(fit: JointFit | None, p_cr: float | None, tip_radius: float) -> float | None:
