@@ -18,6 +18,7 @@ import pytest
 
 from palpate.campaigns.runs import locked, run_dirs
 from palpate.cli import main
+from palpate.config import resolve
 
 BENCH = ["sim", "--campaign", "bench", "--workers", "1", "--no-plots", "--json"]
 
@@ -121,23 +122,30 @@ def test_resume_needs_an_earlier_run_of_the_same_command(
 
 
 FAULTING_SCENE = """name: faulting
+robot: {robot}
 campaign:
   kind: bench
   exposed_lengths_mm: [42, 44]
-  max_travel_past_contact_mm: 0.05   # the beam cannot buckle within 50 um: each trial faults
 """
 
 
 def test_a_faulted_trial_exits_1_with_the_table_printed(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    """A fiber strain guard the buckled beam must trip (50 ue, where the buckled beam bends
+    past 1000 ue): the trial faults, the table is printed all the same, exit 1. (A travel window
+    the beam cannot buckle in is an answer, not a fault: ``done``, verdict ``none``.)"""
+    robot = tmp_path / "robot.yaml"
+    text = resolve("robot.yaml").read_text(encoding="utf-8")
+    assert "strain_limit_ue: 5000" in text
+    robot.write_text(text.replace("strain_limit_ue: 5000", "strain_limit_ue: 50"), "utf-8")
     scene = tmp_path / "faulting.yaml"
-    scene.write_text(FAULTING_SCENE, encoding="utf-8")
+    scene.write_text(FAULTING_SCENE.format(robot=robot), encoding="utf-8")
     argv = ["sim", "--scene", str(scene), "--workers", "1", "--no-plots", "--limit", "1"]
     assert main([*argv, "--out", str(tmp_path / "out")]) == 1
     out = capsys.readouterr().out
     assert "faulting campaign" in out
-    assert "fault" in out.split("trials (", 1)[1]
+    assert "fault: fiber strain" in out.split("trials (", 1)[1]
 
 
 def _children(pid: int) -> list[int]:
