@@ -370,7 +370,7 @@ class IndentationMachine:
 
     def _retracting(self, obs: Observation) -> Command:
         p = self.plan
-        goal = self.plan.retract_goal(self._first_touch)
+        goal = p.retract_goal(self._first_touch)
         if abs(obs.advance - goal) <= p.position_tolerance:
             self._go(
                 self.ending, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains

@@ -140,9 +140,8 @@ def _bench_geometry(
     depth = BENCH_CONTACT_TRANSLATION + spec.exposed_length + stack.sensor.tip_radius
     surface = Surface(point=depth * VERTICAL, normal=-VERTICAL)
     if sample is not None and (sample.tilt != 0.0 or sample.curvature_radius is not None):
-        stage = TubeConfig(name="bench-stage")  # a straight "tube": azimuth from -y
-        nominal = (surface.point, VERTICAL)
-        surface = place_sample(stage, -math.pi / 2, nominal, sample, spec.seed)
+        nominal = (surface.point, VERTICAL)  # the column, a straight "tube": azimuth from -y
+        surface = place_sample(BENCH_COLUMN, -math.pi / 2, nominal, sample, spec.seed)
     return TrialGeometry(0.0, BENCH_CONTACT_TRANSLATION, surface, 0.0, "bench-stage")
 
 
