@@ -33,7 +33,8 @@ class BreathingConfig:
         ``cardiac_mm`` and ``cardiac_period_s``: the heart's beat, always; ``phase``: where in its
         cycle each trial starts, drawn per trial (``random``) or at the cycle's start
         (``start``); ``gate``: the ventilator's breath-hold signal reaches the board (status bit 6
-        of every frame) while a hold lasts.
+        of every frame) while a hold lasts; ``ecg``: an ECG monitor's sync pulse reaches the board
+        (status bit 7) at each R wave while the heart beats (``cardiac_mm`` > 0).
     """
 
     amplitude_mm: float = field(default=3.0, metadata=limits(ge=-50, le=50))
@@ -46,6 +47,7 @@ class BreathingConfig:
     cardiac_period_s: float = field(default=0.85, metadata=limits(gt=0, le=5))
     phase: Literal["random", "start"] = "random"
     gate: bool = True
+    ecg: bool = True
 
     @property
     def cycle(self) -> float:

@@ -32,6 +32,7 @@ from typing import Literal
 from .jointfit import JointFit
 from .jointfit.beliefcheck import CONTRADICTED
 from .jointfit.envelope import BEFORE_WARNING, CORRELATED_WARNING, EDGE_WARNING
+from .pose.heartbeat import Heartbeat
 from .pose.misalignment import Lean
 from .reach import Reach, too_soft
 from .relaxation import RelaxationFit
@@ -97,6 +98,7 @@ class TrialFacts:
         motion_tolerance: the campaign's tolerance on it (m), None: not checked.
         poisson, compliance_max: the believed Poisson ratio and the rig's largest compliance
             (m/N): with them a trial whose window ran out bounds the modulus (``reach``).
+        heart: the heart's beat taken out of the record (``estimation.pose.heartbeat``), None.
     """
 
     state: str = "done"
@@ -118,8 +120,11 @@ class TrialFacts:
     motion_tolerance: float | None = None
     poisson: float | None = None
     compliance_max: float | None = None
+    heart: Heartbeat | None = None
 
 
+HOLDS_RAN_OUT = "no estimate: every breath hold ended before the trial did"
+"""How a gated trial ends when its last allowed breath hold ended before it (robot.body)."""
 MOTION_SHARE = 0.04
 """The surface's motion during a contact, as a share of the fitted indentation, past which the
 trial is not ok (with ``motion_tolerance`` set): about 6 % of the modulus (docs/breathing.md)."""
@@ -136,8 +141,8 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
     (m) is the sensor's, for the depth buckling needs."""
     reach = Reach(facts.travel_window, facts.critical_load, facts.poisson, facts.compliance_max)
     soft = too_soft(fit, facts.reason, reach, tip_radius)
-    if soft is not None:
-        return _none(soft, facts)
+    if soft is not None or facts.reason.startswith(HOLDS_RAN_OUT):
+        return _none(soft or facts.reason, facts)
     if fit is None or not fit.success or fit.modulus is None:
         return _none("no estimate: " + ("no fit" if fit is None else fit.message), facts)
     # outside the designed range: still a number and its interval, marked suspect (a clinician's
@@ -153,9 +158,7 @@ def judge(fit: JointFit | None, facts: TrialFacts, tip_radius: float) -> Verdict
     if imprecise is not None:
         reasons.append(imprecise)
     reasons += _trial_reasons(facts)
-    moved = _moved(fit, facts)
-    if moved is not None:
-        reasons.append(moved)
+    reasons += [why for why in (_moved(fit, facts), _beat(facts)) if why is not None]
     if facts.relaxation is not None and facts.relaxation.relaxes:
         reasons += [w for w in facts.relaxation.warnings if w.startswith(CONTRADICTED)]
         reasons.append(
@@ -254,7 +257,21 @@ def _moved(fit: JointFit, facts: TrialFacts) -> str | None:
     toward = "toward" if moved > 0 else "away from"
     return (
         f"moved: the surface moved {abs(moved) * 1e3:.2f} mm {toward} the sensor between the "
-        f"first touch and the release, over {what} (breathing, the heart?)"
+        f"first touch and the release, over {what} ("
+        + ("a drift: breathing, the patient)" if facts.heart else "breathing, the heart?)")
+    )
+
+
+def _beat(facts: TrialFacts) -> str | None:
+    """That the heart moved the surface past the campaign's tolerance, taken out of the record
+    (the interval carries its amplitude's error), or None."""
+    heart, tol = facts.heart, facts.motion_tolerance
+    if heart is None or tol is None or 2.0 * heart.amplitude <= tol:
+        return None
+    return (
+        f"heartbeat: the surface beat {2e3 * heart.amplitude:.2f} mm peak to peak every "
+        f"{heart.period:.2f} s (the ECG's R waves), past the {tol * 1e3:g} mm tolerance; taken "
+        "out of the record, its amplitude's error carried in the interval"
     )
 
 

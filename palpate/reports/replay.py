@@ -144,7 +144,8 @@ def _replay_joint(
     samples = list(log.of_kind("sample"))
     rows = [(r["state"], logged_number(r["advance"]), r["strains"]) for r in samples]
     tips = [r.get("tip_force") for r in samples] if any("tip_force" in r for r in samples) else None
-    fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples], tips)
+    beats = [r["t"] for r in samples if r.get("beat")]
+    fitted = fit_rows(rows, inputs, stack, section, [r["t"] for r in samples], tips, beats)
     end = log.end or {}
     verdict, relaxed = None, None
     if not inputs.rigid:
@@ -159,6 +160,7 @@ def _replay_joint(
             tip_load_at_buckling(rows, tips),
             fitted.tip_bow,
             fitted.motion,
+            fitted.heart,
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

@@ -44,6 +44,8 @@ class Observation:
     joints_age: float = 0.0
     # the ventilator's breath-hold gate in the newest frame (status bit 6); None: no frame yet
     gate: bool | None = None
+    # an ECG monitor's R-wave pulse in a frame of this tick (status bit 7): the heart's beat
+    beat: bool = False
 
     @property
     def measured_advance(self) -> float:

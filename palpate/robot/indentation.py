@@ -10,10 +10,11 @@ States and the normal path::
     IDLE -> HOMING -> POSITIONING [-> WAITING] -> APPROACH -> CONTACT -> INDENTING -> BUCKLED
          [-> HOLDING] -> RETRACTING -> DONE
 
-With ``TrialPlan.gated`` the machine waits at the stand-off (WAITING) for a breath hold: the
-ventilator's gate (``Observation.gate``) rising no more than ``gate_fresh`` before (a hold
-already under way has an end nobody knows), then approaches and indents within it; the gate
-falling before the indentation is over retracts, ending in FAULT (the tissue moves again).
+With ``TrialPlan.gated`` the machine waits at the stand-off (WAITING) for a breath hold that
+has just begun (``robot.body``), then approaches and indents within it; a hold that ends first
+retracts and waits for the next (the tissue moves again), and after ``hold_retries`` such holds
+the trial ends DONE with no estimate (``estimation.verdict.HOLDS_RAN_OUT``). With an ECG's R
+waves the first beats in contact are indented slowly (``robot.body``).
 
 With ``TrialPlan.hold_time`` > 0 the stage then stands still that long: the buckled beam is
 nearly a constant-force spring, so the hold is a creep test the gratings record
@@ -42,17 +43,10 @@ from dataclasses import dataclass, field
 
 from ..estimation.detect.buckling import BucklingDetector
 from ..estimation.reach import NO_BUCKLING
+from ..estimation.verdict import HOLDS_RAN_OUT
+from .body import BodyWatch
 from .guards import STATE_TIMEOUT, Guards, Observation, limit_violation
-from .plan import (
-    PLANNED_ENDS,
-    TERMINAL,
-    Command,
-    Prober,
-    State,
-    Transition,
-    TrialMarks,
-    TrialPlan,
-)
+from .plan import PLANNED_ENDS, TERMINAL, Command, Prober, State, Transition, TrialMarks, TrialPlan
 from .probe_result import ProbeResult
 from .rest_check import RestCheck
 
@@ -101,7 +95,8 @@ class IndentationMachine:
     _first_touch: float | None = None  # advance at the first contact event, planned or not
     _lost_since: float | None = None  # time the servo replies were lost while retracting
     _rest: RestCheck = field(default_factory=lambda: RestCheck(REZERO_SETTLE_TICKS))
-    _gate: tuple[bool, float | None] = (True, None)  # the gate last seen, the time it rose
+    _body: BodyWatch = field(default_factory=BodyWatch)  # the breath-hold gate, the heart
+    _retry: bool = False  # retracting to wait for the next breath hold
     _contact_ticks: int = 0  # successive ticks with a contact
     _stale_since: float | None = None  # when the stream went stale in a contact phase
     # how the trial will end once retracted: set with the reason, never read back from its text
@@ -132,9 +127,7 @@ class IndentationMachine:
         """Advance the machine by one tick and return the goal to send to the drive."""
         if self.state is State.IDLE:
             self.start(obs.t)
-        if obs.gate is not None:
-            open_, rose = self._gate
-            self._gate = (obs.gate, obs.t if obs.gate and not open_ else rose)
+        self._body.see(obs)
         if not self.finished:
             self._check_guards(obs)
         cmd = self._held(obs) or self._stream_hold(obs) or _HANDLERS[self.state](self, obs)
@@ -179,7 +172,7 @@ class IndentationMachine:
             self._fault(obs, f"FBG stream lost ({obs.stream_age * 1e3:.0f} ms without a frame)")
             return
         if self.plan.gated and self.state in GATED and not obs.gate:
-            self._fault(obs, f"the breath hold ended during {self.state.value}")
+            self._hold_ended(obs)
             return
         violation = limit_violation(self.guards, obs, self.marks.x_contact)
         if violation is not None:
@@ -195,6 +188,17 @@ class IndentationMachine:
         if self.state is not State.WAITING:
             return obs.contact
         return self._contact_ticks >= WAIT_CONFIRM
+
+    def _hold_ended(self, obs: Observation) -> None:
+        """Retract to wait for the next breath hold; past ``hold_retries`` of them, no estimate."""
+        why, body = f"the breath hold ended during {self.state.value}", self._body
+        body.failed_holds += 1
+        if body.failed_holds > self.plan.hold_retries:
+            self.marks.reason, self.ending = f"{HOLDS_RAN_OUT} ({why})", State.DONE
+            self._go(State.RETRACTING, obs.t, self.marks.reason, obs.advance, obs.strains)
+            return
+        self._retry = True
+        self._go(State.RETRACTING, obs.t, f"{why}: to the next", obs.advance, obs.strains)
 
     def _fault(self, obs: Observation, reason: str, *, retract: bool = True) -> None:
         self.marks.reason, self.ending = reason, State.FAULT
@@ -267,8 +271,7 @@ class IndentationMachine:
         """Hold at the stand-off until a breath hold begins (its gate rose just now)."""
         p = self.plan
         target = p.contact_advance - p.standoff
-        rose = self._gate[1]
-        if obs.gate and rose is not None and obs.t - rose <= p.gate_fresh:
+        if self._body.hold_began(obs, p.gate_fresh):
             self._go(State.APPROACH, obs.t, "breath hold", obs.advance, obs.strains)
             return Command(target, p.roll, p.approach_speed)
         return Command(target, p.roll, 0.0)
@@ -289,7 +292,8 @@ class IndentationMachine:
                 obs, f"no contact within {p.approach_window * 1e3:.1f} mm past the expected surface"
             )
             return self._hold(obs)
-        return Command(limit, p.roll, p.approach_speed)
+        goal, speed = self._body.approach(p, obs.advance) or (limit, p.approach_speed)
+        return Command(goal, p.roll, speed)
 
     def _probe_step(self, obs: Observation) -> Command:
         assert self._probing is not None  # set on entering PROBING
@@ -321,7 +325,8 @@ class IndentationMachine:
     def _indent_goal(self, obs: Observation) -> Command:
         assert self.marks.x_contact is not None  # set on entering CONTACT: the window ends short
         window = self.guards.max_travel_past_contact - self.plan.position_tolerance  # of the guard
-        return Command(self.marks.x_contact + window, self.plan.roll, self.plan.indent_speed)
+        speed = self._body.indent_speed(self.plan)
+        return Command(self.marks.x_contact + window, self.plan.roll, speed)
 
     def _indenting(self, obs: Observation) -> Command:
         if self.detector.update(obs.strains, obs.advance, obs.tip_force):
@@ -372,6 +377,10 @@ class IndentationMachine:
         p = self.plan
         goal = p.retract_goal(self._first_touch)
         if abs(obs.advance - goal) <= p.position_tolerance:
+            if self._retry:  # the attempt's marks go: the next hold's are the trial's
+                self._retry, self.marks = False, TrialMarks()
+                self._go(State.POSITIONING, obs.t, "to the next breath hold", goal, obs.strains)
+                return Command(goal, obs.roll, 0.0)
             self._go(
                 self.ending, obs.t, f"retracted ({self.marks.reason})", obs.advance, obs.strains
             )
@@ -382,19 +391,9 @@ class IndentationMachine:
         return Command(obs.advance, obs.roll, 0.0, torque=self.state in PLANNED_ENDS)
 
 
+_STEPS = frozenset(State) - TERMINAL - {State.IDLE, State.PROBING, State.SKIPPED}  # "_<value>"
 _HANDLERS: dict[State, Callable[[IndentationMachine, Observation], Command]] = {
-    State.HOMING: IndentationMachine._homing,
-    State.POSITIONING: IndentationMachine._positioning,
-    State.WAITING: IndentationMachine._waiting,
     State.PROBING: IndentationMachine._probe_step,
-    State.APPROACH: IndentationMachine._approach,
-    State.CONTACT: IndentationMachine._contact,
-    State.INDENTING: IndentationMachine._indenting,
-    State.BUCKLED: IndentationMachine._buckled,
-    State.HOLDING: IndentationMachine._holding,
-    State.RETRACTING: IndentationMachine._retracting,
-    State.DONE: IndentationMachine._terminal,
-    State.FAULT: IndentationMachine._terminal,
-    State.ABORTED: IndentationMachine._terminal,
-    State.UNREACHABLE: IndentationMachine._terminal,
+    **dict.fromkeys(TERMINAL, IndentationMachine._terminal),
+    **{s: getattr(IndentationMachine, f"_{s.value}") for s in _STEPS},
 }

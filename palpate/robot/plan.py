@@ -55,9 +55,15 @@ class TrialPlan:
     position_tolerance: float = 5e-6
     hold_time: float = 0.0  # s at rest after the post-buckling travel (a creep test); 0: none
     # wait at the stand-off for a breath hold (the ventilator's gate, Observation.gate) that
-    # began at most ``gate_fresh`` s before, indent within it; the hold's end ends the trial
+    # began at most ``gate_fresh`` s before, indent within it; a hold that ends first retracts
+    # and waits for the next, ``hold_retries`` times at most (robot.body)
     gated: bool = False
     gate_fresh: float = 1.0
+    hold_retries: int = 2
+    # once an ECG's R waves are seen: the indentation at this speed at most, the approach at full
+    # speed to ``heart_margin`` before the expected surface (robot.body)
+    heart_speed: float = 0.1e-3
+    heart_margin: float = 1e-3
 
     def retract_goal(self, first_touch: float | None) -> float:
         """Home, or further back if the tissue was touched (at ``first_touch``, m) where the plan

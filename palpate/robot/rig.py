@@ -207,6 +207,7 @@ class ServoFbgRig:
             tip_force=tip_force,
             joints_age=age,
             gate=None if self._frame is None else bool(self._frame.flags & Status.BREATH_HOLD),
+            beat=any(f.flags & Status.CARDIAC_TRIGGER for f in frames),
         )
 
     def _tip_force(self, f: Frame) -> float | None:

@@ -5,12 +5,14 @@ a virtual time, and whether the ventilator holds the breath then.
 Each breath is Lujan's ``A sin^(2n)(pi t / T)`` (0 at end-expiration, ``A`` at inspiration);
 after every ``breaths`` breaths a hold at end-expiration that drifts by ``residual_mm`` at an
 even rate (``residual h / H``), an offset the next breaths take back at an even rate; the
-heart's beat on top, always.
+heart's beat on top, always, and an ECG monitor's sync pulse at each of its R waves (the
+mechanical beat lags the R wave: the surface starts toward the sensor ``ECG_LAG`` of a period
+after it).
 
 Usage::
 
     breath = Breath.of(fidelity.breathing, rng)  # None: the tissue stands still
-    breath.lift(2.5), breath.holding(2.5)
+    breath.lift(2.5), breath.holding(2.5), breath.beat(2.5)
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ import numpy as np
 from ..config.breathing import BreathingConfig
 
 MM = 1e-3
+ECG_PULSE = 0.02  # s: a monitor's sync output is a 10-100 ms pulse at each R wave
+ECG_LAG = 0.15  # of a period: the ventricles contract 0.1-0.2 s after the R wave
 
 
 @dataclass(frozen=True)
@@ -47,6 +51,14 @@ class Breath:
         """The ventilator holds the breath at ``t`` (s)."""
         c = self.config
         return c.hold_s > 0 and self._in_cycle(t) >= c.breaths * c.period_s
+
+    def beat(self, t: float) -> bool:
+        """The ECG monitor's sync pulse is on at ``t`` (s): the first ``ECG_PULSE`` after an R
+        wave, while the heart beats and its monitor reaches the board."""
+        c = self.config
+        if not (c.ecg and c.cardiac_mm):
+            return False
+        return (t + self.phase + ECG_LAG * c.cardiac_period_s) % c.cardiac_period_s < ECG_PULSE
 
     def lift(self, t: float) -> float:
         """The surface's displacement (m) toward the sensor at ``t`` (s)."""

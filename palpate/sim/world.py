@@ -55,6 +55,7 @@ CONTACT_EVENT = Status.CONTACT_EVENT
 _CONTACT_FLAG = int(Status.CONTACT_EVENT)  # int() of an IntFlag costs ~0.3 us per sample
 _FORCE_FLAG = int(Status.FORCE_VALID)
 _HOLD_FLAG = int(Status.BREATH_HOLD)
+_BEAT_FLAG = int(Status.CARDIAC_TRIGGER)
 
 
 COARSE_BIN_STEPS = 50  # grid steps in a bin of a coarse contact grid at a fixed length
@@ -359,8 +360,11 @@ class World:
         st = self.state(t)
         wavelengths, reference, tip = self.readout.read(st.strains, st.P, t, self.rng)
         flags = _CONTACT_FLAG if st.contact_event else 0
-        if self.breath is not None and self.breath.config.gate and self.breath.holding(t):
-            flags |= _HOLD_FLAG
+        if self.breath is not None:
+            if self.breath.config.gate and self.breath.holding(t):
+                flags |= _HOLD_FLAG
+            if self.breath.beat(t):
+                flags |= _BEAT_FLAG
         force = None
         if self.has_force:
             force = st.P

@@ -66,7 +66,7 @@ US = 1e-6
 
 
 class Status(IntFlag):
-    """Status bits of the ``flags`` field (bits 7-15 are reserved and sent as 0)."""
+    """Status bits of the ``flags`` field (bits 8-15 are reserved and sent as 0)."""
 
     PEAK_LOST = 1 << 0
     """The interrogator lost at least one peak; a lost peak is sent as 0 fm."""
@@ -82,6 +82,8 @@ class Status(IntFlag):
     """The rig's contact trigger is active (force-scale threshold or camera event input)."""
     BREATH_HOLD = 1 << 6
     """The ventilator's breath-hold gate input is active (the patient's breath is held)."""
+    CARDIAC_TRIGGER = 1 << 7
+    """The ECG monitor's sync output is active: a pulse at each R wave (each heartbeat)."""
 
 
 @dataclass(frozen=True)

@@ -81,10 +81,10 @@ def surface_motion(
     t = np.full(u.shape, np.nan) if times is None else np.asarray(times, dtype=np.float64)
     s = np.asarray(states)
     keep = np.isfinite(u) & np.isfinite(f)
-    free = f[keep & (s == FREE_STATE)]
-    if free.size < FREE_ROWS:
+    free = free_load(s[keep], f[keep])
+    if free is None:
         return None
-    zero, sigma = float(np.median(free)), max(difference_sigma(free), float(free.std()))
+    zero, sigma = free
     lo, hi = (zero + k * sigma for k in LEVEL_SIGMAS)
     hi = max(hi, zero + PEAK_SHARE * (float(np.max(f[keep])) - zero))
     band = keep & (f >= lo) & (f <= hi)
@@ -104,6 +104,16 @@ def surface_motion(
         return Motion(u_in - u_out, sigma=sigma)
     touch, release = (_at(t[b], f[b], middle)[0] for b in (loading, unloading))
     return Motion(u_in - u_out, touch, release, sigma)
+
+
+def free_load(states: ArrayLike, loads: ArrayLike) -> tuple[float, float] | None:
+    """The tip load's zero and noise (N) on the approach's rows (the sensor free after the last
+    zero), None with fewer than ``FREE_ROWS`` of them."""
+    f = np.asarray(loads, dtype=np.float64)
+    free = f[(np.asarray(states) == FREE_STATE) & np.isfinite(f)]
+    if free.size < FREE_ROWS:
+        return None
+    return float(np.median(free)), max(difference_sigma(free), float(free.std()))
 
 
 def _at(x: np.ndarray, f: np.ndarray, load: float) -> tuple[float, float]:

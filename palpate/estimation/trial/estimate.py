@@ -25,7 +25,6 @@ the same inputs and reproduces the fit bit for bit.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -45,16 +44,25 @@ from ..fits.southwell import SouthwellFit, southwell
 from ..fits.stiffness import StiffnessEstimate, paper_estimate
 from ..fits.strain_fit import fit_strains
 from ..jointfit import MIN_POINTS, JointFit, joint_fit
+from ..pose.heartbeat import Heartbeat
 from ..pose.misalignment import Lean
 from ..pose.motion import Motion
 from ..relaxation import RelaxationFit
 from ..verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from .finished import FinishedTrial, tip_load_at_buckling
 from .inputs import EstimatorInputs
-from .lean import lean_of_rows, row_in, rows_in
-from .motion import Row, drift_envelope, record_motion, still_rows
+from .lean import lean_of_rows, loading_tip, rows_in
+from .motion import Row, motion_envelope, still_record
 from .relaxed import relaxation_of
-from .states import LOADING_STATES, RowLoads, on_beam, record_lengths, row_loads, states_at
+from .states import (
+    LOADING_STATES,
+    RowLoads,
+    last_attempt,
+    on_beam,
+    record_lengths,
+    row_loads,
+    states_at,
+)
 
 __all__ = [
     "EstimatorInputs",
@@ -85,7 +93,7 @@ class RecordEstimate:
     """What the record gives: the joint fit and the Southwell fit of the beam's bow (None when
     the record is too short for either); on a rigid reference, the compliance instead.
     ``tip_load``: the fits read the load from a tip grating; ``motion``: the surface's along
-    the axis, measured from it (``estimation.trial.motion``)."""
+    the axis, measured from it, and the heart's ``heart`` (``estimation.trial.motion``)."""
 
     joint: JointFit | None
     southwell: SouthwellFit | None = None
@@ -95,6 +103,7 @@ class RecordEstimate:
     tip_load: bool = False
     loads: RowLoads = dataclasses.field(default_factory=dict)  # the beam states' P, by row
     motion: Motion | None = None
+    heart: Heartbeat | None = None
 
     @property
     def tip_bow(self) -> float | None:
@@ -181,28 +190,33 @@ def fit_rows(
     section: Section,
     times: Sequence[float] | None = None,
     tip_forces: Sequence[float | None] | None = None,
+    beats: Sequence[float] | None = None,
 ) -> RecordEstimate:
     """The estimates from (state, advance, strains) rows: the trial's record or a log's samples;
     beside them the load's lean from the rows before buckling (``estimation.trial.lean``) and, with
     each row's time (s) and a hold in the rows, the relaxation (``estimation.trial.relaxed``). With
-    each row's tip-grating load (N), the joint fit reads the load from it."""
+    each row's tip-grating load (N), the joint fit reads the load from it; with the ticks (s)
+    of an ECG's R-wave pulses, the heart's beat is taken out (``estimation.trial.motion``)."""
     rows = list(rows)
+    start = last_attempt([r[0] for r in rows])  # a gated trial's record of its last breath hold
+    if start:
+        rows, times = rows[start:], None if times is None else times[start:]
+        tip_forces = None if tip_forces is None else tip_forces[start:]
     gratings = len(stack.sensor.used_gratings)
 
     def fit(rows: list[Row]) -> RecordEstimate:
         advance, strains = loading_rows(rows, gratings)
-        tip = _loading_tip(rows, tip_forces, gratings)
+        tip = loading_tip(rows, tip_forces, gratings)
         return fit_record(advance, strains, inputs, stack.sensor, section, tip)
 
-    motion = record_motion(rows, tip_forces, times)
-    if motion is None or times is None or inputs.motion_tolerance is None:
-        fitted = fit(rows)
-    else:  # taken out where the campaign expects the tissue to move
-        raw, rows = rows, still_rows(rows, times, motion.velocity, motion.touch)
-        fitted = fit(rows)
-        joint = drift_envelope(fitted.joint, raw, times, motion, lambda r: fit(r).joint)
-        fitted = dataclasses.replace(fitted, joint=joint)
-    fitted = dataclasses.replace(fitted, motion=motion)
+    def joint(rows: list[Row]) -> JointFit | None:
+        return fit(rows).joint
+
+    drift = inputs.motion_tolerance is not None  # taken out where the campaign expects it
+    raw, (rows, motion, heart) = rows, still_record(rows, times, tip_forces, beats, drift, joint)
+    fitted = fit(rows)
+    envelope = motion_envelope(fitted.joint, raw, times, motion, heart, drift, joint)
+    fitted = dataclasses.replace(fitted, joint=envelope, motion=motion, heart=heart)
     if inputs.rigid:
         return fitted
     lean = lean_of_rows(rows, stack.sensor, section, inputs)
@@ -212,24 +226,6 @@ def fit_rows(
             rows, times, inputs, stack.sensor, section, fitted.joint, tip_forces
         )
     return dataclasses.replace(fitted, lean=lean, relaxation=relaxation)
-
-
-def _loading_tip(
-    rows: list[tuple[str, float, Sequence[float]]],
-    tip_forces: Sequence[float | None] | None,
-    gratings: int,
-) -> FloatArray | None:
-    """The tip loads (N) of the loading rows (as :func:`loading_rows` picks them); None without
-    a tip grating or where a loading row has no finite load."""
-    if not tip_forces or len(tip_forces) != len(rows):
-        return None
-    picked = [
-        math.nan if f is None else float(f)
-        for (state, advance, strains), f in zip(rows, tip_forces, strict=True)
-        if row_in(state, advance, strains, LOADING_STATES, gratings)
-    ]
-    tip = np.asarray(picked, dtype=np.float64)
-    return tip if tip.size and np.all(np.isfinite(tip)) else None
 
 
 def verdict_for(
@@ -243,12 +239,13 @@ def verdict_for(
     buckling_tip_load: float | None = None,
     bow: float | None = None,
     motion: Motion | None = None,
+    heart: Heartbeat | None = None,
 ) -> tuple[Verdict, Verdict | None]:
     """The trial's verdicts (``estimation.verdict``) from its fit, its inputs and how it ended:
     on the elastic estimate, and on the relaxed modulus when the trial held (else None).
     ``buckling_tip_load``: the tip grating's load at the buckling mark (N), None without one;
     ``bow``: w0/L fitted against the tip grating's load (``RecordEstimate.tip_bow``);
-    ``motion``: the surface's motion along the axis (m, :func:`record_motion`)."""
+    ``motion``, ``heart``: the surface's motion along the axis (``estimation.trial.motion``)."""
     length = inputs.exposed_length
     if joint is not None and joint.contact is not None:
         length = inputs.stage.exposed_length(joint.contact)
@@ -272,6 +269,7 @@ def verdict_for(
         bow=bow,
         motion=None if motion is None else motion.moved,
         motion_tolerance=inputs.motion_tolerance,
+        heart=heart,
     )
     elastic = judge(joint, facts, inputs.contact_radius)
     return elastic, relaxed_verdict(relaxation, elastic, facts)
@@ -366,7 +364,9 @@ def estimate_trial(
     if inputs is None:
         return TrialEstimate(paper, length)
     start = time.perf_counter()
-    fitted = fit_rows(result.record, inputs, stack, section, result.times, result.tip_forces)
+    fitted = fit_rows(
+        result.record, inputs, stack, section, result.times, result.tip_forces, result.beats
+    )
     seconds = time.perf_counter() - start
     verdict, relaxed = None, None
     motion = fitted.motion
@@ -383,6 +383,7 @@ def estimate_trial(
             tip_load_at_buckling(result.record, result.tip_forces),
             fitted.tip_bow,
             motion,
+            fitted.heart,
         )
     return TrialEstimate(
         paper,

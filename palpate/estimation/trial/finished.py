@@ -25,7 +25,8 @@ class Marks(Protocol):
 
 class FinishedTrial(Protocol):
     """A finished trial as the estimates read it: its ending (``state``, ``reason``), its marks
-    and its rows (state, advance m, strains), each row's time (s) and tip-grating load (N)."""
+    and its rows (state, advance m, strains), each row's time (s) and tip-grating load (N), and
+    the ticks (s) whose frames carried an ECG's R-wave pulse."""
 
     @property
     def state(self) -> Enum: ...
@@ -39,6 +40,8 @@ class FinishedTrial(Protocol):
     def times(self) -> list[float]: ...
     @property
     def tip_forces(self) -> list[float]: ...
+    @property
+    def beats(self) -> list[float]: ...
 
 
 def tip_load_at_buckling(rows: Rows, tip_forces: Sequence[float | None] | None) -> float | None:

@@ -92,3 +92,21 @@ def lean_of_rows(
     if not path.success:
         return dataclasses.replace(lean, message=f"no misalignment from the path: {path.message}")
     return dataclasses.replace(lean, misalignment=path.angle, misalignment_sigma=path.sigma)
+
+
+def loading_tip(
+    rows: list[tuple[str, float, Sequence[float]]],
+    tip_forces: Sequence[float | None] | None,
+    gratings: int,
+) -> NDArray[np.float64] | None:
+    """The tip loads (N) of the loading rows (as :func:`loading_rows` picks them); None without
+    a tip grating or where a loading row has no finite load."""
+    if not tip_forces or len(tip_forces) != len(rows):
+        return None
+    picked = [
+        math.nan if f is None else float(f)
+        for (state, advance, strains), f in zip(rows, tip_forces, strict=True)
+        if row_in(state, advance, strains, LOADING_STATES, gratings)
+    ]
+    tip = np.asarray(picked, dtype=np.float64)
+    return tip if tip.size and np.all(np.isfinite(tip)) else None

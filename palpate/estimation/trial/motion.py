@@ -14,13 +14,22 @@ errors either side (:func:`drift_envelope`): the interval spans the three.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 
+import numpy as np
+from scipy.optimize import minimize_scalar
+
 from ..jointfit import JointFit
-from ..pose.motion import Motion, surface_motion
+from ..pose.heartbeat import Heartbeat, heartbeat, r_waves
+from ..pose.motion import LEVEL_SIGMAS, Motion, free_load, surface_motion
 
 Row = tuple[str, float, Sequence[float]]
+JointOf = Callable[[list[Row]], JointFit | None]
 DRIFT_SIGMAS = 3.0
+HEART_SCALES = (0.6, 2.0)  # of the least squares' amplitude (which reads 10-40 % small)
+HEART_STEP = 0.05  # of it: the residual's curvature is read this far either side
+HEART_ROWS = ("contact", "indenting")  # rows whose load is the tissue's (not the buckled beam's)
 
 
 def record_motion(
@@ -65,3 +74,136 @@ def drift_envelope(
             lows.append(other.ci_low)
             highs.append(other.ci_high)
     return dataclasses.replace(joint, ci_low=min(lows), ci_high=max(highs))
+
+
+def record_heart(
+    rows: Sequence[Row],
+    tip_forces: Sequence[float | None] | None,
+    times: Sequence[float] | None,
+    pulses: Sequence[float] | None,
+) -> Heartbeat | None:
+    """The heart's beat in a record (``estimation.pose.heartbeat``) from the ticks (s) whose
+    frames carried an ECG's R-wave pulse; None without them, a tip grating or the rows' times."""
+    if not pulses or times is None or not tip_forces or len(tip_forces) != len(rows):
+        return None
+    states = np.asarray([r[0] for r in rows])
+    load = np.asarray([np.nan if f is None else f for f in tip_forces], dtype=np.float64)
+    free = free_load(states, load)
+    if free is None:
+        return None
+    zero, sigma = free
+    load = load - zero
+    contact = np.isin(states, HEART_ROWS) & (load > LEVEL_SIGMAS[0] * sigma)
+    advance = [r[1] for r in rows]
+    return heartbeat(advance, load, times, r_waves(times, pulses), contact)
+
+
+def beating_rows(rows: Sequence[Row], times: Sequence[float], heart: Heartbeat) -> list[Row]:
+    """The rows with the stage's advance taken against the beating surface: as if it stood at
+    the beat's mean."""
+    lift = heart.lift(times)
+    return [(s, u + float(h), e) for (s, u, e), h in zip(rows, lift, strict=True)]
+
+
+def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) -> Heartbeat:
+    """``heart`` at the amplitude where the residual of ``fit`` (the record's joint fit taken
+    against a beat) is least, searched over ``HEART_SCALES`` of the least squares' amplitude; its
+    standard error from the residual's curvature there (the residuals' correlation counted as
+    the fit counts it, by its noise scale). Unchanged where every fit fails."""
+
+    def score(k: float) -> float:
+        joint = fit(heart.scaled(k))
+        ok = joint is not None and joint.success and joint.rms is not None
+        return float(joint.rms) ** 2 if ok and joint is not None and joint.rms else math.inf
+
+    lo, hi = HEART_SCALES
+    found = minimize_scalar(score, bounds=(lo, hi), method="bounded", options={"xatol": 0.01})
+    if not math.isfinite(found.fun):
+        return heart
+    best, step = float(found.x), HEART_STEP
+    around = [score(best - step), float(found.fun), score(best + step)]
+    curve = (around[0] - 2.0 * around[1] + around[2]) / step**2
+    joint = fit(heart.scaled(best))
+    if not (math.isfinite(curve) and curve > 0) or joint is None:
+        return heart.scaled(best, HEART_STEP * heart.amplitude * best)
+    widen = joint.noise_scale or 1.0
+    sigma = widen * math.sqrt(2.0 / (max(joint.n_points, 1) * curve))  # chi2 = n rms^2 rises 1
+    return heart.scaled(best, sigma * heart.amplitude)
+
+
+def heart_envelope(
+    joint: JointFit | None,
+    rows: list[Row],
+    times: Sequence[float],
+    heart: Heartbeat,
+    fit: JointOf,
+) -> JointFit | None:
+    """``joint`` with its interval spanning the fits ``fit`` gives of ``rows`` (as recorded)
+    taken against ``heart`` at ``DRIFT_SIGMAS`` standard errors of its amplitude either side."""
+    if joint is None or joint.ci_low is None or joint.ci_high is None or heart.amplitude <= 0:
+        return joint
+    lows, highs = [joint.ci_low], [joint.ci_high]
+    for k in (-DRIFT_SIGMAS, DRIFT_SIGMAS):
+        factor = max(0.0, 1.0 + k * heart.sigma / heart.amplitude)
+        other = fit(beating_rows(rows, times, heart.scaled(factor)))
+        if other is not None and other.ci_low is not None and other.ci_high is not None:
+            lows.append(other.ci_low)
+            highs.append(other.ci_high)
+    return dataclasses.replace(joint, ci_low=min(lows), ci_high=max(highs))
+
+
+def still_record(
+    rows: list[Row],
+    times: Sequence[float] | None,
+    tip_forces: Sequence[float | None] | None,
+    pulses: Sequence[float] | None,
+    drift: bool,
+    fit: JointOf,
+) -> tuple[list[Row], Motion | None, Heartbeat | None]:
+    """The rows taken against the surface's motion: the heart's beat where the record has an
+    ECG's R waves, then (with ``drift``, where the campaign expects the tissue to move) the
+    drift measured between touch and release; the motion as measured (after the beat) and the
+    beat. ``fit``: the joint fit of rows (the beat's amplitude is set by its residual)."""
+
+    def steady(beat: Heartbeat | None) -> tuple[list[Row], Motion | None]:
+        still = rows if beat is None or times is None else beating_rows(rows, times, beat)
+        motion = record_motion(still, tip_forces, times)
+        if motion is not None and times is not None and drift:
+            still = still_rows(still, times, motion.velocity, motion.touch)
+        return still, motion
+
+    heart = record_heart(rows, tip_forces, times, pulses)
+    if heart is not None:
+        heart = fitted_heart(heart, lambda beat: fit(steady(beat)[0]))
+    return (*steady(heart), heart)
+
+
+def motion_envelope(
+    joint: JointFit | None,
+    raw: list[Row],
+    times: Sequence[float] | None,
+    motion: Motion | None,
+    heart: Heartbeat | None,
+    drift: bool,
+    fit: JointOf,
+) -> JointFit | None:
+    """``joint`` (the fit of :func:`still_record`'s rows of ``raw``) with its interval spanning
+    the fits at the drift's velocity and at the beat's amplitude ``DRIFT_SIGMAS`` standard
+    errors either side (each with the other taken out as measured)."""
+    if times is None:
+        return joint
+    drifting = drift and motion is not None
+    beating = raw if heart is None else beating_rows(raw, times, heart)
+    if drifting:
+        assert motion is not None
+        joint = drift_envelope(joint, beating, times, motion, fit)
+    if heart is not None:
+
+        def still(rows: list[Row]) -> JointFit | None:
+            if not drifting:
+                return fit(rows)
+            assert motion is not None
+            return fit(still_rows(rows, times, motion.velocity, motion.touch))
+
+        joint = heart_envelope(joint, raw, times, heart, still)
+    return joint

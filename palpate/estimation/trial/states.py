@@ -9,7 +9,7 @@ noise setting leaks in.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from statistics import NormalDist
 
 import numpy as np
@@ -82,3 +82,18 @@ def row_loads(
     """Each row's axial load keyed by the row (:data:`RowLoads`)."""
     keys = np.column_stack([advance, strains]).tolist()
     return {tuple(k): p for k, p in zip(keys, states.P.tolist(), strict=True)}
+
+
+def last_attempt(states: Sequence[str]) -> int:
+    """The first row of a gated trial's last attempt: past the last wait for a breath hold
+    that follows a retraction (``robot.body``); 0 for a trial of one attempt.
+
+    >>> last_attempt(["waiting", "approach", "retracting", "waiting", "approach"])
+    4
+    """
+    start, retracted = 0, False
+    for i, state in enumerate(states):
+        retracted = retracted or state == "retracting"
+        if retracted and state == "waiting":
+            start = i + 1
+    return start

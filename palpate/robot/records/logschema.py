@@ -244,6 +244,7 @@ RECORDS: dict[str, dict[str, Field]] = {
         "contact": req(boolean),
         "goal": opt(number(null=True)),
         "tip_force": opt(number(null=True)),
+        "beat": opt(boolean),
     },
     "transition": {
         "t": req(number()),

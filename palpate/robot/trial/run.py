@@ -72,6 +72,7 @@ class TrialResult:
     times: list[float] = field(default_factory=list)  # each record row's time (s, the rig's clock)
     # each row's tip-grating load (N; NaN where the rig had none), empty without a tip grating
     tip_forces: list[float] = field(default_factory=list)
+    beats: list[float] = field(default_factory=list)  # the ticks (s) with an ECG R-wave pulse
     probe: ProbeResult | None = None  # what probing found, when the trial probed
     # the stale stream's gaps the motion held through: (start s, duration s, state held)
     stream_gaps: list[tuple[float, float, str]] = field(default_factory=list)
@@ -130,6 +131,8 @@ def run_trial(
             advance = math.nan if machine.stream_held else obs.measured_advance
             out.record.append((machine.state.value, advance, tuple(obs.strains)))
             out.times.append(obs.t)
+            if obs.beat:
+                out.beats.append(obs.t)
             if obs.tip_force is not None or out.tip_forces:
                 _append_tip(out, obs.tip_force)
             if log is not None:
@@ -237,6 +240,8 @@ def _sample_record(obs: Observation, advance: float, state: State, cmd: Command)
     }
     if obs.tip_force is not None:
         record["tip_force"] = obs.tip_force
+    if obs.beat:
+        record["beat"] = True
     return record
 
 
