@@ -1,6 +1,7 @@
 """The breath-hold gate in the indentation machine (issue 42): a gated trial waits at the
-stand-off for a breath hold that has just begun, indents within it, and a hold that ends before
-the indentation does retracts it (a fault: the tissue moves again)."""
+stand-off for a breath hold that has just begun, indents within it; a hold that ends before the
+indentation does retracts it and the machine waits for the next (issue 62), up to the plan's
+retries, after which the trial ends with no estimate (not a fault)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from dataclasses import dataclass
 
 import pytest
 
+from palpate.estimation.verdict import HOLDS_RAN_OUT
 from palpate.robot.indentation import Guards, Observation, State, TrialPlan
 from palpate.robot.trial.run import run_trial
 from palpate.sim.clock import VirtualClock
@@ -55,12 +57,30 @@ def test_a_hold_under_way_at_the_stand_off_is_waited_out() -> None:
     assert approach.t == pytest.approx(40.0, abs=0.01)
 
 
-def test_a_hold_that_ends_during_the_indentation_retracts_it() -> None:
-    rig = GatedRig(VirtualClock(), holds=hold_from(5.0, 4.0), x_buckle=1.0)  # never buckles
+def test_a_hold_that_ends_during_the_indentation_is_retried_in_the_next() -> None:
+    """A 2.5 s hold is too short for the trial; the next, 20 s long, holds all of it."""
+    rig = GatedRig(VirtualClock(), holds=lambda t: 5.0 <= t < 7.5 or 25.0 <= t < 45.0)
     result = gated(rig)
-    assert result.state is State.FAULT
-    assert result.reason.startswith("the breath hold ended during ")
+    assert result.state is State.DONE, result.reason
+    assert result.reason == "completed"
+    reasons = [tr.reason for tr in result.transitions]
+    assert any(r.startswith("the breath hold ended during ") for r in reasons)
+    assert "to the next breath hold" in reasons
+    assert states(result.transitions).count("waiting") == 2
+    assert result.marks.t_contact is not None and result.marks.t_contact > 25.0  # the 2nd hold's
+    assert result.marks.x_buckling is not None
+
+
+def test_holds_that_keep_ending_first_end_the_trial_with_no_estimate() -> None:
+    """Every hold 4 s, the tissue never buckles the beam: three holds tried, then DONE, retracted,
+    with the reason the verdict reads as no estimate; never a fault."""
+    rig = GatedRig(VirtualClock(), holds=hold_from(5.0, 4.0, cycle=20.0), x_buckle=1.0)
+    result = gated(rig)
+    assert result.state is State.DONE
+    assert result.reason.startswith(HOLDS_RAN_OUT)
+    assert states(result.transitions).count("waiting") == 3  # 1 + TrialPlan.hold_retries
     assert rig.advance == pytest.approx(0.0, abs=1e-5)  # retracted home
+    assert rig.torque
 
 
 def test_an_ungated_plan_goes_without_waiting() -> None:

@@ -48,3 +48,26 @@ def test_each_trial_starts_somewhere_in_the_cycle() -> None:
     assert len(phases) == 5
     assert Breath.of(None, rng) is None
     assert Status.BREATH_HOLD == 1 << 6
+
+
+def test_the_ecg_pulses_once_a_beat_ahead_of_the_motion() -> None:
+    """A 20 ms sync pulse at each R wave, only while the heart beats and its monitor is on; the
+    surface starts toward the sensor ECG_LAG of a period after it."""
+    from palpate.sim.breathing import ECG_LAG, ECG_PULSE
+
+    beating = Breath(BreathingConfig(cardiac_mm=0.4, cardiac_period_s=0.8, phase="start"))
+    t = np.arange(0.0, 8.0, 0.004)
+    on = np.array([beating.beat(x) for x in t])
+    rises = t[1:][on[1:] & ~on[:-1]]
+    assert len(rises) == 10 and np.allclose(np.diff(rises), 0.8, atol=0.005)
+    assert np.count_nonzero(on) == pytest.approx(10 * ECG_PULSE / 0.004, abs=10)
+    heart = np.array([beating.lift(x) for x in t]) - np.array(
+        [Breath(BreathingConfig(phase="start")).lift(x) for x in t]
+    )
+    start = rises[0] + ECG_LAG * 0.8  # the heart's lift crosses its mean upward here
+    assert heart[np.searchsorted(t, start)] == pytest.approx(0.0, abs=2e-6)
+    assert heart[np.searchsorted(t, start + 0.2)] == pytest.approx(0.2e-3, rel=0.01)
+    quiet = Breath(BreathingConfig(cardiac_mm=0.0, phase="start"))
+    unmonitored = Breath(BreathingConfig(cardiac_mm=0.4, ecg=False, phase="start"))
+    assert not any(quiet.beat(x) or unmonitored.beat(x) for x in t)
+    assert Status.CARDIAC_TRIGGER == 1 << 7

@@ -197,11 +197,7 @@ def fit_rows(
     each row's time (s) and a hold in the rows, the relaxation (``estimation.trial.relaxed``). With
     each row's tip-grating load (N), the joint fit reads the load from it; with the ticks (s)
     of an ECG's R-wave pulses, the heart's beat is taken out (``estimation.trial.motion``)."""
-    rows = list(rows)
-    start = last_attempt([r[0] for r in rows])  # a gated trial's record of its last breath hold
-    if start:
-        rows, times = rows[start:], None if times is None else times[start:]
-        tip_forces = None if tip_forces is None else tip_forces[start:]
+    rows, times, tip_forces = last_attempt(list(rows), times, tip_forces)  # of a gated trial
     gratings = len(stack.sensor.used_gratings)
 
     def fit(rows: list[Row]) -> RecordEstimate:
@@ -322,7 +318,8 @@ class TrialEstimate:
         beam_loads: the axial load the joint fit's beam states gave each loading row, by row
             (``estimation.trial.states.RowLoads``): the recording's tip force reuses them.
         motion: the surface's motion along the axis between the first touch and the release
-            (m, :func:`record_motion`), None without a tip grating.
+            (m, :func:`record_motion`), None without a tip grating; ``heart``: the heart's beat
+            taken out of the record, peak to peak (m), None without an ECG's R waves.
     """
 
     paper: StiffnessEstimate | None
@@ -337,6 +334,7 @@ class TrialEstimate:
     relaxed_verdict: Verdict | None = None
     beam_loads: RowLoads = dataclasses.field(default_factory=dict)
     motion: float | None = None
+    heart: float | None = None
 
 
 def estimate_trial(
@@ -398,4 +396,5 @@ def estimate_trial(
         relaxed,
         fitted.loads,
         None if motion is None else motion.moved,
+        None if fitted.heart is None else 2.0 * fitted.heart.amplitude,
     )

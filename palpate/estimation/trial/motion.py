@@ -18,7 +18,7 @@ import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy.optimize import minimize_scalar
+from scipy.optimize import minimize_scalar  # type: ignore[import-untyped,unused-ignore]
 
 from ..jointfit import JointFit
 from ..pose.heartbeat import Heartbeat, heartbeat, r_waves

@@ -20,6 +20,8 @@ from ..beam.section import Section, grating_intervals
 from ..beam.states import BeamStates, infer_states
 from .inputs import EstimatorInputs
 
+Row = tuple[str, float, Sequence[float]]
+
 FloatArray = NDArray[np.float64]
 LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})  # the joint fit's rows
 # a row's axial load (N) by the row, (advance, *strains) as recorded: what the estimate's beam
@@ -84,16 +86,22 @@ def row_loads(
     return {tuple(k): p for k, p in zip(keys, states.P.tolist(), strict=True)}
 
 
-def last_attempt(states: Sequence[str]) -> int:
-    """The first row of a gated trial's last attempt: past the last wait for a breath hold
-    that follows a retraction (``robot.body``); 0 for a trial of one attempt.
+def last_attempt(
+    rows: list[Row], times: Sequence[float] | None, loads: Sequence[float | None] | None
+) -> tuple[list[Row], Sequence[float] | None, Sequence[float | None] | None]:
+    """The rows (and their times and tip loads) of a gated trial's last attempt: past the last
+    wait for a breath hold that follows a retraction (``robot.body``); all of a trial of one.
 
-    >>> last_attempt(["waiting", "approach", "retracting", "waiting", "approach"])
-    4
+    >>> states = ["waiting", "approach", "retracting", "waiting", "approach"]
+    >>> last_attempt([(s, 0.0, ()) for s in states], None, None)[0]
+    [('approach', 0.0, ())]
     """
     start, retracted = 0, False
-    for i, state in enumerate(states):
+    for i, (state, _, _) in enumerate(rows):
         retracted = retracted or state == "retracting"
         if retracted and state == "waiting":
             start = i + 1
-    return start
+    if not start:
+        return rows, times, loads
+    later = None if times is None else times[start:]
+    return rows[start:], later, None if loads is None else loads[start:]

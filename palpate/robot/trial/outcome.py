@@ -61,6 +61,7 @@ class Outcome:
     relaxation: RelaxationFit | None = None
     relaxed_verdict: Verdict | None = None
     motion: float | None = None  # m, the surface's along the axis (estimation.pose.motion)
+    heart: float | None = None  # m, the heart's beat peak to peak (estimation.pose.heartbeat)
 
     @property
     def status(self) -> str:
@@ -103,6 +104,7 @@ def outcome_fields(
         "relaxation": estimate.relaxation,
         "relaxed_verdict": estimate.relaxed_verdict,
         "motion": estimate.motion,
+        "heart": estimate.heart,
     }
 
 

@@ -142,6 +142,7 @@ class Estimated(Protocol):
     relaxation: RelaxationFit | None
     relaxed_verdict: Verdict | None
     motion: float | None
+    heart: float | None
 
 
 def estimate_row(o: Estimated) -> dict[str, Any]:
@@ -163,6 +164,7 @@ def estimate_row(o: Estimated) -> dict[str, Any]:
         "calibration": None if o.calibration is None else o.calibration.as_dict(),
         **relaxed_row(o.relaxation, o.relaxed_verdict),
         **({} if o.motion is None else {"motion_mm": o.motion * 1e3}),
+        **({} if o.heart is None else {"heart_mm": o.heart * 1e3}),
     }
 
 

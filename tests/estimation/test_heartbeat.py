@@ -1,0 +1,74 @@
+"""The heart's beat in a record (issue 62): R waves from the ticks with the ECG's pulse, the
+phase between them, and the beat's lag and amplitude from a tip load pressed into a beating
+surface (``estimation.pose.heartbeat``); and a gated trial's last attempt
+(``estimation.trial.states.last_attempt``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from palpate.estimation.pose.heartbeat import Heartbeat, heartbeat, r_waves
+
+PERIOD, AMPLITUDE, LAG = 0.9, 0.15e-3, 0.3  # s, m (half peak to peak), of a period
+
+
+def record(seconds: float, speed: float, noise: float, seed: int = 0):  # type: ignore[no-untyped-def]
+    """A tip advancing at ``speed`` (m/s) into a Hertz-like surface (P = k d^1.5) that beats
+    ``AMPLITUDE`` toward it, ``LAG`` of a period after each R wave; 250 rows a second."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, seconds, 0.004)
+    x = speed * t
+    lift = AMPLITUDE * np.sin(2 * np.pi * (t / PERIOD - LAG))
+    depth = np.clip(x - 0.1e-3 + lift, 0.0, None)
+    load = 3.0e3 * depth**1.5 + rng.normal(0.0, noise, t.size)
+    pulses = t[(t % PERIOD) < 0.02]
+    return t, x, load, pulses
+
+
+def test_r_waves_are_the_first_ticks_of_each_pulse() -> None:
+    t, _, _, pulses = record(5.0, 0.1e-3, 0.0)
+    waves = r_waves(t.tolist(), pulses.tolist())
+    assert len(waves) == 6
+    assert np.allclose(np.diff(waves), PERIOD, atol=0.004)
+
+
+def test_the_phase_runs_evenly_between_r_waves() -> None:
+    beat = Heartbeat((1.0, 2.0, 3.2))  # past the last R wave: the median period, 1.1 s
+    assert beat.phase([1.5, 2.6, 3.75]) == pytest.approx([math.pi, math.pi, math.pi])
+    assert beat.period == pytest.approx(1.1)
+    assert beat.lift([1.0]) == pytest.approx([0.0])
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_beat_is_measured_from_the_load(seed: int) -> None:
+    t, x, load, pulses = record(6.0, 0.1e-3, 2e-5, seed)
+    beat = heartbeat(x, load, t, r_waves(t.tolist(), pulses.tolist()), load > 1e-4)
+    assert beat is not None
+    lag = -math.atan2(beat.cos, beat.sin) / (2 * math.pi)
+    assert lag == pytest.approx(LAG, abs=0.02)
+    assert beat.amplitude == pytest.approx(AMPLITUDE, rel=0.25)
+    true = AMPLITUDE * np.sin(2 * np.pi * (t / PERIOD - LAG))
+    fitted = beat.lift(t) * AMPLITUDE / beat.amplitude
+    assert np.max(np.abs(fitted - true)) < 0.15 * AMPLITUDE
+
+
+def test_no_beat_without_two_r_waves_or_enough_contact() -> None:
+    t, x, load, pulses = record(6.0, 0.1e-3, 0.0)
+    assert heartbeat(x, load, t, [0.0], load > 0) is None
+    assert heartbeat(x, load, t, [0.0, 0.9], np.zeros(t.size, bool)) is None
+
+
+def test_a_gated_trial_is_estimated_from_its_last_attempt() -> None:
+    from palpate.estimation.trial.states import last_attempt
+
+    states = ["waiting", "approach", "indenting", "retracting", "positioning", "waiting"]
+    states += ["approach", "indenting"]
+    rows = [(s, float(i), ()) for i, s in enumerate(states)]
+    kept, times, loads = last_attempt(rows, [float(i) for i in range(8)], [0.0] * 8)
+    assert [r[0] for r in kept] == ["approach", "indenting"]
+    assert times == [6.0, 7.0] and loads == [0.0, 0.0]
+    once = rows[:4]
+    assert last_attempt(once, None, None) == (once, None, None)
