@@ -150,17 +150,12 @@ def _replay_joint(
     verdict, relaxed = None, None
     if not inputs.rigid:
         verdict, relaxed = verdict_for(
-            fitted.joint,
+            fitted,
             inputs,
             str(end.get("state")),
             str(end.get("reason")),
             section,
-            fitted.lean,
-            fitted.relaxation,
             tip_load_at_buckling(rows, tips),
-            fitted.tip_bow,
-            fitted.motion,
-            fitted.heart,
         )
     lean = fitted.lean if "lean" in recorded else None  # logs before issue 25 have none
     keys = estimator_keys(

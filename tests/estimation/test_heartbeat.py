@@ -56,7 +56,7 @@ def test_the_beat_is_measured_from_the_load(seed: int) -> None:
 
 
 def test_no_beat_without_two_r_waves_or_enough_contact() -> None:
-    t, x, load, pulses = record(6.0, 0.1e-3, 0.0)
+    t, x, load, _pulses = record(6.0, 0.1e-3, 0.0)
     assert heartbeat(x, load, t, [0.0], load > 0) is None
     assert heartbeat(x, load, t, [0.0, 0.9], np.zeros(t.size, bool)) is None
 
@@ -69,6 +69,7 @@ def test_a_gated_trial_is_estimated_from_its_last_attempt() -> None:
     rows = [(s, float(i), ()) for i, s in enumerate(states)]
     kept, times, loads = last_attempt(rows, [float(i) for i in range(8)], [0.0] * 8)
     assert [r[0] for r in kept] == ["approach", "indenting"]
-    assert times == [6.0, 7.0] and loads == [0.0, 0.0]
+    assert times == [6.0, 7.0]
+    assert loads == [0.0, 0.0]
     once = rows[:4]
     assert last_attempt(once, None, None) == (once, None, None)

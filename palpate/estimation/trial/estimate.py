@@ -225,23 +225,18 @@ def fit_rows(
 
 
 def verdict_for(
-    joint: JointFit | None,
+    fitted: RecordEstimate,
     inputs: EstimatorInputs,
     state: str,
     reason: str,
     section: Section,
-    lean: Lean | None = None,
-    relaxation: RelaxationFit | None = None,
     buckling_tip_load: float | None = None,
-    bow: float | None = None,
-    motion: Motion | None = None,
-    heart: Heartbeat | None = None,
 ) -> tuple[Verdict, Verdict | None]:
-    """The trial's verdicts (``estimation.verdict``) from its fit, its inputs and how it ended:
-    on the elastic estimate, and on the relaxed modulus when the trial held (else None).
-    ``buckling_tip_load``: the tip grating's load at the buckling mark (N), None without one;
-    ``bow``: w0/L fitted against the tip grating's load (``RecordEstimate.tip_bow``);
-    ``motion``, ``heart``: the surface's motion along the axis (``estimation.trial.motion``)."""
+    """The trial's verdicts (``estimation.verdict``) from what its record gave (the joint fit,
+    the lean, the relaxation, the bow, the surface's motion and the heart's beat), its inputs
+    and how it ended: on the elastic estimate, and on the relaxed modulus when the trial held
+    (else None). ``buckling_tip_load``: the tip grating's load at the buckling mark (N)."""
+    joint, relaxation, motion = fitted.joint, fitted.relaxation, fitted.motion
     length = inputs.exposed_length
     if joint is not None and joint.contact is not None:
         length = inputs.stage.exposed_length(joint.contact)
@@ -256,16 +251,16 @@ def verdict_for(
         poisson=inputs.poisson,
         compliance_max=inputs.compliance[1],
         orientation_verified=inputs.orientation_verified,
-        lean=lean,
+        lean=fitted.lean,
         misalignment_sigma=inputs.misalignment_sigma,
         relaxation=relaxation,
         designed_range=inputs.designed_range,
         probe_reason=inputs.probe_reason,
         buckling_tip_load=buckling_tip_load,
-        bow=bow,
+        bow=fitted.tip_bow,
         motion=None if motion is None else motion.moved,
         motion_tolerance=inputs.motion_tolerance,
-        heart=heart,
+        heart=fitted.heart,
     )
     elastic = judge(joint, facts, inputs.contact_radius)
     return elastic, relaxed_verdict(relaxation, elastic, facts)
@@ -369,19 +364,13 @@ def estimate_trial(
     verdict, relaxed = None, None
     motion = fitted.motion
     if not inputs.rigid:
-        state = result.state.value
         verdict, relaxed = verdict_for(
-            fitted.joint,
+            fitted,
             inputs,
-            state,
+            result.state.value,
             result.reason,
             section,
-            fitted.lean,
-            fitted.relaxation,
             tip_load_at_buckling(result.record, result.tip_forces),
-            fitted.tip_bow,
-            motion,
-            fitted.heart,
         )
     return TrialEstimate(
         paper,

@@ -129,12 +129,7 @@ def run_trial(
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
             # a row whose strains are stale has no advance: no estimate reads it (as a missed read)
             advance = math.nan if machine.stream_held else obs.measured_advance
-            out.record.append((machine.state.value, advance, tuple(obs.strains)))
-            out.times.append(obs.t)
-            if obs.beat:
-                out.beats.append(obs.t)
-            if obs.tip_force is not None or out.tip_forces:
-                _append_tip(out, obs.tip_force)
+            _append_row(out, obs, machine.state, advance)
             if log is not None:
                 probe_logged = _write_tick(log, obs, advance, machine, cmd, probe_logged)
             if on_tick is not None:
@@ -161,11 +156,18 @@ def _record_gap(
         log.write({"kind": "stream_gap", "t": gap[0], "duration": gap[1], "state": gap[2]})
 
 
-def _append_tip(out: TrialResult, force: float | None) -> None:
-    """The row's tip load, the rows before the first one NaN (the list stays row-aligned)."""
+def _append_row(out: TrialResult, obs: Observation, state: State, advance: float) -> None:
+    """One tick's row: its state, advance and strains, its time, an R wave's tick, and its tip
+    load (the rows before the first one NaN: the list stays row-aligned)."""
+    out.record.append((state.value, advance, tuple(obs.strains)))
+    out.times.append(obs.t)
+    if obs.beat:
+        out.beats.append(obs.t)
+    if obs.tip_force is None and not out.tip_forces:
+        return
     if not out.tip_forces:
         out.tip_forces.extend([math.nan] * (len(out.record) - 1))
-    out.tip_forces.append(math.nan if force is None else force)
+    out.tip_forces.append(math.nan if obs.tip_force is None else obs.tip_force)
 
 
 def _out_of_ticks(machine: IndentationMachine, t: float, ticks: int, max_ticks: int) -> bool:

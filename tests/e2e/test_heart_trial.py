@@ -1,0 +1,77 @@
+"""A lung trial beside the heart (issue 62): the world beats the surface 0.5 mm along the axis at
+70 a minute and an ECG's R waves reach the board (frame status bit 7); the trial indents slowly
+once it sees them, the estimate takes the beat out of the record (its amplitude measured, not
+told), the verdict names it, and a replay of the log gives the same estimate. Without a heart
+nothing of it runs."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from palpate.campaigns.campaign import campaign_trials
+from palpate.config import load, load_stack, resolve
+from palpate.config.scene import SceneConfig
+from palpate.reports.replay import replay
+from palpate.robot.records.log import read_log
+from palpate.simulation.result import TrialOutcome
+from palpate.simulation.trial import run_sim_trial
+
+pytestmark = pytest.mark.slow  # two simulated lung trials
+
+SCENE = load(SceneConfig, resolve("scenes/invivo/near-heart.yaml"))
+STACK = load_stack(SCENE.robot)
+
+
+def run_n2(scene: SceneConfig, tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
+    """N2 (2 kPa, 40 mm) through the 15 deg tube, downward."""
+    spec = next(
+        s
+        for s in campaign_trials(scene, STACK, 0)
+        if s.sample == "N2" and s.tube.name == "bent15" and s.orientation == "downward"
+    )
+    return run_sim_trial(spec, scene, STACK, log_dir=tmp_path_factory.mktemp("logs"))
+
+
+@pytest.fixture(scope="module")
+def beating(tmp_path_factory: pytest.TempPathFactory) -> TrialOutcome:
+    return run_n2(SCENE, tmp_path_factory)
+
+
+def test_the_beat_is_measured_and_taken_out(beating: TrialOutcome) -> None:
+    assert beating.state == "done", beating.reason
+    assert beating.heart == pytest.approx(0.5e-3, rel=0.1)  # peak to peak, measured
+    assert beating.joint is not None
+    assert beating.joint.modulus is not None
+    assert beating.joint.modulus == pytest.approx(2e3, rel=0.1)
+    assert beating.joint.ci_low is not None
+    assert beating.joint.ci_high is not None
+    assert beating.joint.ci_low <= 2e3 <= beating.joint.ci_high
+    assert beating.verdict is not None
+    assert any(r.startswith("heartbeat: the surface beat") for r in beating.verdict.reasons)
+
+
+def test_the_log_keeps_the_r_waves_and_replays_the_estimate(beating: TrialOutcome) -> None:
+    assert beating.log_path is not None
+    samples = list(read_log(beating.log_path).of_kind("sample"))
+    indenting = [r for r in samples if r["state"] == "indenting"]
+    first, last = indenting[0], indenting[-1]
+    speed = (last["advance"] - first["advance"]) / (last["t"] - first["t"])
+    assert speed == pytest.approx(0.1e-3, rel=0.1)  # the heart's 0.1 mm/s, not the scene's 0.5
+    assert sum(1 for r in samples if r.get("beat")) > 20
+    assert replay(beating.log_path)["identical"] is True
+
+
+def test_without_a_heart_nothing_of_it_runs(tmp_path_factory: pytest.TempPathFactory) -> None:
+    fidelity = SCENE.fidelity
+    assert fidelity.breathing is not None
+    still = dataclasses.replace(fidelity.breathing, cardiac_mm=0.0)
+    scene = dataclasses.replace(SCENE, fidelity=dataclasses.replace(fidelity, breathing=still))
+    outcome = run_n2(scene, tmp_path_factory)
+    assert outcome.state == "done", outcome.reason
+    assert outcome.heart is None
+    assert outcome.log_path is not None
+    assert not any(r.get("beat") for r in read_log(outcome.log_path).of_kind("sample"))
+    assert outcome.verdict is not None
+    assert not any(r.startswith("heartbeat") for r in outcome.verdict.reasons)
