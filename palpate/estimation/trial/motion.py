@@ -29,6 +29,8 @@ JointOf = Callable[[list[Row]], JointFit | None]
 DRIFT_SIGMAS = 3.0
 HEART_SCALES = (0.6, 2.0)  # of the least squares' amplitude (which reads 10-40 % small)
 HEART_STEP = 0.05  # of it: the residual's curvature is read this far either side
+HEART_FLOOR = 0.05  # the amplitude's standard error at least (of it): the residual's minimum
+# lies 0-10 % below the true amplitude on the scenes of docs/invivo.md (drift, the law's form)
 HEART_ROWS = ("contact", "indenting")  # rows whose load is the tissue's (not the buckled beam's)
 
 
@@ -109,7 +111,8 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
     """``heart`` at the amplitude where the residual of ``fit`` (the record's joint fit taken
     against a beat) is least, searched over ``HEART_SCALES`` of the least squares' amplitude; its
     standard error from the residual's curvature there (the residuals' correlation counted as
-    the fit counts it, by its noise scale). Unchanged where every fit fails."""
+    the fit counts it, by its noise scale), ``HEART_FLOOR`` of it at least. Unchanged where every
+    fit fails."""
 
     def score(k: float) -> float:
         joint = fit(heart.scaled(k))
@@ -125,10 +128,10 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
     curve = (around[0] - 2.0 * around[1] + around[2]) / step**2
     joint = fit(heart.scaled(best))
     if not (math.isfinite(curve) and curve > 0) or joint is None:
-        return heart.scaled(best, HEART_STEP * heart.amplitude * best)
+        return heart.scaled(best, HEART_FLOOR * heart.amplitude * best)
     widen = joint.noise_scale or 1.0
     sigma = widen * math.sqrt(2.0 / (max(joint.n_points, 1) * curve))  # chi2 = n rms^2 rises 1
-    return heart.scaled(best, sigma * heart.amplitude)
+    return heart.scaled(best, max(sigma, HEART_FLOOR * best) * heart.amplitude)
 
 
 def heart_envelope(
