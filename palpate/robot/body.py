@@ -9,7 +9,8 @@ ventilator's breath-hold gate (frame status bit 6) and an ECG monitor's R waves 
   (0.1 mm/s: the 0.2-0.6 mm to buckling then span 2-7 beats), so the estimate can tell the beat
   from the tissue (``estimation.trial.motion``). The time this takes is made in the approach:
   through the stand-off at full speed to ``TrialPlan.heart_margin`` before the expected
-  surface. Without an ECG nothing changes.
+  surface. Only in a breath hold (``TrialPlan.gated``): free breathing moves the tissue more
+  than the beat, and no faster. Without an ECG nothing changes.
 
 Usage::
 
@@ -51,12 +52,13 @@ class BodyWatch:
         """The approach's goal and speed (m, m/s) while the heart is seen and the tip is short of
         ``heart_margin`` before the expected surface; None: the plan's approach."""
         near = plan.contact_advance - plan.heart_margin
-        if self.beating and advance < near - plan.position_tolerance:
+        if plan.gated and self.beating and advance < near - plan.position_tolerance:
             return near, plan.fast_speed
         return None
 
     def indent_speed(self, plan: TrialPlan) -> float:
-        """The plan's indentation speed, or the heart's once the heart is seen to beat."""
-        if self.beating:
+        """The plan's indentation speed, or the heart's once the heart is seen to beat (in a breath
+        hold: breathing is no drift the estimate can take out beside the beat)."""
+        if plan.gated and self.beating:
             return min(plan.indent_speed, plan.heart_speed)
         return plan.indent_speed

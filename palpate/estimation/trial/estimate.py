@@ -56,6 +56,7 @@ from .motion import Row, motion_envelope, still_record
 from .relaxed import relaxation_of
 from .states import (
     LOADING_STATES,
+    WAITING,
     RowLoads,
     last_attempt,
     on_beam,
@@ -196,8 +197,11 @@ def fit_rows(
     beside them the load's lean from the rows before buckling (``estimation.trial.lean``) and, with
     each row's time (s) and a hold in the rows, the relaxation (``estimation.trial.relaxed``). With
     each row's tip-grating load (N), the joint fit reads the load from it; with the ticks (s)
-    of an ECG's R-wave pulses, the heart's beat is taken out (``estimation.trial.motion``)."""
-    rows, times, tip_forces = last_attempt(list(rows), times, tip_forces)  # of a gated trial
+    of an ECG's R-wave pulses, in a gated trial (its rows wait for a breath hold), the heart's beat
+    is taken out (``estimation.trial.motion``)."""
+    rows = list(rows)
+    beats = beats if any(r[0] == WAITING for r in rows) else None  # in a breath hold only
+    rows, times, tip_forces = last_attempt(rows, times, tip_forces)  # of a gated trial
     gratings = len(stack.sensor.used_gratings)
 
     def fit(rows: list[Row]) -> RecordEstimate:

@@ -21,6 +21,7 @@ from ..beam.states import BeamStates, infer_states
 from .inputs import EstimatorInputs
 
 Row = tuple[str, float, Sequence[float]]
+WAITING = "waiting"  # a gated trial's rows at the stand-off, waiting for a breath hold
 
 FloatArray = NDArray[np.float64]
 LOADING_STATES = frozenset({"approach", "contact", "indenting", "buckled"})  # the joint fit's rows
@@ -99,7 +100,7 @@ def last_attempt(
     start, retracted = 0, False
     for i, (state, _, _) in enumerate(rows):
         retracted = retracted or state == "retracting"
-        if retracted and state == "waiting":
+        if retracted and state == WAITING:
             start = i + 1
     if not start:
         return rows, times, loads
