@@ -69,9 +69,16 @@ def drift_envelope(
     dv = DRIFT_SIGMAS * motion.velocity_sigma
     if dv <= 0.0:
         return joint
+    velocities = (motion.velocity - dv, motion.velocity + dv)
+    return spanning(joint, [fit(still_rows(rows, times, v, motion.touch)) for v in velocities])
+
+
+def spanning(joint: JointFit, others: Sequence[JointFit | None]) -> JointFit:
+    """``joint`` with its interval widened to hold the intervals of ``others`` (those with one)."""
+    if joint.ci_low is None or joint.ci_high is None:
+        return joint
     lows, highs = [joint.ci_low], [joint.ci_high]
-    for v in (motion.velocity - dv, motion.velocity + dv):
-        other = fit(still_rows(rows, times, v, motion.touch))
+    for other in others:
         if other is not None and other.ci_low is not None and other.ci_high is not None:
             lows.append(other.ci_low)
             highs.append(other.ci_high)
@@ -145,14 +152,9 @@ def heart_envelope(
     taken against ``heart`` at ``DRIFT_SIGMAS`` standard errors of its amplitude either side."""
     if joint is None or joint.ci_low is None or joint.ci_high is None or heart.amplitude <= 0:
         return joint
-    lows, highs = [joint.ci_low], [joint.ci_high]
-    for k in (-DRIFT_SIGMAS, DRIFT_SIGMAS):
-        factor = max(0.0, 1.0 + k * heart.sigma / heart.amplitude)
-        other = fit(beating_rows(rows, times, heart.scaled(factor)))
-        if other is not None and other.ci_low is not None and other.ci_high is not None:
-            lows.append(other.ci_low)
-            highs.append(other.ci_high)
-    return dataclasses.replace(joint, ci_low=min(lows), ci_high=max(highs))
+    sigmas = (-DRIFT_SIGMAS, DRIFT_SIGMAS)
+    factors = [max(0.0, 1.0 + k * heart.sigma / heart.amplitude) for k in sigmas]
+    return spanning(joint, [fit(beating_rows(rows, times, heart.scaled(f))) for f in factors])
 
 
 def still_record(
