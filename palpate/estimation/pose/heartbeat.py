@@ -6,8 +6,9 @@ one at the median period), and the surface lifts ``h = a cos(phi) + b sin(phi)``
 sensor. A tip pressed ``d = x + h - x0`` into tissue pushes back about as ``d^1.5``, so in contact
 ``P^(2/3)`` is linear in the stage's advance ``x`` and in ``cos(phi)``, ``sin(phi)``: one least
 squares gives ``a`` and ``b`` in metres (:func:`heartbeat`). That lag (the phase of ``h``) is
-sharp; the amplitude reads 10-15 % small where the tissue's law is not Hertz's or the tip loses
-contact in the troughs, and the trial's joint fit sets it (``estimation.trial.motion``).
+sharp; the amplitude reads 10-40 % small where the tissue's law is not Hertz's, the tip loses
+contact in the troughs or the surface drifts, and the trial's joint fit sets it
+(``estimation.trial.motion``).
 
 Usage::
 

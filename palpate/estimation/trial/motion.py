@@ -121,19 +121,22 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
     the fit counts it, by its noise scale), ``HEART_FLOOR`` of it at least. Unchanged where every
     fit fails."""
 
+    fits: dict[float, JointFit | None] = {}  # by scale: the search's, read again at its best
+
     def score(k: float) -> float:
-        joint = fit(heart.scaled(k))
-        ok = joint is not None and joint.success and joint.rms is not None
-        return float(joint.rms) ** 2 if ok and joint is not None and joint.rms else math.inf
+        joint = fits[k] = fit(heart.scaled(k))
+        if joint is None or not joint.success or joint.rms is None:
+            return math.inf
+        return float(joint.rms) ** 2
 
     lo, hi = HEART_SCALES
     found = minimize_scalar(score, bounds=(lo, hi), method="bounded", options={"xatol": 0.01})
     if not math.isfinite(found.fun):
         return heart
     best, step = float(found.x), HEART_STEP
+    joint = fits[best] if best in fits else fit(heart.scaled(best))
     around = [score(best - step), float(found.fun), score(best + step)]
     curve = (around[0] - 2.0 * around[1] + around[2]) / step**2
-    joint = fit(heart.scaled(best))
     if not (math.isfinite(curve) and curve > 0) or joint is None:
         return heart.scaled(best, HEART_FLOOR * heart.amplitude * best)
     widen = joint.noise_scale or 1.0
