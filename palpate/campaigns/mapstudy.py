@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from palpate.config.sample import InclusionConfig, SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 
@@ -31,12 +32,19 @@ from .survey import run_survey
 Plan = tuple[str, int]  # (strategy, probe budget)
 
 
-def world_scene(scene: SceneConfig, index: int, seed: int, plain: bool = False) -> SceneConfig:
+def world_scene(
+    scene: SceneConfig, index: int, seed: int, plain: bool = False, whole: bool = False
+) -> SceneConfig:
     """World ``index``: the scene's one sample with its inclusion at a seeded random point of
-    the patch (or taken out, ``plain``)."""
+    the patch (or taken out, ``plain``; or, ``whole``, its inclusions drawn whole:
+    :func:`drawn_inclusions`)."""
     sample = scene.campaign_samples()[0]
     if plain:
         moved = dataclasses.replace(sample, inclusions=())
+    elif whole:
+        rng = np.random.default_rng([seed, index, 57])
+        drawn = drawn_inclusions(sample, scene.campaign.patch_mm, rng)
+        moved = dataclasses.replace(sample, inclusions=drawn)
     else:
         inc = sample.inclusions[0]
         x0, y0, x1, y1 = scene.campaign.patch_mm
@@ -52,12 +60,58 @@ def world_scene(scene: SceneConfig, index: int, seed: int, plain: bool = False) 
     )
 
 
+SIZES_MM = (2.0, 4.0)  # radii drawn (uniform)
+CONTRASTS = (3.0, 10.0)  # stiff contrasts drawn (log-uniform)
+SOFT_SHARE, SOFT_CONTRAST = 0.25, 0.3  # a quarter of them soft, at 0.3x
+TOP_MM = (0.5, 2.0)  # the sphere's top under the surface (uniform): within what the tip sees
+APART_CONTACTS = 2.0  # footprints at least this many contact radii apart
+CONTACT_MM = 1.8  # the paper's tip's contact radius on the S8 phantom (docs/maps.md)
+
+
+def drawn_inclusions(
+    sample: SampleConfig, patch_mm: tuple[float, ...], rng: np.random.Generator
+) -> tuple[InclusionConfig, ...]:
+    """A world drawn whole: 0-3 spheres (:data:`SIZES_MM`, :data:`CONTRASTS`, a share soft),
+    each footprint inside the patch and :data:`APART_CONTACTS` contact radii clear of the
+    others (a draw that cannot be placed in 200 tries is left out)."""
+    x0, y0, x1, y1 = patch_mm
+    out: list[InclusionConfig] = []
+    for _ in range(int(rng.integers(0, 4))):
+        r = float(rng.uniform(*SIZES_MM))
+        soft = bool(rng.random() < SOFT_SHARE)
+        contrast = SOFT_CONTRAST if soft else float(np.exp(rng.uniform(*np.log(CONTRASTS))))
+        depth = float(rng.uniform(*TOP_MM)) + r
+        for _try in range(200):
+            x, y = (float(v) for v in rng.uniform([x0 + r, y0 + r], [x1 - r, y1 - r]))
+            clear = all(
+                math.hypot(x - o.center_mm[0], y - o.center_mm[1])
+                >= r + o.radius_mm + APART_CONTACTS * CONTACT_MM
+                for o in out
+            )
+            if clear:
+                out.append(
+                    InclusionConfig(
+                        center_mm=(x, y, depth),
+                        radius_mm=r,
+                        modulus_kpa=contrast * sample.modulus_kpa,
+                    )
+                )
+                break
+    return tuple(out)
+
+
 def survey_row(
-    scene: SceneConfig, stack: StackConfig, plan: Plan, index: int, seed: int, plain: bool
+    scene: SceneConfig,
+    stack: StackConfig,
+    plan: Plan,
+    index: int,
+    seed: int,
+    plain: bool,
+    whole: bool = False,
 ) -> dict[str, Any]:
     """One survey of world ``index`` by ``plan``: its scores and costs (picklable)."""
     strategy, budget = plan
-    world = world_scene(scene, index, seed, plain)
+    world = world_scene(scene, index, seed, plain, whole)
     result = run_survey(
         world, stack, seed=seed * 1000 + index, strategy=strategy, max_probes=budget
     )
@@ -71,6 +125,8 @@ def survey_row(
         "lab_time_s": result.lab_time,
         "map_s_per_probe": result.map_seconds / max(len(result.probes), 1),
         "found": bool(s is not None and s.found),
+        "truth": None if result.truth is None else result.truth.as_dict()["inclusions"],
+        "inclusions": [] if s is None else [i.as_dict() for i in s.inclusions],
         **result.scores(),
         "probe_list": [p.record() for p in result.probes],  # to summarise again (SI, exact)
     }
@@ -86,16 +142,20 @@ def run_map_study(
     seed: int = 0,
     workers: int = 1,
     progress: Callable[[dict[str, Any]], None] | None = None,
+    whole: bool = False,
 ) -> list[dict[str, Any]]:
-    """Every plan on every world, and the active plan on as many homogeneous worlds."""
+    """Every plan on every world, and the active plan on as many homogeneous worlds; with
+    ``whole``, every plan on worlds drawn whole (:func:`drawn_inclusions`: some of them hold
+    none, so no homogeneous worlds beside them)."""
     jobs = [(plan, k, False) for plan in plans for k in range(worlds)]
-    active = next((p for p in plans if p[0] == "active"), None)
-    if active is not None:
+    active = next((p for p in plans if p[0].startswith("active")), None)
+    if active is not None and not whole:
         jobs += [(active, k, True) for k in range(worlds)]
     rows: list[dict[str, Any]] = []
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
         futures = [
-            pool.submit(survey_row, scene, stack, plan, k, seed, plain) for plan, k, plain in jobs
+            pool.submit(survey_row, scene, stack, plan, k, seed, plain, whole)
+            for plan, k, plain in jobs
         ]
         for future in concurrent.futures.as_completed(futures):
             row = future.result()
@@ -118,7 +178,9 @@ def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
         line["probes_median"] = _median([r["probes"] for r in rs])
         line["lab_time_s_median"] = _median([r["lab_time_s"] for r in rs])
         line["map_s_per_probe_max"] = max(r["map_s_per_probe"] for r in rs)
-        if plain:
+        if any("inclusions_true" in r or "false_inclusions" in r for r in rs):
+            line.update(whole_lines(rs))
+        elif plain:
             line["homogeneous"] = True
             line["false_alarms"] = sum(r["found"] for r in rs)
         else:
@@ -129,6 +191,24 @@ def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
                 line[f"{key}_median"] = _median([r[key] for r in rs if r.get(key) is not None])
         out.append(line)
     return out
+
+
+def whole_lines(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The rates of a study on worlds drawn whole: every true inclusion found (of its kind),
+    worlds with a false one, the centre's error and interval per found inclusion, soft ones
+    read as soft."""
+    per = [i for r in rows for i in r.get("per_inclusion", [])]
+    found = [i for i in per if i["found"]]
+    soft = [i for i in per if i["kind"] == "soft"]
+    return {
+        "inclusions_true": len(per),
+        "inclusions_found": len(found),
+        "worlds_with_a_false_one": sum(r.get("false_inclusions", 0) > 0 for r in rows),
+        "center_error_mm_median": _median([i["center_error_mm"] for i in found]),
+        "center_in_ci": sum(i["center_in_ci"] for i in found),
+        "soft_true": len(soft),
+        "soft_found_as_soft": sum(i["found"] for i in soft),
+    }
 
 
 def _median(values: Sequence[float]) -> float | None:

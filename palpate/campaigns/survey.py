@@ -64,16 +64,23 @@ __all__ = [
 def truth_of(sample: SampleConfig) -> Truth | None:
     if not sample.inclusions:
         return None
-    inc = sample.inclusions[0]
-    c = inc.center
-    return Truth((c[0], c[1]), inc.radius, c[2], inc.modulus / sample.modulus)
+    every = [
+        Truth((c[0], c[1]), inc.radius, c[2], inc.modulus / sample.modulus)
+        for inc in sample.inclusions
+        for c in (inc.center,)
+    ]
+    return dataclasses.replace(every[0], others=tuple(every[1:]))
 
 
 def moved_scene(
     scene: SceneConfig, sample: SampleConfig, point: tuple[float, float]
 ) -> SceneConfig:
     """The scene whose one sample sits so that the tip, indenting where a single trial does,
-    presses at ``point`` (m) of the patch: the inclusions' centres relative to that point."""
+    presses at ``point`` (m) of the patch: the inclusions' centres relative to that point. A
+    world of the whole patch (``fidelity.inclusion_offsets: patch``) keeps the sample where it
+    is and takes the point from the trial (``TrialSpec.at``): one factorisation a survey."""
+    if scene.fidelity.inclusion_offsets == "patch":
+        return scene
     moved = tuple(
         dataclasses.replace(
             inc,
@@ -104,6 +111,7 @@ def probe_spec(
         roll=0.0,
         exposed_length=length,
         seed=seed * 1_000_003 + k,
+        at=point if scene.fidelity.inclusion_offsets == "patch" else (0.0, 0.0),
     )
 
 

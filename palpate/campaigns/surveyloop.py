@@ -15,8 +15,8 @@ from __future__ import annotations
 import json
 import math
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -32,6 +32,7 @@ from palpate.maps import (
     summarise,
 )
 from palpate.maps.gp import LENGTH_SCALE_MAX
+from palpate.maps.inclusions import Inclusion, find_inclusions
 from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
 from palpate.robot.records.ros2 import nanoseconds
 
@@ -98,6 +99,20 @@ class Truth:
     radius: float
     depth: float
     contrast: float
+    others: tuple[Truth, ...] = ()  # the sample's other inclusions
+
+    @property
+    def kind(self) -> str:
+        return "stiff" if self.contrast > 1.0 else "soft"
+
+    def one(self) -> dict[str, Any]:
+        return {
+            "center_mm": [self.centre[0] / MM, self.centre[1] / MM],
+            "radius_mm": self.radius / MM,
+            "depth_mm": self.depth / MM,
+            "contrast": self.contrast,
+            "kind": self.kind,
+        }
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -105,6 +120,7 @@ class Truth:
             "inclusion_radius_mm": self.radius / MM,
             "inclusion_depth_mm": self.depth / MM,
             "contrast": self.contrast,
+            "inclusions": [t.one() for t in (self, *self.others)],
         }
 
 
@@ -130,10 +146,14 @@ class SurveyResult:
         centre); a homogeneous sample's "false alarm"."""
         s = self.summary
         if self.truth is None:
-            return {"false_alarm": bool(s is not None and s.found)}
+            return {
+                "false_alarm": bool(s is not None and s.found),
+                "false_inclusions": 0 if s is None else len(s.inclusions),
+            }
         out: dict[str, Any] = {"detected": bool(s is not None and s.found)}
         if s is None:
             return out
+        out.update(inclusion_scores(s.inclusions, (self.truth, *self.truth.others)))
         xx, yy = np.meshgrid(s.x, s.y)
         t = self.truth
         inside = np.hypot(xx - t.centre[0], yy - t.centre[1]) <= t.radius
@@ -166,6 +186,35 @@ class SurveyResult:
             "scores": self.scores(),
             "probes": [p.as_dict() for p in self.probes],
         }
+
+
+def inclusion_scores(found: Sequence[Inclusion], truths: Sequence[Truth]) -> dict[str, Any]:
+    """Every true inclusion against the map's list: matched to the nearest reported one of its
+    kind whose centre is within its radius (at least 2 mm) of its own; the reported ones no
+    true inclusion took are false. Per true inclusion: found, the centre's error (mm), whether
+    the centre's interval holds it."""
+    free = list(found)
+    rows: list[dict[str, Any]] = []
+    for t in truths:
+        reach = max(t.radius, 2 * MM)
+        same = [f for f in free if f.kind == t.kind]
+        dist = [math.hypot(f.centre[0] - t.centre[0], f.centre[1] - t.centre[1]) for f in same]
+        if not same or min(dist) > reach:
+            rows.append({"kind": t.kind, "found": False})
+            continue
+        f = same[int(np.argmin(dist))]
+        free.remove(f)
+        (x0, x1), (y0, y1) = f.centre_ci
+        held = x0 <= t.centre[0] <= x1 and y0 <= t.centre[1] <= y1
+        rows.append(
+            {"kind": t.kind, "found": True, "center_error_mm": min(dist) / MM, "center_in_ci": held}
+        )
+    return {
+        "inclusions_found": sum(r["found"] for r in rows),
+        "inclusions_true": len(truths),
+        "false_inclusions": len(free),
+        "per_inclusion": rows,
+    }
 
 
 def run_plan(
@@ -234,7 +283,9 @@ def map_of(
         fitted = StiffnessMap.fit(probes, seed=seed, length_scale_max=scale)
     except MapError as exc:
         return None, f"; no map: {exc}"
-    return summarise(fitted, patch, threshold=threshold, seed=seed), ""
+    summary = summarise(fitted, patch, threshold=threshold, seed=seed)
+    every = find_inclusions(fitted, patch, summary, seed=seed)
+    return replace(summary, inclusions=tuple(every)), ""
 
 
 def publish_map(

@@ -58,6 +58,12 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="the study's plans, strategy:budget, comma-separated",
     )
     parser.add_argument("--workers", type=positive_int, default=2, help="the study's processes")
+    parser.add_argument(
+        "--whole",
+        action="store_true",
+        help="the study's worlds drawn whole: 0-3 spheres each, their sizes, contrasts (a "
+        "quarter soft) and depths drawn (a scene with fidelity.inclusion_offsets: patch)",
+    )
 
 
 def map_scene(path: Path, sample: str | None) -> SceneConfig:
@@ -153,7 +159,14 @@ def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
     from palpate.campaigns.mapstudy import run_map_study, summarise_study
 
     plans: list[tuple[str, int]] = args.plans
-    total = args.worlds * (len(plans) + any(p[0] == "active" for p in plans))
+    whole = args.whole
+    if whole and scene.fidelity.inclusion_offsets != "patch":
+        raise InputError(
+            f"--whole: worlds drawn whole need fidelity.inclusion_offsets: patch (the scene has "
+            f"{scene.fidelity.inclusion_offsets!r}; config/scenes/maps/several.yaml has it)"
+        )
+    extra = any(p[0] == "active" for p in plans) and not whole
+    total = args.worlds * (len(plans) + extra)
     bar = progress_bar(total, f"{scene.name} map study")
 
     def done(_: dict[str, Any]) -> None:
@@ -168,6 +181,7 @@ def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
             seed=args.seed,
             workers=args.workers,
             progress=done,
+            whole=whole,
         )
     finally:
         bar.close()
@@ -176,6 +190,7 @@ def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
     payload = {
         "scene": scene.name,
         "worlds": args.worlds,
+        "whole": whole,
         "seed": args.seed,
         "summary": table,
         "rows": rows,

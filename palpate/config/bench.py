@@ -82,7 +82,7 @@ class BenchMapConfig:
 
     target: str
     patch_mm: tuple[float, ...] = (-10.0, -10.0, 10.0, 10.0)
-    strategy: Literal["active", "raster", "random"] = "active"
+    strategy: Literal["active", "active-all", "raster", "random"] = "active"
     max_probes: int = field(default=30, metadata=limits(ge=1, le=10000))
     threshold_kpa: float | None = field(default=None, metadata=limits(gt=0))
     seed: int = field(default=0, metadata=limits(ge=0))

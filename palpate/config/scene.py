@@ -75,10 +75,15 @@ class FidelityConfig:
     # a coarser grid (rounded to whole encoder counts) solves fewer equilibria per trial and
     # interpolates linearly between them: a cheaper world, for speed-over-accuracy levels.
     contact_grid_um: float | None = field(default=None, metadata=limits(gt=0, le=1000))
-    # A sample with one inclusion seen from a point the 3-D tables were not solved at: solve
-    # there ("exact", 10-100 s a new distance) or interpolate between solves at fixed distances
-    # ("interpolated", sim/fem3d/offsets.py: what a map's many points need; docs/maps.md).
-    inclusion_offsets: Literal["exact", "interpolated"] = "exact"
+    # A sample with inclusions seen from a point the 3-D tables were not solved at: solve
+    # there ("exact", 10-100 s a new distance), interpolate one inclusion between solves at
+    # fixed distances ("interpolated", sim/fem3d/offsets.py), or factorise the whole patch once
+    # and press anywhere on it ("patch", sim/fem3d/patch.py: any number of inclusions, about a
+    # minute a geometry, milliseconds a point; docs/maps.md).
+    inclusion_offsets: Literal["exact", "interpolated", "patch"] = "exact"
+    # The patch of the sample's surface (mm, [x_min, y_min, x_max, y_max] of the tip's centre)
+    # that "patch" meshes finely (a map's campaign.patch_mm must lie inside it).
+    inclusion_patch_mm: tuple[float, ...] = (-10.0, -10.0, 10.0, 10.0)
 
     # the SI views of the unit-suffixed fields (palpate.config.units)
     fbg_noise = SI("fbg_noise_pm", PM)  # m of wavelength
@@ -156,7 +161,7 @@ class CampaignConfig:
     # probes (its travel counts in the map's lab time). Each probe indents on the bench column
     # at the first of exposed_lengths_mm.
     patch_mm: tuple[float, ...] = (-10.0, -10.0, 10.0, 10.0)
-    strategy: Literal["active", "raster", "random"] = "active"
+    strategy: Literal["active", "active-all", "raster", "random"] = "active"
     max_probes: int = field(default=30, metadata=limits(ge=1, le=10000))
     map_threshold_kpa: float | None = field(default=None, metadata=limits(gt=0))
     stage_speed_mm_per_s: float = field(default=5.0, metadata=limits(gt=0, le=1000))
@@ -238,6 +243,8 @@ class SceneConfig:
                         f"samples[{k}].inclusions: fidelity.inclusion_offsets: interpolated "
                         "holds one inclusion a sample"
                     )
+        if self.fidelity.inclusion_offsets == "patch":
+            _check_world_patch(self)
         if self.campaign.kind == "map":
             _check_map(self)
 
@@ -299,6 +306,20 @@ def check_patch(patch_mm: tuple[float, ...], key: str) -> None:
         raise ValueError(
             f"{key}: [x_min, y_min, x_max, y_max] with x_max > x_min and y_max > "
             f"y_min, got {list(patch_mm)}"
+        )
+
+
+def _check_world_patch(scene: SceneConfig) -> None:
+    """``fidelity.inclusion_patch_mm``: four corners in order, holding a map's patch."""
+    world = scene.fidelity.inclusion_patch_mm
+    check_patch(world, "fidelity.inclusion_patch_mm")
+    if scene.campaign.kind != "map":
+        return
+    x0, y0, x1, y1 = scene.campaign.patch_mm
+    if x0 < world[0] or y0 < world[1] or x1 > world[2] or y1 > world[3]:
+        raise ValueError(
+            f"fidelity.inclusion_patch_mm: {list(world)} must hold the map's campaign.patch_mm "
+            f"{list(scene.campaign.patch_mm)} (the world is meshed finely only there)"
         )
 
 

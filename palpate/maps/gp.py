@@ -82,6 +82,28 @@ class MapError(ValueError):
     """Too few usable probes for a map."""
 
 
+def area_median(xy: FloatArray, values: FloatArray, n: int = 41) -> float:
+    """The median of ``values`` over the area the probes at ``xy`` cover (each weighted by the
+    share of an n x n grid over their bounding box nearest to it): an active plan crowds its
+    probes on the inclusions, and their plain median reads the tissue around them high (369
+    kPa against 319 on a 314 kPa phantom holding two). A raster's probes weigh the same.
+
+    >>> corners = [[0, 0], [0, 1], [1, 0], [1, 1]]
+    >>> crowd = [[0.9, 0.9], [0.95, 0.9], [0.9, 0.95], [0.95, 0.95], [0.92, 0.92]]
+    >>> values = np.array([1.0] * 4 + [2.0] * 5)
+    >>> float(np.median(values)), area_median(np.array(corners + crowd), values)
+    (2.0, 1.0)
+    """
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    gx, gy = (np.linspace(a, b, n) for a, b in zip(lo, hi, strict=True))
+    cells = np.stack([g.ravel() for g in np.meshgrid(gx, gy)], axis=1)
+    nearest = np.argmin(((cells[:, None, :] - xy[None, :, :]) ** 2).sum(axis=2), axis=1)
+    weight = np.bincount(nearest, minlength=len(values)).astype(float)
+    order = np.argsort(values)
+    cumulative = np.cumsum(weight[order])
+    return float(values[order][np.searchsorted(cumulative, 0.5 * cumulative[-1])])
+
+
 @dataclass(frozen=True)
 class StiffnessMap:
     """A fitted map (:meth:`fit`): the process, the probes it used, the background log E."""
@@ -108,7 +130,7 @@ class StiffnessMap:
         xy = np.array([[p.x / MM, p.y / MM] for p in used])
         y = np.log([float(p.modulus or 0.0) for p in used])
         noise = np.array([p.log_sigma() ** 2 for p in used])
-        background = float(np.median(y))
+        background = area_median(xy, y)
         top = length_scale_max / MM
         kernel = ConstantKernel(0.01, AMPLITUDE) * RBF(0.5 * top, (LENGTH_SCALE_MIN_MM, top))
         gp = GaussianProcessRegressor(

@@ -25,15 +25,19 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage  # type: ignore[import-untyped,unused-ignore]
 from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
 
 from .extent import Extent, ExtentError, fit_extent
 from .gp import LENGTH_SCALE_MAX, MIN_PROBES, MM, MapError, Patch, StiffnessMap
 from .probes import Z95, Probe
+
+if TYPE_CHECKING:
+    from .inclusions import Inclusion
 
 FloatArray = NDArray[np.float64]
 MIN_RISE = 0.10  # the smallest rise above the background a threshold from the data takes
@@ -63,6 +67,7 @@ class MapSummary:
     radius_ci: tuple[float, float] | None = None
     apparent_radius: float | None = None  # the region's (equal area disc), m
     extent: Extent | None = None
+    inclusions: tuple[Inclusion, ...] = ()  # every one the map reads (maps.inclusions)
 
     def inside(self, x: FloatArray, y: FloatArray) -> NDArray[np.bool_]:
         """Whether points (m, any shape) lie within the reported boundary: the extent's disc,
@@ -98,6 +103,7 @@ class MapSummary:
             "background_kpa": self.background / 1e3,
             "peak_kpa": float(np.max(self.mean)) / 1e3,
             "max_p_above": float(np.max(self.p_above)),
+            "inclusions": [i.as_dict() for i in self.inclusions],
         }
 
 
@@ -136,14 +142,15 @@ def summarise(
             f"{100 * rise:+.1f} % of the background"
         )
         return MapSummary(**base, found=False, evidence=evidence)
-    region = p > 0.5
+    region = peak_region(p > 0.5, mean)
     weight = np.where(region, mean - t, 0.0)
     centre = (
         float(points[:, 0] @ weight / weight.sum()),
         float(points[:, 1] @ weight / weight.sum()),
     )
     apparent = math.sqrt(region.sum() * _cell(patch, GRID) / math.pi)
-    centre_ci, radius_ci = _intervals(m, patch, t, np.random.default_rng(seed))
+    reach = apparent + m.length_scale
+    centre_ci, radius_ci = _intervals(m, patch, t, np.random.default_rng(seed), centre, reach)
     evidence = (
         f"inclusion found: above {math.exp(t) / 1e3:.4g} kPa with probability {best:.3f}; the "
         f"map's peak is {100 * rise:+.1f} % of the background"
@@ -183,6 +190,15 @@ def _extent(
     return ext if within and r <= 0.5 * patch.diagonal and math.isfinite(ext.radius_se) else None
 
 
+def peak_region(region: NDArray[np.bool_], mean: FloatArray) -> NDArray[np.bool_]:
+    """The connected part of ``region`` (flat, on the summary's grid) holding its highest
+    mean: one inclusion's, when the map holds several."""
+    labels, _ = ndimage.label(region.reshape(GRID, GRID))
+    flat = labels.ravel()
+    top = int(np.argmax(np.where(region, mean, -np.inf)))
+    return np.asarray(flat == flat[top])
+
+
 def above(mean: FloatArray, sd: FloatArray, t: float) -> FloatArray:
     """P(log E > t) of a normal posterior with ``mean`` and ``sd``."""
     return np.asarray(ndtr((mean - t) / np.maximum(sd, 1e-12)), dtype=np.float64)
@@ -206,19 +222,40 @@ def _cell(patch: Patch, n: int) -> float:
 
 
 def _intervals(
-    m: StiffnessMap, patch: Patch, t: float, rng: np.random.Generator
+    m: StiffnessMap,
+    patch: Patch,
+    t: float,
+    rng: np.random.Generator,
+    centre: tuple[float, float],
+    reach: float,
 ) -> tuple[tuple[tuple[float, float], tuple[float, float]], tuple[float, float]]:
-    """95 % intervals of the centre (x and y) and the radius over posterior draws (a draw
-    with no point above the threshold counts as radius 0 and no centre)."""
+    """95 % intervals of the centre (x and y) and the radius over posterior draws, each draw's
+    region taken within ``reach`` of ``centre`` (a draw with no point above the threshold
+    there counts as radius 0 and no centre)."""
     points = patch.points(DRAW_GRID)
-    f = m.draws(points, DRAWS, rng)
-    above = f > t
-    weight = np.where(above, f - t, 0.0)
+    return drawn(m.draws(points, DRAWS, rng), points, patch, t, 1.0, centre, reach)
+
+
+def drawn(
+    draws: FloatArray,
+    points: FloatArray,
+    patch: Patch,
+    t: float,
+    sign: float,
+    centre: tuple[float, float],
+    reach: float,
+) -> tuple[tuple[tuple[float, float], tuple[float, float]], tuple[float, float]]:
+    """95 % intervals of a region's centre (x, y) and radius over posterior ``draws`` (n, k)
+    of log E at ``points`` (k, 2) on the draw grid: each draw's region is where it is past
+    ``t`` (above for ``sign`` 1, below for -1) within ``reach`` of ``centre``, its centre the
+    centroid weighted by how far past."""
+    close = np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]) <= reach
+    weight = (sign * (draws[:, close] - t)).clip(min=0.0)
     total = weight.sum(axis=1)
     some = total > 0
-    cx = (weight[some] @ points[:, 0]) / total[some]
-    cy = (weight[some] @ points[:, 1]) / total[some]
-    radius = np.sqrt(above.sum(axis=1) * _cell(patch, DRAW_GRID) / math.pi)
+    cx = (weight[some] @ points[close, 0]) / total[some]
+    cy = (weight[some] @ points[close, 1]) / total[some]
+    radius = np.sqrt(np.count_nonzero(weight, axis=1) * _cell(patch, DRAW_GRID) / math.pi)
     if not some.any():
         nan = (math.nan, math.nan)
         return (nan, nan), (0.0, float(np.percentile(radius, 97.5)))

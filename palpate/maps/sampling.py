@@ -7,7 +7,10 @@ largest straddle score, ``1.96 sd - |mean - threshold|`` on log E (Bryan et al. 
 the process is unsure and near the level set), less a travel penalty in proportion to the
 distance from the last probe (RASEC: half the travel at equal F1). It stops when the boundary
 is known to ``tolerance``: the area still uncertain (0.05 < P(above) < 0.95) is at most
-``tolerance`` times the boundary's length (with no region, a ``tolerance``-wide square)::
+``tolerance`` times the boundary's length (with no region, a ``tolerance``-wide square).
+``active-all`` straddles a second level too, half-way from the background down to the map's
+lowest point and at least 10 % under the background, and stops when both boundaries are known:
+soft regions (cysts) as well as stiff ones (issue 57)::
 
     plan = Active(patch, max_probes=30)
     while (point := plan.next(probes)) is not None:
@@ -25,11 +28,11 @@ from numpy.typing import NDArray
 
 from .gp import LENGTH_SCALE_MAX, MIN_PROBES, MapError, Patch, StiffnessMap
 from .probes import Probe
-from .region import GRID, above, log_threshold
+from .region import GRID, MIN_RISE, above, log_threshold
 
 FloatArray = NDArray[np.float64]
 Point = tuple[float, float]
-STRATEGIES = ("active", "raster", "random")
+STRATEGIES = ("active", "active-all", "raster", "random")
 Z = 1.96
 START = 3  # the active plan's first raster, START x START cells
 
@@ -94,8 +97,10 @@ class Active:
         min_spacing: float = 0.5e-3,
         seed: int = 0,
         length_scale_max: float = LENGTH_SCALE_MAX,
+        soft: bool = False,
     ) -> None:
         self.patch, self.max_probes, self.threshold = patch, max_probes, threshold
+        self.soft = soft  # straddle the soft level too (``active-all``: cysts as well)
         self.tolerance, self.travel_penalty, self.min_spacing = (
             tolerance,
             travel_penalty,
@@ -118,19 +123,24 @@ class Active:
         except MapError:  # too few numbers yet: go on with what a raster would do
             return self._fallback(probes)
         mean, sd = m.predict(self.candidates)
-        t = log_threshold(m, mean, self.threshold)
-        if self._known(mean, sd, t):
+        levels = [log_threshold(m, mean, self.threshold)]
+        if self.soft:  # half-way down to the lowest point, at least 10 % under the background
+            low = m.background + 0.5 * (float(np.min(mean)) - m.background)
+            levels.append(min(low, m.background - math.log1p(MIN_RISE)))
+        signs = (1.0, -1.0)[: len(levels)]
+        if all(self._known(mean, sd, t, sign) for t, sign in zip(levels, signs, strict=True)):
             self.stopped = f"boundary known to {self.tolerance * 1e3:g} mm"
             return None
         last = np.array([probes[-1].x, probes[-1].y])
         travel = np.hypot(*(self.candidates - last).T) / self.patch.diagonal
-        score = Z * sd - np.abs(mean - t) - self.travel_penalty * travel
+        straddle = np.max([Z * sd - np.abs(mean - t) for t in levels], axis=0)
+        score = straddle - self.travel_penalty * travel
         score[self._too_close(probes)] = -np.inf
         best = int(np.argmax(score))
         return float(self.candidates[best, 0]), float(self.candidates[best, 1])
 
-    def _known(self, mean: FloatArray, sd: FloatArray, t: float) -> bool:
-        p = above(mean, sd, t).reshape(GRID, GRID)
+    def _known(self, mean: FloatArray, sd: FloatArray, t: float, sign: float = 1.0) -> bool:
+        p = above(sign * mean, sd, sign * t).reshape(GRID, GRID)
         cell = self.patch.area / (GRID - 1) ** 2
         band = float(np.count_nonzero((p > 0.05) & (p < 0.95))) * cell
         region = p > 0.5
@@ -174,9 +184,14 @@ def plan_for(
     length_scale_max: float = LENGTH_SCALE_MAX,
 ) -> Strategy:
     """The plan named ``strategy`` (one of :data:`STRATEGIES`)."""
-    if strategy == "active":
+    if strategy in ("active", "active-all"):
         return Active(
-            patch, max_probes, threshold=threshold, seed=seed, length_scale_max=length_scale_max
+            patch,
+            max_probes,
+            threshold=threshold,
+            seed=seed,
+            length_scale_max=length_scale_max,
+            soft=strategy == "active-all",
         )
     if strategy == "raster":
         return raster(patch, max_probes)

@@ -44,6 +44,7 @@ from .fem import FeTissueLaw, LayerProblem, table_key
 from .fem.problem import significant
 from .fem3d import Inclusion, InclusionProblem, InclusionWorld
 from .fem3d.offsets import MapWorld, on_axis
+from .fem3d.patch import PatchProblem, PatchWorld
 from .viscoelastic import PowerLawSolid, Relaxation, StandardLinearSolid
 
 HALF_SPACE_RATIO = 200.0
@@ -98,14 +99,16 @@ def fe_world(
     fidelity: FidelityConfig,
     tip_radius: float,
     at: tuple[float, float] = (0.0, 0.0),
-) -> LayerProblem | InclusionWorld | MapWorld:
+) -> LayerProblem | InclusionWorld | MapWorld | PatchWorld:
     """The FE tissue of ``sample`` under a tip pressing at ``at`` (x, y in m on its surface,
     from the sample's origin, where a single trial indents): its layer's problem, or with
     inclusions the layer and its 3-D problem as seen from that point
     (:class:`sim.fem3d.InclusionWorld`; the 3-D model is cut at ``SOLID_LIMIT_RATIO`` R deep
     and wide, which the inclusions' factor does not feel). Points at the same distance from a
     single inclusion share one 3-D table. With ``fidelity.inclusion_offsets: interpolated`` the
-    factor is read between solves at fixed distances (:class:`sim.fem3d.offsets.MapWorld`)."""
+    factor is read between solves at fixed distances (:class:`sim.fem3d.offsets.MapWorld`); with
+    ``patch``, the whole of ``fidelity.inclusion_patch_mm`` is factorised once with every
+    inclusion and the tip presses anywhere on it (:class:`sim.fem3d.patch.PatchWorld`)."""
     layer = fe_problem(sample, fidelity, tip_radius)
     if not sample.inclusions:
         return layer
@@ -130,6 +133,10 @@ def fe_world(
         n_depths=layer.n_depths,
     )
     x, y = at
+    if fidelity.inclusion_offsets == "patch":
+        patch = tuple(significant(v * 1e-3 / tip_radius) for v in fidelity.inclusion_patch_mm)
+        where = (significant(x / tip_radius), significant(y / tip_radius))
+        return PatchWorld(layer, PatchProblem(solid, patch), where)  # type: ignore[arg-type]
     if x or y:
         solid = solid.seen_from(significant(x / tip_radius), significant(y / tip_radius))
     if fidelity.inclusion_offsets == "interpolated":

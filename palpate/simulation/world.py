@@ -57,6 +57,7 @@ class TrialSpec:
     seed: int
     reference: float | None = None  # Pa, the reported reference modulus; None: the truth
     indent_speed: float | None = None  # m/s; None: the campaign's indent_speed_mm_per_s
+    at: tuple[float, float] = (0.0, 0.0)  # m: the point of the sample's surface it presses
 
     @property
     def stage(self) -> Stage:
@@ -236,7 +237,7 @@ def trial_world(
         sensor=stack.sensor,
         fbg=stack.fbg,
         fidelity=scene.fidelity,
-        tissue=tissue_model(sample, scene.fidelity, stack.sensor.tip_radius),
+        tissue=tissue_model(sample, scene.fidelity, stack.sensor.tip_radius, spec.at),
         surface=geo.surface,
         pose=_pose_fn(stack, spec, geo.tube),
         joints=servos.read,

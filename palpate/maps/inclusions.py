@@ -1,0 +1,155 @@
+"""Every inclusion a map holds: its stiff and its soft regions, each with centre and radius.
+
+The summary (:mod:`maps.region`) answers for the map's highest region. A patch can hold
+several nodules, and a cyst reads softer than the tissue around it, so the map is read again
+against two levels, ``min_rise`` (10 %) above and below the background in log E. Each connected
+region of the summary's grid where the posterior is past a level with probability over one half
+is a candidate; it is an inclusion when its most certain point is past it with probability at
+least ``found_probability`` (0.95), the summary's rule. For each, as the summary does for its
+one: a threshold half-way (in log E) from the background to the region's own extreme, the
+centroid of the region past it weighted by how far past, the equal-area radius, and 95 %
+intervals from joint posterior draws, each draw's region taken near the inclusion (within its
+radius and one length scale of the map). The first of the list is the summary's own inclusion,
+with its extent (the disc through the tip's contact) where it has one; the rest by how far
+their extreme reads from the background. Depth is not read from a single modulus a probe:
+``depth_mm`` is null until the probes carry their modulus against depth (issue 57)::
+
+    found = find_inclusions(StiffnessMap.fit(probes), patch, summary)
+    [(f.kind, f.centre, f.radius) for f in found]
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage  # type: ignore[import-untyped,unused-ignore]
+from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
+
+from .gp import MM, Patch, StiffnessMap
+from .region import DRAW_GRID, DRAWS, FOUND_PROBABILITY, GRID, MIN_RISE, MapSummary, drawn
+
+FloatArray = NDArray[np.float64]
+Interval = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Inclusion:
+    """One region the map reads as an inclusion (m, Pa).
+
+    Attributes:
+        kind: ``"stiff"`` or ``"soft"``.
+        centre, centre_ci: its centre and the 95 % intervals of x and y.
+        radius, radius_ci: its radius and 95 % interval.
+        extreme: the map's highest (stiff) or lowest (soft) modulus in it.
+        probability: how sure the map is that its most certain point is past the level.
+    """
+
+    kind: str
+    centre: tuple[float, float]
+    centre_ci: tuple[Interval, Interval]
+    radius: float
+    radius_ci: Interval
+    extreme: float
+    probability: float
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "kind": self.kind,
+            "center_mm": [self.centre[0] / MM, self.centre[1] / MM],
+            "center_ci_mm": [[v / MM for v in axis] for axis in self.centre_ci],
+            "radius_mm": self.radius / MM,
+            "radius_ci_mm": [v / MM for v in self.radius_ci],
+            "depth_mm": None,
+            "depth_ci_mm": None,
+            "extreme_kpa": self.extreme / 1e3,
+            "probability": self.probability,
+        }
+
+
+def find_inclusions(
+    m: StiffnessMap,
+    patch: Patch,
+    summary: MapSummary,
+    *,
+    min_rise: float = MIN_RISE,
+    found_probability: float = FOUND_PROBABILITY,
+    seed: int = 0,
+) -> list[Inclusion]:
+    """Every stiff and soft inclusion of the map over ``patch``; ``summary``'s first."""
+    points = patch.points(GRID)
+    mean, sd = m.predict(points)
+    near = patch.points(DRAW_GRID)
+    draws = m.draws(near, DRAWS, np.random.default_rng(seed))
+    found: list[Inclusion] = []
+    for kind, sign in (("stiff", 1.0), ("soft", -1.0)):
+        level = m.background + sign * math.log1p(min_rise)
+        p = ndtr(sign * (mean - level) / np.maximum(sd, 1e-12))
+        labels, n = ndimage.label((p > 0.5).reshape(GRID, GRID))
+        for k in range(1, n + 1):
+            mask = labels.ravel() == k
+            best = float(p[mask].max())
+            if best < found_probability:
+                continue
+            found.append(_read(kind, sign, m, patch, points, mean, mask, near, draws, best))
+    found.sort(key=lambda f: -abs(math.log(f.extreme) - m.background))
+    return _summary_first(found, summary)
+
+
+def _read(
+    kind: str,
+    sign: float,
+    m: StiffnessMap,
+    patch: Patch,
+    points: FloatArray,
+    mean: FloatArray,
+    mask: NDArray[np.bool_],
+    near: FloatArray,
+    draws: FloatArray,
+    probability: float,
+) -> Inclusion:
+    """One region's inclusion: its own half-way threshold, centroid, radius and intervals."""
+    extreme = float(sign * np.max(sign * mean[mask]))
+    t = m.background + 0.5 * (extreme - m.background)
+    past = np.where(mask, sign * (mean - t), 0.0).clip(min=0.0)
+    centre = (float(points[:, 0] @ past / past.sum()), float(points[:, 1] @ past / past.sum()))
+    cell = patch.area / (GRID - 1) ** 2
+    radius = math.sqrt(np.count_nonzero(past) * cell / math.pi)
+    reach = radius + m.length_scale
+    centre_ci, radius_ci = drawn(draws, near, patch, t, sign, centre, reach)
+    return Inclusion(
+        kind,
+        centre,
+        centre_ci,
+        radius,
+        radius_ci,
+        math.exp(extreme),
+        probability,
+    )
+
+
+def _summary_first(found: list[Inclusion], summary: MapSummary) -> list[Inclusion]:
+    """The list with the summary's inclusion first, carrying the summary's centre, radius and
+    intervals (its extent's disc), so the first entry and the summary's keys agree."""
+    if not summary.found or summary.centre is None:
+        return found
+    assert summary.centre_ci is not None
+    assert summary.radius is not None
+    assert summary.radius_ci is not None
+    cx, cy = summary.centre
+    stiff = [f for f in found if f.kind == "stiff"]
+    if not stiff:
+        return found
+    own = min(stiff, key=lambda f: math.hypot(f.centre[0] - cx, f.centre[1] - cy))
+    first = Inclusion(
+        "stiff",
+        summary.centre,
+        summary.centre_ci,
+        summary.radius,
+        summary.radius_ci,
+        own.extreme,
+        own.probability,
+    )
+    return [first, *(f for f in found if f is not own)]

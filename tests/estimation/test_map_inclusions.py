@@ -1,0 +1,83 @@
+"""Every inclusion a map reads (maps.inclusions) on synthetic probes: two stiff bumps and a
+soft dip, each found where it is and of its kind; a flat patch gives none (unit tests of the
+arithmetic; docs/maps.md judges it through whole trials on the patch world)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from palpate.campaigns.surveyloop import Truth, inclusion_scores
+from palpate.maps import Patch, StiffnessMap, raster_points, summarise
+from palpate.maps.inclusions import find_inclusions
+from palpate.maps.probes import Z95, Probe
+
+PATCH = Patch.from_mm((-10.0, -10.0, 10.0, 10.0))
+E0 = 314e3
+STIFF_A, STIFF_B, SOFT = (4e-3, -4e-3), (-5e-3, 4e-3), (-4.5e-3, -5e-3)
+
+
+def _modulus(x: float, y: float) -> float:
+    def bump(c: tuple[float, float], rise: float) -> float:
+        return rise * math.exp(-((x - c[0]) ** 2 + (y - c[1]) ** 2) / (2 * 2.2e-3**2))
+
+    return E0 * (1.0 + bump(STIFF_A, 0.45) + bump(STIFF_B, 0.3)) * (1.0 - bump(SOFT, 0.3))
+
+
+def _probes(field, seed: int = 0) -> list[Probe]:
+    rng = np.random.default_rng(seed)
+    out = []
+    for x, y in raster_points(PATCH, 121):
+        e = field(x, y) * math.exp(rng.normal(0.0, 0.02))
+        out.append(Probe(x, y, e, (e * math.exp(-Z95 * 0.02), e * math.exp(Z95 * 0.02)), "ok"))
+    return out
+
+
+def _read(field):
+    m = StiffnessMap.fit(_probes(field))
+    summary = summarise(m, PATCH)
+    return summary, find_inclusions(m, PATCH, summary)
+
+
+def test_two_stiff_bumps_and_a_soft_dip_are_each_found_of_their_kind() -> None:
+    summary, found = _read(_modulus)
+    assert [f.kind for f in found].count("stiff") == 2
+    assert [f.kind for f in found].count("soft") == 1
+    assert found[0].centre == summary.centre  # the summary's inclusion comes first
+    for truth, kind in ((STIFF_A, "stiff"), (STIFF_B, "stiff"), (SOFT, "soft")):
+        near = min(
+            (f for f in found if f.kind == kind),
+            key=lambda f: math.hypot(f.centre[0] - truth[0], f.centre[1] - truth[1]),
+        )
+        assert math.hypot(near.centre[0] - truth[0], near.centre[1] - truth[1]) < 0.5e-3
+        (x0, x1), (y0, y1) = near.centre_ci
+        assert x0 <= truth[0] <= x1
+        assert y0 <= truth[1] <= y1
+    assert found[0].as_dict()["depth_mm"] is None  # not read from one modulus a probe
+
+
+def test_the_summary_reads_the_highest_of_two_bumps_not_between_them() -> None:
+    summary, _ = _read(_modulus)
+    assert summary.centre is not None
+    assert math.hypot(summary.centre[0] - STIFF_A[0], summary.centre[1] - STIFF_A[1]) < 0.5e-3
+
+
+def test_a_flat_patch_holds_no_inclusion() -> None:
+    _, found = _read(lambda x, y: E0)
+    assert found == []
+
+
+def test_scores_match_each_truth_to_its_own_kind_and_count_the_rest_as_false() -> None:
+    _, found = _read(_modulus)
+    truths = [Truth(STIFF_A, 2.5e-3, 3.5e-3, 5.0), Truth(SOFT, 3e-3, 4e-3, 0.3)]
+    scores = inclusion_scores(found, truths)
+    assert scores["inclusions_found"] == 2
+    assert scores["false_inclusions"] == 1  # the second bump, not in this truth
+    assert [r["kind"] for r in scores["per_inclusion"]] == ["stiff", "soft"]
+    missed = inclusion_scores([], truths)
+    assert missed["inclusions_found"] == 0
+    assert not missed["per_inclusion"][0]["found"]
+    assert Truth(SOFT, 3e-3, 4e-3, 0.3).kind == "soft"
+    assert pytest.approx(4.0) == Truth(STIFF_A, 2.5e-3, 3.5e-3, 5.0).one()["center_mm"][0]
