@@ -121,6 +121,7 @@ def survey_row(
         "budget": budget,
         "world": index,
         "plain": plain,
+        "whole": whole,
         "probes": len(result.probes),
         "lab_time_s": result.lab_time,
         "map_s_per_probe": result.map_seconds / max(len(result.probes), 1),
@@ -178,7 +179,7 @@ def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
         line["probes_median"] = _median([r["probes"] for r in rs])
         line["lab_time_s_median"] = _median([r["lab_time_s"] for r in rs])
         line["map_s_per_probe_max"] = max(r["map_s_per_probe"] for r in rs)
-        if any("inclusions_true" in r or "false_inclusions" in r for r in rs):
+        if any(r.get("whole") for r in rs):
             line.update(whole_lines(rs))
         elif plain:
             line["homogeneous"] = True

@@ -8,9 +8,9 @@ the process is unsure and near the level set), less a travel penalty in proporti
 distance from the last probe (RASEC: half the travel at equal F1). It stops when the boundary
 is known to ``tolerance``: the area still uncertain (0.05 < P(above) < 0.95) is at most
 ``tolerance`` times the boundary's length (with no region, a ``tolerance``-wide square).
-``active-all`` straddles a second level too, half-way from the background down to the map's
-lowest point and at least 10 % under the background, and stops when both boundaries are known:
-soft regions (cysts) as well as stiff ones (issue 57)::
+``active-all`` straddles two more levels, 10 % above the background (a weaker nodule beside a
+stronger one) and half-way from the background down to the map's lowest point, at least 10 %
+under it (a cyst), and stops when every boundary is known (issue 57)::
 
     plan = Active(patch, max_probes=30)
     while (point := plan.next(probes)) is not None:
@@ -123,21 +123,28 @@ class Active:
         except MapError:  # too few numbers yet: go on with what a raster would do
             return self._fallback(probes)
         mean, sd = m.predict(self.candidates)
-        levels = [log_threshold(m, mean, self.threshold)]
-        if self.soft:  # half-way down to the lowest point, at least 10 % under the background
-            low = m.background + 0.5 * (float(np.min(mean)) - m.background)
-            levels.append(min(low, m.background - math.log1p(MIN_RISE)))
-        signs = (1.0, -1.0)[: len(levels)]
-        if all(self._known(mean, sd, t, sign) for t, sign in zip(levels, signs, strict=True)):
+        levels = [(log_threshold(m, mean, self.threshold), 1.0)]
+        if self.soft:
+            levels += self._other_levels(m, mean)
+        if all(self._known(mean, sd, t, sign) for t, sign in levels):
             self.stopped = f"boundary known to {self.tolerance * 1e3:g} mm"
             return None
         last = np.array([probes[-1].x, probes[-1].y])
         travel = np.hypot(*(self.candidates - last).T) / self.patch.diagonal
-        straddle = np.max([Z * sd - np.abs(mean - t) for t in levels], axis=0)
+        straddle = np.max([Z * sd - np.abs(mean - t) for t, _ in levels], axis=0)
         score = straddle - self.travel_penalty * travel
         score[self._too_close(probes)] = -np.inf
         best = int(np.argmax(score))
         return float(self.candidates[best, 0]), float(self.candidates[best, 1])
+
+    @staticmethod
+    def _other_levels(m: StiffnessMap, mean: FloatArray) -> list[tuple[float, float]]:
+        """``active-all``'s levels beside the threshold: 10 % above the background (a weaker
+        nodule beside a stronger one reads between the two), and half-way down to the lowest
+        point, at least 10 % under the background (a cyst); each with its side."""
+        floor = m.background + math.log1p(MIN_RISE)
+        low = m.background + 0.5 * (float(np.min(mean)) - m.background)
+        return [(floor, 1.0), (min(low, m.background - math.log1p(MIN_RISE)), -1.0)]
 
     def _known(self, mean: FloatArray, sd: FloatArray, t: float, sign: float = 1.0) -> bool:
         p = above(sign * mean, sd, sign * t).reshape(GRID, GRID)

@@ -17,6 +17,7 @@ from palpate.sim.fem3d.patch import PatchWorld
 from palpate.sim.sample_law import fe_world
 
 SCENE = resolve("scenes/maps/several.yaml")
+pytestmark = pytest.mark.slow  # two factorisations of a small patch: 20-40 s
 
 
 @pytest.fixture(scope="module")

@@ -81,3 +81,29 @@ def test_scores_match_each_truth_to_its_own_kind_and_count_the_rest_as_false() -
     assert not missed["per_inclusion"][0]["found"]
     assert Truth(SOFT, 3e-3, 4e-3, 0.3).kind == "soft"
     assert pytest.approx(4.0) == Truth(STIFF_A, 2.5e-3, 3.5e-3, 5.0).one()["center_mm"][0]
+
+
+def test_active_all_finds_the_weaker_bump_and_the_dip_that_active_leaves() -> None:
+    from palpate.maps import plan_for
+
+    def surveyed(strategy: str) -> list:
+        rng = np.random.default_rng(3)
+        plan = plan_for(strategy, PATCH, 40, seed=3)
+        probes: list[Probe] = []
+        while (point := plan.next(probes)) is not None:
+            e = _modulus(*point) * math.exp(rng.normal(0.0, 0.02))
+            sd = 0.02
+            probes.append(Probe(*point, e, (e * math.exp(-Z95 * sd), e * math.exp(Z95 * sd)), "ok"))
+        m = StiffnessMap.fit(probes)
+        return find_inclusions(m, PATCH, summarise(m, PATCH))
+
+    every = surveyed("active-all")
+    truths = [
+        Truth(STIFF_A, 2.5e-3, 3.5e-3, 5.0),
+        Truth(STIFF_B, 2.5e-3, 3.5e-3, 5.0),
+        Truth(SOFT, 3e-3, 4e-3, 0.3),
+    ]
+    scores = inclusion_scores(every, truths)
+    assert scores["inclusions_found"] == 3
+    assert scores["false_inclusions"] == 0
+    assert inclusion_scores(surveyed("active"), truths)["inclusions_found"] < 3

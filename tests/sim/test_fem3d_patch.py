@@ -81,6 +81,7 @@ def test_on_the_axis_it_matches_an_axisymmetric_solve_holding_the_sphere() -> No
     assert np.all(np.abs(excess - 1.0) < 0.12), excess
 
 
+@pytest.mark.slow
 def test_a_sphere_far_away_changes_nothing_and_soft_reads_soft() -> None:
     near = Inclusion(0.0, 0.0, 1.0, 0.5, 5.0)
     far = Inclusion(0.0, 3.6, 1.0, 0.5, 5.0)  # 3.6 R off: beyond what the tip feels
@@ -92,6 +93,7 @@ def test_a_sphere_far_away_changes_nothing_and_soft_reads_soft() -> None:
     assert np.all(factor(_patch(soft, fine=0.25, half=0.5), (0.0, 0.0))[1:] < 0.97)
 
 
+@pytest.mark.slow
 def test_the_factor_falls_away_from_the_sphere_and_is_one_without() -> None:
     problem = _patch(BELOW, fine=0.25, half=1.2)
     over = factor(problem, (0.0, 0.0))

@@ -1,0 +1,107 @@
+"""A study on worlds drawn whole (issue 57), read again probe by probe: for each world, after
+how many probes the map first reads each true inclusion (of its kind, its centre within its
+radius, at least 2 mm), and after how many it read all of them; beside the study's own rates.
+
+    palpate map --scene config/scenes/maps/several.yaml --worlds 20 --whole \\
+        --plans active-all:40 --seed 1 --workers 2 --json > study.json
+    python bench/map_worlds.py study.json
+
+Only the map's arithmetic runs here (each prefix of a survey's probes mapped again), no trial.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+from typing import Any
+
+from palpate.campaigns.surveyloop import Truth, inclusion_scores
+from palpate.maps import Patch, Probe, StiffnessMap, summarise
+from palpate.maps.gp import MIN_PROBES, MapError
+from palpate.maps.inclusions import find_inclusions
+
+MM = 1e-3
+
+
+def truths(row: dict[str, Any]) -> list[Truth]:
+    return [
+        Truth(
+            (t["center_mm"][0] * MM, t["center_mm"][1] * MM),
+            t["radius_mm"] * MM,
+            t["depth_mm"] * MM,
+            t["contrast"],
+        )
+        for t in row["truth"] or []
+    ]
+
+
+def firsts(row: dict[str, Any], patch: Patch) -> tuple[list[int | None], int | None]:
+    """Per true inclusion, the first probe count whose map reads it; the count that reads all."""
+    probes = [Probe.from_record(p) for p in row["probe_list"]]
+    known = truths(row)
+    first: list[int | None] = [None] * len(known)
+    for k in range(MIN_PROBES, len(probes) + 1):
+        try:
+            m = StiffnessMap.fit(probes[:k], seed=0)
+        except MapError:
+            continue
+        found = find_inclusions(m, patch, summarise(m, patch))
+        rows = inclusion_scores(found, known)["per_inclusion"]
+        for i, r in enumerate(rows):
+            if r["found"] and first[i] is None:
+                first[i] = k
+    every = None if None in first or not first else max(f for f in first if f is not None)
+    return first, every
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("study", help="the JSON `palpate map --worlds N --whole --json` printed")
+    parser.add_argument("--patch-mm", type=float, nargs=4, default=(-10, -10, 10, 10))
+    args = parser.parse_args(argv)
+    with open(args.study, encoding="utf-8") as fh:
+        study = json.load(fh)
+    patch = Patch.from_mm(tuple(args.patch_mm))
+    single, every, used = [], [], []
+    for row in study["rows"]:
+        first, all_of = firsts(row, patch)
+        n = len(row["truth"] or [])
+        print(
+            json.dumps(
+                {
+                    "world": row["world"],
+                    "true": n,
+                    "found": row.get("inclusions_found"),
+                    "false": row.get("false_inclusions"),
+                    "first_probe": first,
+                    "all_by": all_of,
+                    "probes": row["probes"],
+                }
+            )
+        )
+        used.append(row["probes"])
+        if n == 1 and first[0] is not None:
+            single.append(first[0])
+        if n and all_of is not None:
+            every.append(all_of)
+    print(json.dumps({"summary": study["summary"]}))
+    print(
+        json.dumps(
+            {
+                "median_probes_to_find_a_single_inclusion": statistics.median(single)
+                if single
+                else None,
+                "median_probes_to_find_every_inclusion": statistics.median(every)
+                if every
+                else None,
+                "median_probes_used": statistics.median(used),
+            }
+        )
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
