@@ -115,10 +115,9 @@ class Truth:
         }
 
     def as_dict(self) -> dict[str, Any]:
+        first = self.one()
         return {
-            "inclusion_center_mm": [self.centre[0] / MM, self.centre[1] / MM],
-            "inclusion_radius_mm": self.radius / MM,
-            "inclusion_depth_mm": self.depth / MM,
+            **{f"inclusion_{k}": first[k] for k in ("center_mm", "radius_mm", "depth_mm")},
             "contrast": self.contrast,
             "inclusions": [t.one() for t in (self, *self.others)],
         }

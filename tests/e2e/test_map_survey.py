@@ -108,6 +108,8 @@ def test_palpate_map_refuses_a_scene_that_is_not_a_map(
     assert main(["map", "--sample", "nobody", "--out", str(tmp_path)]) == 2
     assert main(["map", "--worlds", "1", "--plans", "spiral:3", "--out", str(tmp_path)]) == 2
     assert "--plans" in capsys.readouterr().err
+    assert main(["map", "--worlds", "1", "--whole", "--out", str(tmp_path)]) == 2
+    assert "inclusion_offsets: patch" in capsys.readouterr().err
 
 
 def test_a_map_scene_with_a_bad_key_is_refused(tmp_path: Path) -> None:
