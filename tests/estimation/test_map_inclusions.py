@@ -107,3 +107,19 @@ def test_active_all_finds_the_weaker_bump_and_the_dip_that_active_leaves() -> No
     assert scores["inclusions_found"] == 3
     assert scores["false_inclusions"] == 0
     assert inclusion_scores(surveyed("active"), truths)["inclusions_found"] < 3
+
+
+def test_two_nodules_whose_blurred_footprints_touch_are_two() -> None:
+    a, b = (-4e-3, 0.0), (4e-3, 0.0)  # 8 mm apart: one region at the 10 % level
+
+    def two(x: float, y: float) -> float:
+        def bump(c: tuple[float, float]) -> float:
+            return 0.4 * math.exp(-((x - c[0]) ** 2 + (y - c[1]) ** 2) / (2 * 2.2e-3**2))
+
+        return E0 * (1.0 + bump(a) + bump(b))
+
+    _, found = _read(two)
+    truths = [Truth(a, 2.5e-3, 3.5e-3, 5.0), Truth(b, 2.5e-3, 3.5e-3, 5.0)]
+    scores = inclusion_scores(found, truths)
+    assert scores["inclusions_found"] == 2
+    assert scores["false_inclusions"] == 0
