@@ -6,7 +6,9 @@ number as a grey cross, a ``suspect`` one in orange); the map's uncertainty (sd 
 and the probability of being above the threshold with its one-half contour (the apparent
 region), the inclusion's extent (the disc fitted through the tip's contact, solid black on every
 panel: the boundary the map reports), the estimated centre with its 95 % box, and in simulation
-the inclusion's footprint (dashed) and centre (+). A survey that found nothing says so in the title.
+every true inclusion's footprint (dashed) and centre (+). The map's other inclusions (a map of
+several, ``maps.inclusions``): each disc on every panel, black if stiff, cyan if soft, its
+centre and its 95 % box on the right. A survey that found nothing says so in the title.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from palpate.campaigns.survey import SurveyResult
 
 MM = 1e-3
 COLOURS = {"ok": "k", "suspect": "tab:orange", "none": "0.6"}
+SOFT = "tab:cyan"  # a soft inclusion's marks
 
 
 def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
@@ -59,8 +62,11 @@ def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
             Rectangle((x0 / MM, y0 / MM), (x1 - x0) / MM, (y1 - y0) / MM, fill=False, color="k")
         )
         axes[2].plot(s.centre[0] / MM, s.centre[1] / MM, "kx", ms=9, label="estimated centre")
+    _others(axes, s.inclusions[1:])
     _legend(fig, result)
     verdict = "inclusion found" if s.found else "no inclusion found"
+    if len(s.inclusions) > 1:
+        verdict = f"{len(s.inclusions)} inclusions found"
     fig.suptitle(
         f"{title}: {verdict}; {len(result.probes)} probes, {result.lab_time:.0f} s of lab time "
         f"({result.stopped})"
@@ -84,6 +90,8 @@ def _legend(fig: Any, result: SurveyResult) -> None:
     if s is not None and s.centre is not None:
         handles.append(Line2D([], [], ls="", marker="x", ms=8, color="k",
                               label="estimated centre; its 95 % box (right)"))  # fmt: skip
+    if s is not None and any(i.kind == "soft" for i in s.inclusions):
+        handles.append(Line2D([], [], color=SOFT, lw=1.5, label="a soft inclusion (reported)"))
     if result.truth is not None:
         handles.append(Line2D([], [], color="w", ls="--", lw=1.2, marker="+", ms=8,
                               label="the true inclusion and centre (simulation)"))  # fmt: skip
@@ -111,20 +119,27 @@ def _probes(ax: Any, result: SurveyResult) -> None:
 
 
 def _truth(ax: Any, result: SurveyResult) -> None:
-    t = result.truth
-    if t is None:
+    if result.truth is None:
         return
-    ax.add_patch(
-        Circle(
-            (t.centre[0] / MM, t.centre[1] / MM),
-            t.radius / MM,
-            fill=False,
-            ls="--",
-            color="w",
-            lw=1.2,
-        )
-    )
-    ax.plot(t.centre[0] / MM, t.centre[1] / MM, "w+", ms=9)
+    for t in (result.truth, *result.truth.others):
+        centre = (t.centre[0] / MM, t.centre[1] / MM)
+        ax.add_patch(Circle(centre, t.radius / MM, fill=False, ls="--", color="w", lw=1.2))
+        ax.plot(*centre, "w+", ms=9)
+
+
+def _others(axes: Any, others: Any) -> None:
+    """The map's inclusions beyond its first: each disc on every panel (black stiff, cyan
+    soft), its centre and its 95 % box on the right."""
+    for inc in others:
+        colour = "k" if inc.kind == "stiff" else SOFT
+        centre = (inc.centre[0] / MM, inc.centre[1] / MM)
+        for ax in axes:
+            ax.add_patch(Circle(centre, inc.radius / MM, fill=False, color=colour, lw=1.5))
+        (x0, x1), (y0, y1) = inc.centre_ci
+        box = Rectangle((x0 / MM, y0 / MM), (x1 - x0) / MM, (y1 - y0) / MM, fill=False)
+        box.set_edgecolor(colour)
+        axes[2].add_patch(box)
+        axes[2].plot(*centre, "x", color=colour, ms=9)
 
 
 def _save(fig: Any, path: Path) -> Path:
