@@ -4,8 +4,9 @@ Why scikit-learn's ``GaussianProcessRegressor``: it takes a per-point noise vari
 (``alpha``), which is what a probe's interval is (heteroscedastic), fits the kernel's amplitude
 and length scale by maximum marginal likelihood with restarts, and returns the posterior mean,
 sd and covariance; a hand-written GP would repeat it. The process is on log E (moduli are
-positive and their intervals scale with them), its mean the probes' median (the background
-tissue: an inclusion fills a small part of a patch), coordinates in mm (the length scale's
+positive and their intervals scale with them), its mean the probes' median over the area
+they cover (:func:`area_median`; the background tissue: an inclusion fills a small part of a
+patch), coordinates in mm (the length scale's
 bound: about a tip radius, the narrowest bump a tip sees). Usage::
 
     m = StiffnessMap.fit(probes, patch)
