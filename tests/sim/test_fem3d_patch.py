@@ -24,7 +24,7 @@ from palpate.sim.fem3d.patch import (
     solve_compliance,
     touchable,
 )
-from palpate.sim.fem3d.solver import ContactError, _fixed_dofs
+from palpate.sim.fem3d.solver import ContactError, fixed_dofs
 from palpate.sim.fem3d.stiffness import assemble, element_moduli
 
 SMALL = InclusionProblem(
@@ -52,7 +52,7 @@ def test_the_condensed_compliance_is_the_direct_solve() -> None:
     mu, bulk = element_moduli(grid, SMALL.poisson, problem.solid.inclusions)
     K = assemble(grid, mu, bulk)
     free = np.ones(3 * grid.n_nodes, dtype=bool)
-    free[_fixed_dofs(grid, "bonded", "full")] = False
+    free[fixed_dofs(grid, "bonded", "full")] = False
     lu = splinalg.splu(K[free][:, free].tocsc())
     surface = touchable(problem, grid)
     column = {int(d): k for k, d in enumerate(np.flatnonzero(free))}

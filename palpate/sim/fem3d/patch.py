@@ -30,21 +30,25 @@ import functools
 import hashlib
 import sys
 import time
-import warnings
 from dataclasses import asdict, dataclass, replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy import linalg  # type: ignore[import-untyped,unused-ignore]
-from scipy.sparse import linalg as splinalg  # type: ignore[import-untyped,unused-ignore]
 
 from ...store.cache import cache_dir, cached_arrays, parameter_record
 from ..fem.problem import LayerProblem, significant
 from ..fem.table import ForceTable, load_table, table_key
-from .grid import Feature, HexGrid, graded_axis, nested_dissection
+from .grid import Feature, HexGrid, graded_axis
 from .problem import InclusionProblem
-from .solver import COARSE, GROWTH, ContactError, _fixed_dofs, contact
+from .solver import (
+    COARSE,
+    GROWTH,
+    ContactError,
+    contact,
+    elimination_order,
+    factor_in_order,
+)
 from .stiffness import assemble, element_moduli
 from .world import scaled_table
 
@@ -183,21 +187,8 @@ def solve_compliance(problem: PatchProblem) -> PatchCompliance:
     K = assemble(grid, mu, bulk)
     surface = touchable(problem, grid)
     last = 3 * surface + 2
-    is_free = np.ones(3 * grid.n_nodes, dtype=bool)
-    is_free[_fixed_dofs(grid, problem.solid.base, "full")] = False
-    order = (3 * nested_dissection(grid.shape)[:, None] + np.arange(3)).ravel()
-    keep = is_free[order]
-    keep[np.isin(order, last)] = False
-    free = np.concatenate([order[keep], last])
-    K = K[free][:, free].tocsc()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        try:
-            lu = splinalg.splu(
-                K, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
-            )
-        except (RuntimeError, RuntimeWarning) as exc:
-            raise ContactError(f"factorisation of the patch failed: {exc}") from exc
+    free = elimination_order(grid, problem.solid.base, "full", last)
+    lu = factor_in_order(K[free][:, free].tocsc(), "the patch")
     n, m = free.size, last.size
     if not (np.array_equal(lu.perm_r, np.arange(n)) and np.array_equal(lu.perm_c, np.arange(n))):
         raise ContactError("the patch's factorisation reordered its unknowns")
@@ -297,9 +288,3 @@ class PatchWorld:
         layer = load_table(self.layer)
         n = layer.depths.size
         return scaled_table(layer, factor(self.problem, self.at)[:n], self.key)
-
-
-def describe(problem: PatchProblem) -> dict[str, Any]:
-    """What the patch's mesh is (for a report)."""
-    grid = problem.grid()
-    return {"nodes": grid.n_nodes, "touchable": int(touchable(problem, grid).size)}

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,22 +120,8 @@ def factorise(problem: InclusionProblem, homogeneous: bool = False) -> Complianc
     K = assemble(grid, mu, bulk)
     nx, ny, nz = grid.shape
     n = grid.n_nodes
-    is_free = np.ones(3 * n, dtype=bool)
-    is_free[_fixed_dofs(grid, problem.base, symmetry)] = False
-    order = (3 * nested_dissection(grid.shape)[:, None] + np.arange(3)).ravel()
-    free = order[is_free[order]]  # the free dofs in elimination order
-    K = K[free][:, free].tocsc()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        try:
-            lu = splinalg.splu(
-                K,
-                permc_spec="NATURAL",
-                diag_pivot_thresh=0.0,
-                options={"SymmetricMode": True},
-            )
-        except (RuntimeError, RuntimeWarning) as exc:
-            raise ContactError(f"factorisation of the 3-D layer failed: {exc}") from exc
+    free = elimination_order(grid, problem.base, symmetry)
+    lu = factor_in_order(K[free][:, free].tocsc(), "the 3-D layer")
     i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     r = np.hypot(grid.x[i], grid.y[j]).ravel()
     inside = r < 1.0
@@ -153,7 +140,41 @@ def factorise(problem: InclusionProblem, homogeneous: bool = False) -> Complianc
     )
 
 
-def _fixed_dofs(grid: HexGrid, base: str, symmetry: str) -> IntArray:
+def elimination_order(
+    grid: HexGrid, base: str, symmetry: str, last: IntArray | None = None
+) -> IntArray:
+    """The free dofs in elimination order (geometric nested dissection of the nodes, a node's
+    three dofs together), the dofs ``last`` moved to the end in their own order."""
+    is_free = np.ones(3 * grid.n_nodes, dtype=bool)
+    is_free[fixed_dofs(grid, base, symmetry)] = False
+    order = (3 * nested_dissection(grid.shape)[:, None] + np.arange(3)).ravel()
+    if last is None:
+        return np.asarray(order[is_free[order]])
+    keep = is_free[order] & ~np.isin(order, last)
+    return np.concatenate([order[keep], last])
+
+
+def factor_in_order(K: Any, what: str) -> splinalg.SuperLU:
+    """``K`` (CSC, symmetric positive definite, its unknowns in :func:`elimination_order`)
+    factorised as ordered: no column reordering, no pivoting.
+
+    Raises:
+        ContactError: the factorisation failed (``what`` names the matrix).
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        try:
+            return splinalg.splu(
+                K,
+                permc_spec="NATURAL",
+                diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True},
+            )
+        except (RuntimeError, RuntimeWarning) as exc:
+            raise ContactError(f"factorisation of {what} failed: {exc}") from exc
+
+
+def fixed_dofs(grid: HexGrid, base: str, symmetry: str) -> IntArray:
     """The fixed dofs: the base's (all of them when bonded; the vertical ones when sliding,
     with pins that hold the rigid in-plane motions no mirror plane holds: no reaction, the
     loads are vertical) and the normal ones on the mirror planes."""
