@@ -26,10 +26,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage  # type: ignore[import-untyped,unused-ignore]
-from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
 
 from .gp import MM, Patch, StiffnessMap
-from .region import DRAW_GRID, DRAWS, FOUND_PROBABILITY, GRID, MIN_RISE, MapSummary, drawn
+from .region import (
+    DRAW_GRID,
+    DRAWS,
+    FOUND_PROBABILITY,
+    GRID,
+    MIN_RISE,
+    MapSummary,
+    above,
+    drawn,
+)
 
 FloatArray = NDArray[np.float64]
 Interval = tuple[float, float]
@@ -86,7 +94,7 @@ def find_inclusions(
     found: list[Inclusion] = []
     for kind, sign in (("stiff", 1.0), ("soft", -1.0)):
         level = m.background + sign * math.log1p(min_rise)
-        p = ndtr(sign * (mean - level) / np.maximum(sd, 1e-12))
+        p = above(sign * mean, sd, sign * level)
         labels, n = ndimage.label((p > 0.5).reshape(GRID, GRID))
         for k in range(1, n + 1):
             for mask in split(labels.ravel() == k, sign * (mean - m.background)):
