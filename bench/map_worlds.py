@@ -6,7 +6,8 @@ radius, at least 2 mm), and after how many it read all of them; beside the study
         --plans active-all:40 --seed 1 --workers 2 --json > study.json
     python bench/map_worlds.py study.json
 
-Only the map's arithmetic runs here (each prefix of a survey's probes mapped again), no trial.
+Only the map's arithmetic runs here (each prefix of a survey's probes mapped again as the
+survey maps them, ``campaigns.surveyloop.map_of``), no trial.
 """
 
 from __future__ import annotations
@@ -17,10 +18,9 @@ import statistics
 import sys
 from typing import Any
 
-from palpate.campaigns.surveyloop import Truth, inclusion_scores
-from palpate.maps import Patch, Probe, StiffnessMap, summarise
-from palpate.maps.gp import MIN_PROBES, MapError
-from palpate.maps.inclusions import find_inclusions
+from palpate.campaigns.surveyloop import LENGTH_SCALE_TIPS, Truth, inclusion_scores, map_of
+from palpate.maps import Patch, Probe
+from palpate.maps.gp import MIN_PROBES
 
 MM = 1e-3
 
@@ -37,18 +37,19 @@ def truths(row: dict[str, Any]) -> list[Truth]:
     ]
 
 
-def firsts(row: dict[str, Any], patch: Patch) -> tuple[list[int | None], int | None]:
-    """Per true inclusion, the first probe count whose map reads it; the count that reads all."""
+def firsts(
+    row: dict[str, Any], patch: Patch, seed: int, scale: float
+) -> tuple[list[int | None], int | None]:
+    """Per true inclusion, the first probe count whose map (the survey's own: ``map_of`` with
+    its seed and length scale) reads it; the count that reads all."""
     probes = [Probe.from_record(p) for p in row["probe_list"]]
     known = truths(row)
     first: list[int | None] = [None] * len(known)
     for k in range(MIN_PROBES, len(probes) + 1):
-        try:
-            m = StiffnessMap.fit(probes[:k], seed=0)
-        except MapError:
+        summary, _ = map_of(probes[:k], patch, None, seed, scale)
+        if summary is None:
             continue
-        found = find_inclusions(m, patch, summarise(m, patch))
-        rows = inclusion_scores(found, known)["per_inclusion"]
+        rows = inclusion_scores(summary.inclusions, known)["per_inclusion"]
         for i, r in enumerate(rows):
             if r["found"] and first[i] is None:
                 first[i] = k
@@ -60,13 +61,15 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("study", help="the JSON `palpate map --worlds N --whole --json` printed")
     parser.add_argument("--patch-mm", type=float, nargs=4, default=(-10, -10, 10, 10))
+    parser.add_argument("--tip-mm", type=float, default=3.5, help="the sensor's tip radius")
     args = parser.parse_args(argv)
     with open(args.study, encoding="utf-8") as fh:
         study = json.load(fh)
     patch = Patch.from_mm(tuple(args.patch_mm))
     single, every, used = [], [], []
     for row in study["rows"]:
-        first, all_of = firsts(row, patch)
+        seed = study["seed"] * 1000 + row["world"]  # the survey's (campaigns.mapstudy)
+        first, all_of = firsts(row, patch, seed, LENGTH_SCALE_TIPS * args.tip_mm * MM)
         n = len(row["truth"] or [])
         print(
             json.dumps(
