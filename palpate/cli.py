@@ -84,6 +84,10 @@ COMMANDS: dict[str, Command] = {
         "palpate.commands.teleop",
         "Jog roll, advance and tube from the keyboard; live pose, strains and flags; store poses.",
     ),
+    "ros": Command(
+        "palpate.commands.ros",
+        "Serve the stack as a ROS 2 node: trials and surveys on request, their topics as they run.",
+    ),
 }
 
 

@@ -34,7 +34,7 @@ import math
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -62,6 +62,35 @@ BEAM_POINTS = 24
 TOPICS = ("/joint_states", "/fbg/strains", "/tip/force", "/tf", "/scene")
 Publisher = Callable[[Observation, State], None]
 FloatArray = NDArray[np.float64]
+
+
+class View(Protocol):
+    """What a trial publishes its ticks to: the live view here, or the ROS 2 node's topics
+    (``palpate.ros``)."""
+
+    def trial(self, stage: Stage) -> Publisher:
+        """The publisher of one trial on ``stage``."""
+        ...
+
+    def cloud(
+        self, topic: str, stamp: int, names: Sequence[str], columns: Sequence[FloatArray]
+    ) -> None:
+        """A map's point cloud (columns x, y first, m) at ``stamp`` (ns)."""
+        ...
+
+
+def beam_reading(
+    sensor: SensorConfig, section: Section, strains: Sequence[float], length: float
+) -> tuple[float, float]:
+    """(axial load N, end shortening m) of one tick's strains at exposed ``length`` (the
+    estimator's beam state, ``estimation.beam.states``), NaN when they do not fit."""
+    if length <= 0 or len(strains) != len(sensor.used_gratings):
+        return math.nan, math.nan
+    intervals = grating_intervals(sensor, length)
+    s = infer_states(
+        np.asarray([strains]), intervals, length, section.EA, section.fiber_offset, 1e-6
+    )
+    return float(s.P[0]), float(s.e[0])
 
 
 def add_live_argument(parser: argparse.ArgumentParser, what: str) -> None:
@@ -234,7 +263,7 @@ class _Feed:
         if not wanted or not all(math.isfinite(x) for x in (obs.advance, obs.roll)):
             return
         length = self._length(obs.advance)
-        load, shortening = self._beam(obs.strains, length)
+        load, shortening = beam_reading(v.sensor, v.section, obs.strains, length)
         if obs.tip_force is not None:  # a tip force grating reads the load itself
             load = obs.tip_force
         if v.force.has_sinks():
@@ -245,17 +274,6 @@ class _Feed:
 
     def _length(self, advance: float) -> float:
         return self.stage.exposed_length(advance)
-
-    def _beam(self, strains: tuple[float, ...], length: float) -> tuple[float, float]:
-        """(axial load N, end shortening m) of the tick's strains, NaN when they do not fit."""
-        v = self.view
-        if length <= 0 or len(strains) != len(v.sensor.used_gratings):
-            return math.nan, math.nan
-        intervals = grating_intervals(v.sensor, length)
-        s = infer_states(
-            np.asarray([strains]), intervals, length, v.section.EA, v.section.fiber_offset, 1e-6
-        )
-        return float(s.P[0]), float(s.e[0])
 
     def _geometry(self, obs: Observation, length: float, shortening: float, stamp: int) -> None:
         from foxglove.messages import FrameTransforms, SceneEntity, SceneUpdate, Timestamp

@@ -275,8 +275,11 @@ PALPATE_ROOMS: dict[str, frozenset[str]] = {
     "palpate.faults": _BELOW_REPORTS | {"palpate.reports"},
     # the work both front ends call (the command line, the Python API)
     "palpate.services": _BELOW_REPORTS | {"palpate.reports", "palpate.faults", "palpate.lab"},
-    "palpate.commands": _BELOW_REPORTS
+    # the ROS 2 node: a front end beside the commands (its command, palpate ros, starts it)
+    "palpate.ros": _BELOW_REPORTS
     | {"palpate.reports", "palpate.faults", "palpate.lab", "palpate.services"},
+    "palpate.commands": _BELOW_REPORTS
+    | {"palpate.reports", "palpate.faults", "palpate.lab", "palpate.services", "palpate.ros"},
     # the Python API (palpate/api.py): the other front end, beside the commands (never above
     # them: both call the rooms below, the services first)
     "palpate.api": _BELOW_REPORTS

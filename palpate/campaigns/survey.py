@@ -45,7 +45,7 @@ from palpate.simulation.trial import TrialOutcome, run_sim_trial
 from palpate.simulation.world import BENCH_COLUMN, TrialSpec
 
 if TYPE_CHECKING:
-    from palpate.live import LiveView
+    from palpate.live import View
 
 __all__ = [
     "PROBES_FILE",
@@ -124,7 +124,7 @@ def run_survey(
     max_probes: int | None = None,
     run_dir: Path | None = None,
     on_probe: Callable[[Probe], None] | None = None,
-    live: LiveView | None = None,
+    live: View | None = None,
 ) -> SurveyResult:
     """Run the scene's map campaign (``strategy`` and ``max_probes`` override its keys); with
     ``run_dir``, trial logs under ``logs/`` and the probes in ``probes.jsonl``, read back first
@@ -157,7 +157,7 @@ def _probe_at(
     point: tuple[float, float],
     seed: int,
     logs: Path | None,
-    live: LiveView | None,
+    live: View | None,
 ) -> tuple[Probe, TrialOutcome]:
     """The next probe's trial at ``point``, the stage's travel to it from the last probe."""
     sample = scene.campaign_samples()[0]

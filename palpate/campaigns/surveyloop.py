@@ -37,7 +37,7 @@ from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_fra
 from palpate.robot.records.ros2 import nanoseconds
 
 if TYPE_CHECKING:
-    from palpate.live import LiveView
+    from palpate.live import View
 
 MM = 1e-3
 PROBES_FILE = "probes.jsonl"
@@ -222,7 +222,7 @@ def run_plan(
     *,
     run_dir: Path | None = None,
     on_probe: Callable[[Probe], None] | None = None,
-    live: LiveView | None = None,
+    live: View | None = None,
     truth: Truth | None = None,
 ) -> SurveyResult:
     """Probe until the plan stops; with ``run_dir`` the probes in ``probes.jsonl``, read back
@@ -288,7 +288,7 @@ def map_of(
 
 
 def publish_map(
-    live: LiveView, probes: list[Probe], patch: Patch, threshold: float | None, scale: float
+    live: View, probes: list[Probe], patch: Patch, threshold: float | None, scale: float
 ) -> None:
     """The probes so far and their map on the live view, stamped with the lab time."""
     stamp = nanoseconds(sum(p.lab_time for p in probes))

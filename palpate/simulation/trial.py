@@ -23,7 +23,7 @@ from palpate.config.sample import AssumedConfig
 from palpate.config.scene import CampaignConfig, FidelityConfig, SceneConfig
 from palpate.config.schema import ServoBusConfig, StackConfig
 from palpate.estimation.beam.stage import Stage
-from palpate.live import LiveView
+from palpate.live import View
 from palpate.robot.drive import DriveController
 from palpate.robot.dynamixel.driver import DynamixelBus
 from palpate.robot.indentation import Observation, Prober, State, TrialPlan
@@ -167,9 +167,11 @@ def run_sim_trial(
     log_dir: Path | None = None,
     keep_series: bool = False,
     hook: EmulatorHook | None = None,
-    live: LiveView | None = None,
+    live: View | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> TrialOutcome:
-    """Run one simulated trial end to end and estimate the modulus; ``live``: its live view."""
+    """Run one simulated trial end to end and estimate the modulus; ``live``: its live view (or
+    the ROS 2 node's topics); ``stop``: asked every tick whether to stop and retract."""
     c = trial_campaign(spec, scene)
     geo = trial_geometry(stack, spec, trial_sample(scene, spec))
     retract = geo.contact_translation - c.standoff - 1e-3
@@ -210,6 +212,7 @@ def run_sim_trial(
                 on_log=None if hook is None else hook.log_opened,
                 # the world's truth the controller never sees, for the report (and --resume)
                 before_estimate=lambda _: [_world_record(world)],
+                stop=stop,
             )
             done = run_session_trial(rig, clock, setup)
     outcome = outcome_of(spec, geo, done.result, done.estimate, done.log_path, series)
@@ -283,7 +286,7 @@ def _rig_settings(
 def _on_tick(
     world: World,
     series: dict[str, list[float]] | None,
-    live: LiveView | None,
+    live: View | None,
     stage: Stage,
 ) -> Callable[[Observation, State], None] | None:
     """The trial's ``on_tick``: the series recorder (with ``series``), the live view's feed."""

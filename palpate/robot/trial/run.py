@@ -100,9 +100,12 @@ def run_trial(
     max_ticks: int = 200_000,
     on_tick: Callable[[Observation, State], None] | None = None,
     prober: Callable[[TrialPlan], Prober] | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> TrialResult:
     """Run one trial to DONE, UNREACHABLE, FAULT or ABORTED; the rig is left retracted or
-    torque-free. ``prober`` builds the probing step (``robot.probing``) when the trial probes.
+    torque-free. ``prober`` builds the probing step (``robot.probing``) when the trial probes;
+    ``stop`` is asked before every tick whether an operator stop came (a remote client's: the
+    trial retracts from that tick on and ends ABORTED).
 
     One tick every ``rig.tick`` seconds of ``clock``; after ``max_ticks`` the trial is aborted
     (and retracts). Every transition and every tick is written to ``log`` as it happens, and
@@ -126,6 +129,8 @@ def run_trial(
         while not machine.finished:
             if _out_of_ticks(machine, clock.now(), ticks, max_ticks):
                 break
+            if stop is not None and machine.ending is not State.ABORTED and stop():
+                machine.abort(clock.now(), "stop requested")
             obs, cmd, recovered = _tick(rig, machine, clock.now(), recovered)
             # a row whose strains are stale has no advance: no estimate reads it (as a missed read)
             advance = math.nan if machine.stream_held else obs.measured_advance

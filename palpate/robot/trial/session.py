@@ -58,6 +58,7 @@ class TrialSetup:
         on_log: called with the log once it is open (fault injection watches it).
         before_estimate: records written to the log before the estimate (the simulated
             world's truth, which the controller never sees).
+        stop: asked every tick whether an operator stop came (``robot.trial.run.run_trial``).
     """
 
     plan: TrialPlan
@@ -71,6 +72,7 @@ class TrialSetup:
     on_tick: Callable[[Observation, State], None] | None = None
     on_log: Callable[[TrialLogWriter], None] | None = None
     before_estimate: Callable[[TrialResult], list[dict[str, Any]]] | None = None
+    stop: Callable[[], bool] | None = None
 
 
 @dataclass(frozen=True)
@@ -97,6 +99,7 @@ def run_session_trial(rig: ZeroingRig, clock: Clock, setup: TrialSetup) -> Sessi
             log,
             on_tick=setup.on_tick,
             prober=setup.prober,
+            stop=setup.stop,
         )
         estimate = setup.estimate(result)
         if log is not None:

@@ -1,0 +1,98 @@
+"""Serve the stack as a ROS 2 node: trials and surveys on request, their topics as they run.
+
+``palpate ros`` starts the node ``/palpate/palpate`` on a simulated scene (``--scene``, no
+hardware) and serves until Ctrl-C or SIGTERM; a running trial then stops, retracts and closes
+its log and recording. Topics, services and parameters: docs/ros2.md (``palpate.ros.names``).
+Every trial is the one ``palpate sim --scene SCENE --seed SEED`` runs, so a trial started over
+ROS 2 gives the same row. DDS stays on this machine unless ``--network``.
+
+    palpate ros --scene scenes/robot.yaml &
+    python3 -c "..."   # a client: call /palpate/run_trial (std_srvs/srv/Trigger)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import re
+from datetime import datetime
+from pathlib import Path
+
+from palpate.argtypes import non_negative_int, positive_float
+from palpate.config import resolve
+from palpate.config.loader import InputError
+from palpate.lab.hardware import Terminated, terminate_as_interrupt
+
+log = logging.getLogger(__name__)
+
+NAMESPACE = re.compile(r"[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*")
+
+
+def register(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--scene", default="scenes/robot.yaml", help="the simulated scene whose trials it runs"
+    )
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="the campaign's seed (as palpate sim)"
+    )
+    parser.add_argument(
+        "--rate",
+        type=positive_float,
+        default=50.0,
+        help="messages per second of the trial's clock on the streams (measured_js, ...)",
+    )
+    parser.add_argument("--namespace", default="palpate", help="the node's namespace")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="trial logs and recordings under OUT/logs (default: out/ros/<date-time>)",
+    )
+    parser.add_argument(
+        "--network",
+        action="store_true",
+        help="discoverable beyond this machine (default: DDS on the loopback only)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    if not NAMESPACE.fullmatch(args.namespace):
+        raise InputError(f"--namespace: {args.namespace!r} is not a ROS 2 namespace")
+    try:  # the node's own dependency (the [ros] extra), loaded only here
+        from palpate.ros.node import PalpateNode
+        from palpate.ros.runner import SimRunner
+    except ImportError as exc:
+        raise InputError(
+            f"palpate ros needs ROS 2's Python client ({exc}): python3 -m pip install -e "
+            "'.[ros]' (the ROS 2 wheels: Python 3.11 on Linux), or source a ROS 2 install"
+        ) from None
+    out = args.out or Path("out/ros") / datetime.now().strftime("%Y%m%d-%H%M%S")
+    runner = SimRunner(resolve(args.scene), seed=args.seed, out=out)
+    node = PalpateNode(runner, namespace=args.namespace, rate=args.rate, network=args.network)
+    try:
+        _announce(node.name, runner.label, out, args)
+        with terminate_as_interrupt():
+            node.spin()
+    except (KeyboardInterrupt, Terminated) as exc:
+        log.warning("palpate ros: stopped (%s)", type(exc).__name__)
+    finally:
+        node.close()
+    return 0
+
+
+def _announce(name: str, label: str, out: Path, args: argparse.Namespace) -> None:
+    from palpate.ros.names import SERVICES, TOPICS
+
+    namespace = "/" + args.namespace.strip("/")
+    topics = [t if t.startswith("/") else f"{namespace}/{t}" for t in TOPICS]
+    services = [f"{namespace}/{s}" for s in SERVICES]
+    if args.json:
+        facts = {"node": name, "topics": topics, "services": services, "out": str(out)}
+        print(json.dumps(facts), flush=True)
+        return
+    print(f"ROS 2 node {name} ({label}); logs under {out}")
+    print("services: " + ", ".join(services))
+    print("topics: " + ", ".join(topics), flush=True)
+    where = "this machine and beyond" if args.network else "this machine only (--network opens it)"
+    log.info("DDS: %s; Ctrl-C to stop", where)

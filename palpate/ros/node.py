@@ -1,0 +1,183 @@
+"""The ROS 2 node: the topics of :mod:`palpate.ros.view`, the services of :mod:`palpate.ros.names`,
+on rclpy with a context of its own (a program may hold other nodes).
+
+On this machine only unless asked: before its context starts, the node sets
+``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` (ROS 2 Iron and later), so DDS discovery and
+traffic stay on the loopback; ``network=True`` (``palpate ros --network``) leaves the range to
+the environment, for a lab that opens the robot to its network on purpose::
+
+    node = PalpateNode(SimRunner(Path("config/scenes/robot.yaml")), rate=50.0)
+    node.spin()          # until Ctrl-C or SIGTERM: a running trial stops, retracts, logs its end
+    node.close()
+
+A service that runs a trial answers when the trial has ended; ``stop`` answers at once, and
+the running trial retracts from its next control tick. Only one trial or survey runs at a time
+(a second request while one runs is refused, not queued).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import threading
+from typing import Any, Protocol
+
+import rclpy
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from std_srvs.srv import Trigger
+
+from palpate.config import InputError
+from palpate.config.schema import StackConfig
+from palpate.live import View
+from palpate.simulation.trial import TrialOutcome, TrialSpec
+
+from .view import RosView
+
+log = logging.getLogger(__name__)
+
+LOCALHOST = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+SHUTDOWN_WAIT_S = 120.0  # wall time a running trial has to retract and close its log
+
+
+class Runner(Protocol):
+    """What the node runs (``palpate.ros.runner.SimRunner``)."""
+
+    simulated: bool
+    stack: StackConfig
+
+    @property
+    def label(self) -> str: ...
+
+    def spec(self, which: str) -> TrialSpec: ...
+
+    def run(self, spec: TrialSpec, view: View, stop: Any) -> TrialOutcome: ...
+
+    def survey(self, view: View, max_probes: int | None) -> Any: ...
+
+
+class PalpateNode:
+    """The node ``palpate`` in ``namespace``, its topics at ``rate`` per second of the trial's
+    clock, serving ``runner``'s trials."""
+
+    def __init__(
+        self,
+        runner: Runner,
+        *,
+        namespace: str = "palpate",
+        rate: float = 50.0,
+        network: bool = False,
+    ) -> None:
+        if not network:
+            os.environ.update(LOCALHOST)
+        self.runner = runner
+        self.context = rclpy.Context()
+        rclpy.init(args=[], context=self.context)
+        self.node = rclpy.create_node("palpate", namespace=namespace, context=self.context)
+        self.node.declare_parameter("trial", "")
+        self.node.declare_parameter("max_probes", 0)
+        self.view = RosView(self.node, runner.stack, rate=rate, sim_time=runner.simulated)
+        self.stopping = threading.Event()
+        self.busy = threading.Lock()
+        work, quick = MutuallyExclusiveCallbackGroup(), ReentrantCallbackGroup()
+        serve = self.node.create_service
+        serve(Trigger, "run_trial", self._run_trial, callback_group=work)
+        serve(Trigger, "run_survey", self._run_survey, callback_group=work)
+        serve(Trigger, "stop", self._stop, callback_group=quick)
+        self.executor = MultiThreadedExecutor(num_threads=3, context=self.context)
+        self.executor.add_node(self.node)
+        self.running: str | None = None  # the trial running now (its id)
+        self._closed = False
+
+    @property
+    def name(self) -> str:
+        return str(self.node.get_fully_qualified_name())
+
+    def spin(self) -> None:
+        """Serve until the context shuts down or the caller is interrupted (KeyboardInterrupt,
+        ``palpate.lab.hardware.Terminated``): then a running trial is told to stop."""
+        try:
+            self.executor.spin()
+        except ExternalShutdownException:
+            pass
+        except BaseException:
+            self.stopping.set()
+            raise
+
+    def close(self) -> None:
+        """Stop a running trial (it retracts and closes its log), then the executor, the node
+        and the context (idempotent)."""
+        if self._closed:
+            return
+        self._closed = True
+        self.stopping.set()
+        self.executor.shutdown(timeout_sec=SHUTDOWN_WAIT_S)
+        self.node.destroy_node()
+        if self.context.ok():
+            rclpy.shutdown(context=self.context)
+
+    # -- services -----------------------------------------------------------------------------
+    def _run_trial(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        which = str(self.node.get_parameter("trial").value)
+        return self._exclusive(response, lambda: self._trial(which))
+
+    def _trial(self, which: str) -> tuple[bool, str]:
+        spec = self.runner.spec(which)
+        if which:  # a named trial runs once; the next request runs the next one in order
+            self.node.set_parameters([rclpy.parameter.Parameter("trial", value="")])
+        self.running = spec.trial_id
+        try:
+            outcome = self.runner.run(spec, self.view, self.stopping.is_set)
+        finally:
+            self.running = None
+        row = json.dumps(outcome.as_dict(), default=_plain)
+        self.view.finished(row)
+        return outcome.state in ("done", "unreachable"), row
+
+    def _run_survey(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        def survey() -> tuple[bool, str]:
+            most = int(self.node.get_parameter("max_probes").value)
+            result = self.runner.survey(self.view, most or None)
+            return True, json.dumps(result.as_dict(), default=_plain)
+
+        return self._exclusive(response, survey)
+
+    def _exclusive(self, response: Trigger.Response, work: Any) -> Trigger.Response:
+        """Run ``work`` (-> success, message) unless something runs already; bad input is an
+        answer (success False, the message), a bug is logged with its traceback."""
+        if not self.busy.acquire(blocking=False):
+            response.success, response.message = False, f"busy: {self.running or 'a survey'} runs"
+            return response
+        try:
+            self.stopping.clear()
+            response.success, response.message = work()
+        except InputError as exc:
+            response.success, response.message = False, str(exc)
+        except Exception as exc:
+            log.exception("palpate ros: internal error")
+            response.success, response.message = False, f"internal error: {exc!r}"
+        finally:
+            self.busy.release()
+        return response
+
+    def _stop(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        running = self.running
+        self.stopping.set()
+        response.success = running is not None
+        response.message = (
+            f"stopping {running}: it retracts at its next tick"
+            if running is not None
+            else "no trial running"
+        )
+        return response
+
+
+def _plain(value: Any) -> Any:
+    """JSON for what a row may hold besides plain values (numpy scalars)."""
+    if hasattr(value, "item"):
+        return value.item()
+    raise TypeError(f"not JSON: {type(value).__name__}")
+
+
+__all__ = ["PalpateNode", "Runner"]
