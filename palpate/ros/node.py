@@ -17,6 +17,7 @@ the running trial retracts from its next control tick. Only one trial or survey 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -26,6 +27,7 @@ from typing import Any, Protocol
 import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
 from std_srvs.srv import Trigger
 
 from palpate.config import InputError
@@ -73,7 +75,8 @@ class PalpateNode:
             os.environ.update(LOCALHOST)
         self.runner = runner
         self.context = rclpy.Context()
-        rclpy.init(args=[], context=self.context)
+        # the command handles SIGINT and SIGTERM itself: a running trial retracts first
+        rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.node = rclpy.create_node("palpate", namespace=namespace, context=self.context)
         self.node.declare_parameter("trial", "")
         self.node.declare_parameter("max_probes", 0)
@@ -88,6 +91,7 @@ class PalpateNode:
         self.executor = MultiThreadedExecutor(num_threads=3, context=self.context)
         self.executor.add_node(self.node)
         self.running: str | None = None  # the trial running now (its id)
+        self._worker: threading.Thread | None = None  # the executor's thread while it spins
         self._closed = False
 
     @property
@@ -96,14 +100,27 @@ class PalpateNode:
 
     def spin(self) -> None:
         """Serve until the context shuts down or the caller is interrupted (KeyboardInterrupt,
-        ``palpate.lab.hardware.Terminated``): then a running trial is told to stop."""
+        ``palpate.lab.hardware.Terminated``): then a running trial is told to stop. The
+        executor spins in a thread of its own; this one waits where a signal reaches it."""
+        # not Thread.join here: a signal that interrupts it marks the thread ended on Python 3.11
+        ended = threading.Event()
+        worker = self._worker = threading.Thread(
+            target=self._spin, args=(ended,), name="palpate-ros"
+        )
+        worker.start()
         try:
-            self.executor.spin()
-        except ExternalShutdownException:
-            pass
+            while not ended.wait(timeout=1.0):
+                pass
         except BaseException:
             self.stopping.set()
             raise
+
+    def _spin(self, ended: threading.Event) -> None:
+        try:
+            with contextlib.suppress(ExternalShutdownException):
+                self.executor.spin()
+        finally:
+            ended.set()
 
     def close(self) -> None:
         """Stop a running trial (it retracts and closes its log), then the executor, the node
@@ -113,9 +130,13 @@ class PalpateNode:
         self._closed = True
         self.stopping.set()
         self.executor.shutdown(timeout_sec=SHUTDOWN_WAIT_S)
+        if self._worker is not None:  # its spin ends with the executor
+            self._worker.join(timeout=SHUTDOWN_WAIT_S)
         self.node.destroy_node()
         if self.context.ok():
             rclpy.shutdown(context=self.context)
+        # DDS's threads end here, not at the interpreter's exit (where their order is not ours)
+        self.context.destroy()
 
     # -- services -----------------------------------------------------------------------------
     def _run_trial(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:

@@ -4,13 +4,15 @@
     python tests/ros/client.py --namespace palpate run_trial stop ...
 
 Each service name is called once, in order; ``stop@N`` calls ``stop`` once the trial has
-published N joint states (a trial under way), while the previous call is still running.
+published N joint states (a trial under way), while the previous call is still running;
+``name=value`` sets the node's parameter (an integer when it reads as one).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import threading
 import time
@@ -19,12 +21,14 @@ from typing import Any
 
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
-import rclpy  # noqa: E402
-from rclpy.executors import MultiThreadedExecutor  # noqa: E402
-from rclpy.qos import DurabilityPolicy, QoSProfile  # noqa: E402
-from std_srvs.srv import Trigger  # noqa: E402
+import rclpy
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import DurabilityPolicy, QoSProfile
+from std_srvs.srv import Trigger
 
-from palpate.ros.names import SERVICES, TOPICS  # noqa: E402
+from palpate.ros.names import SERVICES, TOPICS
 
 WAIT_S = 600.0  # wall time for a service to appear and answer (a busy machine)
 
@@ -47,6 +51,7 @@ def main() -> None:
     stamps: dict[str, list[float]] = defaultdict(list)
     last: dict[str, Any] = {}
     states: list[str] = []
+    pushes: list[float] = []
     lock = threading.Lock()
 
     def subscriber(topic: str, kind: str) -> None:
@@ -62,6 +67,9 @@ def main() -> None:
                 header = getattr(message, "header", None)
                 if header is not None:
                     stamps[topic].append(header.stamp.sec + header.stamp.nanosec * 1e-9)
+                if topic == "measured_cf":
+                    if math.isfinite(message.wrench.force.z):
+                        pushes.append(message.wrench.force.z)
                 if topic == "trial/state":
                     states.append(message.data)
                 last[topic] = message
@@ -74,10 +82,24 @@ def main() -> None:
     clients = {s: node.create_client(Trigger, f"{ns}/{s}") for s in SERVICES}
     executor = MultiThreadedExecutor(num_threads=2)
     executor.add_node(node)
-    threading.Thread(target=executor.spin, daemon=True).start()
+    spinning = threading.Thread(target=executor.spin)
+    spinning.start()
     answers: list[dict[str, Any]] = []
     pending: list[Any] = []
-    for call in args.calls:
+    parameters = AsyncParameterClient(node, f"{ns}/palpate")
+    for k, call in enumerate(args.calls):
+        if "=" in call:
+            name, _, text = call.partition("=")
+            value: Any = int(text) if text.lstrip("-").isdigit() else text
+            if not parameters.wait_for_services(timeout_sec=WAIT_S):
+                raise SystemExit("no parameter services")
+            future = parameters.set_parameters([Parameter(name, value=value)])
+            deadline = time.monotonic() + WAIT_S
+            while not future.done() and time.monotonic() < deadline:
+                time.sleep(0.01)
+            [set_result] = future.result().results
+            answers.append({"call": call, "success": set_result.successful, "message": ""})
+            continue
         service, _, after = call.partition("@")
         client = clients[service]
         if not client.wait_for_service(timeout_sec=WAIT_S):
@@ -88,8 +110,8 @@ def main() -> None:
                 time.sleep(0.01)
         future = client.call_async(Trigger.Request())
         pending.append((call, future))
-        if not after and call != args.calls[-1] and "@" in args.calls[args.calls.index(call) + 1]:
-            continue  # the next call interrupts this one: do not wait for it
+        if k + 1 < len(args.calls) and "@" in args.calls[k + 1]:
+            continue  # the next call comes while this one runs: do not wait for it yet
         for name, f in pending:
             deadline = time.monotonic() + WAIT_S
             while not f.done() and time.monotonic() < deadline:
@@ -99,17 +121,17 @@ def main() -> None:
         pending.clear()
     time.sleep(0.5)  # the last messages in flight (DDS delivers asynchronously)
     with lock:
-        cf = last.get("measured_cf")
         out = {
             "answers": answers,
             "counts": dict(counts),
             "states": states,
-            "stamps": {k: v for k, v in stamps.items()},
+            "stamps": dict(stamps.items()),
             "result": last["trial/result"].data if "trial/result" in last else None,
-            "last_force_z": None if cf is None else cf.wrench.force.z,
+            "strongest_push_n": min(pushes, default=None),  # +z into the tissue: most negative
         }
     print(json.dumps(out))
     executor.shutdown()
+    spinning.join()  # DDS's threads end before the interpreter's exit, not during it
     node.destroy_node()
     rclpy.shutdown()
 

@@ -1,0 +1,159 @@
+"""The ROS 2 node (``palpate ros``) with real rclpy and DDS, each side in its own process as a
+lab's software would be: a client (tests/ros/client.py) receives every topic during a simulated
+trial, a trial run over ROS 2 gives the row ``palpate sim`` gives with the same seed, a stop
+retracts the running trial, a survey publishes its map, and the names the node advertises are
+the ones docs/ros2.md lists. Every test's DDS domain is its own, on the loopback."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+pytest.importorskip("rclpy", reason="the ros extra (ROS 2 wheels) is not installed")
+
+from palpate.api import load_scene, read_log, simulate_trial
+from palpate.ros.names import PARAMETERS, SERVICES, TOPICS
+
+CLIENT = Path(__file__).with_name("client.py")
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "ros2.md"
+WAIT_S = 600.0  # a bound on waiting for a process (a busy machine), never a measured time
+
+
+@pytest.fixture
+def domain() -> dict[str, str]:
+    """An environment with a DDS domain of the test's own, on the loopback only."""
+    env = dict(os.environ)
+    env["ROS_DOMAIN_ID"] = str(random.randint(1, 100))
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    return env
+
+
+@pytest.fixture
+def node(tmp_path: Path, domain: dict[str, str]) -> Iterator[tuple[dict[str, Any], Path]]:
+    yield from _node(tmp_path, domain, "scenes/robot.yaml")
+
+
+def _node(tmp_path: Path, env: dict[str, str], scene: str) -> Iterator[tuple[dict[str, Any], Path]]:
+    out = tmp_path / "node"
+    command = [sys.executable, "-m", "palpate", "ros", "--scene", scene, "--json"]
+    process = subprocess.Popen(
+        [*command, "--out", str(out)], env=env, stdout=subprocess.PIPE, text=True
+    )
+    assert process.stdout is not None
+    facts = json.loads(process.stdout.readline())  # printed once the node serves
+    try:
+        yield facts, out
+    finally:
+        process.terminate()
+        assert process.wait(timeout=WAIT_S) == 0  # SIGTERM: a clean stop
+        process.stdout.close()
+
+
+def client(env: dict[str, str], *calls: str) -> dict[str, Any]:
+    done = subprocess.run(
+        [sys.executable, str(CLIENT), *calls],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+        check=True,
+    )
+    return dict(json.loads(done.stdout.splitlines()[-1]))
+
+
+def test_a_trial_over_ros2_is_the_trial_palpate_sim_runs(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str], tmp_path: Path
+) -> None:
+    seen = client(domain, "run_trial")
+    [answer] = seen["answers"]
+    assert answer["success"], answer["message"]
+    row = json.loads(answer["message"])
+    assert json.loads(seen["result"]) == row  # trial/result carries the same row
+    expected = simulate_trial(load_scene("scenes/robot.yaml"), 0, log_dir=tmp_path / "cli")
+    wanted = json.loads(json.dumps(expected.as_dict()))
+    assert {k: v for k, v in row.items() if k != "log"} == {
+        k: v for k, v in wanted.items() if k != "log"
+    }
+    assert Path(row["log"]).is_relative_to(node[1])
+    assert read_log(row["log"]).end["state"] == "done"
+    # every stream and the latched topics reached a subscriber in another process
+    streams = ("measured_js", "measured_cp", "measured_cf", "fbg/strains", "/clock")
+    assert all(seen["counts"].get(t, 0) > 20 for t in streams), seen["counts"]
+    assert seen["counts"]["/diagnostics"] >= 1
+    assert seen["counts"]["trial/result"] == 1
+    assert seen["states"][-1] == "done"
+    assert "indenting" in seen["states"]
+    stamps = seen["stamps"]["measured_js"]
+    rate = (len(stamps) - 1) / (stamps[-1] - stamps[0])
+    assert rate == pytest.approx(50.0, rel=0.05)  # --rate's default, per second of the clock
+    # the tissue pushed back on the tip (-z) by about the beam's buckling load
+    assert seen["strongest_push_n"] < -0.1
+
+
+def test_stop_retracts_the_running_trial(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+) -> None:
+    seen = client(domain, "run_trial", "stop@30")
+    trial, stop = seen["answers"]
+    assert stop["success"]
+    assert "retracts" in stop["message"]
+    row = json.loads(trial["message"])
+    assert not trial["success"]
+    assert row["state"] == "aborted"
+    assert row["reason"] == "aborted: stop requested"
+    assert seen["states"][-2:] == ["retracting", "aborted"]
+    log = read_log(row["log"])
+    assert log.end["state"] == "aborted"
+    steps = [(r["from"], r["to"]) for r in log.of_kind("transition")]
+    assert steps[-1] == ("retracting", "aborted")
+
+
+def test_a_stop_with_nothing_running_says_so_and_a_named_trial_runs(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+) -> None:
+    seen = client(
+        domain, "stop", "trial=S7-bent30-sideways-L42", "run_trial", "trial=nope", "run_trial"
+    )
+    stop, named, trial, _, unknown = seen["answers"]
+    assert not stop["success"]
+    assert stop["message"] == "no trial running"
+    assert named["success"]
+    assert trial["success"]
+    assert json.loads(trial["message"])["trial"] == "S7-bent30-sideways-L42"
+    assert not unknown["success"]
+    assert "no trial 'nope'" in unknown["message"]
+
+
+def test_a_survey_over_ros2_publishes_its_map(tmp_path: Path, domain: dict[str, str]) -> None:
+    for facts, out in _node(tmp_path, domain, "scenes/maps/inclusion.yaml"):
+        env = {**domain}
+        seen = client(env, "run_trial", "max_probes=4", "run_survey")
+        refused, _, survey = seen["answers"]
+        assert not refused["success"]
+        assert "map scene" in refused["message"]
+        assert survey["success"], survey["message"]
+        summary = json.loads(survey["message"])
+        assert len(summary["probes"]) == seen["counts"]["map/probes"] == 4
+        assert seen["counts"]["map/grid"] >= 1
+        assert (out / "survey-1" / "probes.jsonl").exists()
+        assert facts["node"] == "/palpate/palpate"
+
+
+def test_the_node_advertises_what_docs_ros2_lists(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+) -> None:
+    facts, _ = node
+    topics = {t if t.startswith("/") else f"/palpate/{t}" for t in TOPICS}
+    assert set(facts["topics"]) == topics
+    assert set(facts["services"]) == {f"/palpate/{s}" for s in SERVICES}
+    text = DOCS.read_text(encoding="utf-8")
+    for name, (kind, _) in {**TOPICS, **SERVICES, **PARAMETERS}.items():
+        assert f"| `{name}` | `{kind}` |" in text, name
