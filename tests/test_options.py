@@ -62,6 +62,8 @@ ACCEPTS: dict[tuple[str, str], frozenset[str]] = {
     ("trial", "--live"): frozenset({"0"}),
     ("teleop", "--rate"): frozenset(),
     ("teleop", "--live"): frozenset({"0"}),
+    ("ros", "--seed"): frozenset({"0"}),
+    ("ros", "--rate"): frozenset(),
 }
 
 # What each command needs besides the option under test, so only that option can be wrong.

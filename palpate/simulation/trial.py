@@ -170,8 +170,7 @@ def run_sim_trial(
     live: View | None = None,
     stop: Callable[[], bool] | None = None,
 ) -> TrialOutcome:
-    """Run one simulated trial end to end and estimate the modulus; ``live``: its live view (or
-    the ROS 2 node's topics); ``stop``: asked every tick whether to stop and retract."""
+    """One simulated trial, estimated; ``live``: its view, ``stop``: asked each tick (run_trial)."""
     c = trial_campaign(spec, scene)
     geo = trial_geometry(stack, spec, trial_sample(scene, spec))
     retract = geo.contact_translation - c.standoff - 1e-3

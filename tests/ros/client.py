@@ -67,9 +67,8 @@ def main() -> None:
                 header = getattr(message, "header", None)
                 if header is not None:
                     stamps[topic].append(header.stamp.sec + header.stamp.nanosec * 1e-9)
-                if topic == "measured_cf":
-                    if math.isfinite(message.wrench.force.z):
-                        pushes.append(message.wrench.force.z)
+                if topic == "measured_cf" and math.isfinite(message.wrench.force.z):
+                    pushes.append(message.wrench.force.z)
                 if topic == "trial/state":
                     states.append(message.data)
                 last[topic] = message

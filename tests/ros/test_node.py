@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import os
 import random
+import re
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -157,3 +158,22 @@ def test_the_node_advertises_what_docs_ros2_lists(
     text = DOCS.read_text(encoding="utf-8")
     for name, (kind, _) in {**TOPICS, **SERVICES, **PARAMETERS}.items():
         assert f"| `{name}` | `{kind}` |" in text, name
+
+
+def test_the_client_docs_ros2_shows_runs_a_trial(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str], tmp_path: Path
+) -> None:
+    blocks = re.findall(r"```python\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.S)
+    [shown] = [b for b in blocks if "create_client" in b]
+    script = tmp_path / "client_doc.py"
+    script.write_text(shown, encoding="utf-8")
+    done = subprocess.run(
+        [sys.executable, str(script)],
+        env=domain,
+        capture_output=True,
+        text=True,
+        timeout=WAIT_S,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[0] == "S7-straight-downward-L42"

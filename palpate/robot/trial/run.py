@@ -104,8 +104,7 @@ def run_trial(
 ) -> TrialResult:
     """Run one trial to DONE, UNREACHABLE, FAULT or ABORTED; the rig is left retracted or
     torque-free. ``prober`` builds the probing step (``robot.probing``) when the trial probes;
-    ``stop`` is asked before every tick whether an operator stop came (a remote client's: the
-    trial retracts from that tick on and ends ABORTED).
+    ``stop`` is asked before each tick whether an operator stop came (it retracts, ABORTED).
 
     One tick every ``rig.tick`` seconds of ``clock``; after ``max_ticks`` the trial is aborted
     (and retracts). Every transition and every tick is written to ``log`` as it happens, and
