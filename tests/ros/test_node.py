@@ -12,6 +12,7 @@ import random
 import re
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -20,7 +21,7 @@ import pytest
 
 pytest.importorskip("rclpy", reason="the ros extra (ROS 2 wheels) is not installed")
 
-from palpate.api import load_scene, read_log, simulate_trial
+from palpate.api import load_scene, read_log, read_recording, simulate_trial
 from palpate.ros.names import PARAMETERS, SERVICES, TOPICS
 
 CLIENT = Path(__file__).with_name("client.py")
@@ -177,3 +178,34 @@ def test_the_client_docs_ros2_shows_runs_a_trial(
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.split()[0] == "S7-straight-downward-L42"
+
+
+def test_sigterm_mid_trial_retracts_and_leaves_a_complete_log(
+    tmp_path: Path, domain: dict[str, str]
+) -> None:
+    out = tmp_path / "node"
+    command = [sys.executable, "-m", "palpate", "ros", "--json", "--out", str(out)]
+    node = subprocess.Popen(command, env=domain, stdout=subprocess.PIPE, text=True)
+    assert node.stdout is not None
+    json.loads(node.stdout.readline())
+    caller = subprocess.Popen(
+        [sys.executable, str(CLIENT), "run_trial"], env=domain, stdout=subprocess.DEVNULL
+    )
+    try:
+        logs = out / "logs"
+        deadline = time.monotonic() + WAIT_S
+        while time.monotonic() < deadline:  # the trial under way: its log has ticks
+            found = list(logs.glob("*.jsonl")) if logs.exists() else []
+            if found and found[0].read_text(encoding="utf-8").count('"kind":"sample"') > 20:
+                break
+            time.sleep(0.05)
+        node.terminate()
+        assert node.wait(timeout=WAIT_S) == 0
+    finally:
+        caller.kill()
+        caller.wait()
+        node.stdout.close()
+    log = read_log(found[0])
+    assert log.end["state"] == "aborted"
+    assert log.end["reason"] == "aborted: stop requested"
+    assert read_recording(found[0].with_suffix(".mcap")).complete
