@@ -33,13 +33,13 @@ from palpate.config.scene import CampaignConfig, SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.config.targets import save_target
 from palpate.estimation.beam.stage import Stage
-from palpate.lab.hardware import open_hardware, run_on_hardware
+from palpate.lab.hardware import Hardware, open_hardware, run_on_hardware
+from palpate.lab.jog import jog_session, jog_tick
 from palpate.live import LiveView, Publisher, add_live_argument, live_view
 from palpate.robot.indentation import State
 from palpate.robot.rig import ServoFbgRig
 from palpate.robot.teleop import Teleop
 from palpate.robot.teleop.stagejog import StageJog
-from palpate.robot.trial.setup import detector_for, guards_for, rig_settings
 from palpate.robot.xystage import StageController
 from palpate.sensor.clock import Clock, SystemClock
 from palpate.simulation.twin import SimulatedBench
@@ -163,9 +163,7 @@ def _body(where: _Where, args: argparse.Namespace, summary: dict[str, Any]) -> i
         if where.sim is not None:
             stack_.enter_context(where.sim)
         hw = stack_.enter_context(open_hardware(where.stack, clock=SystemClock(), **where.ports))
-        session = _session(
-            where.stack, where.campaign, hw.drive, hw.reader, hw.clock, args, where.targets
-        )
+        session = _session(where.stack, where.campaign, hw, args, where.targets)
         if hw.stage is not None and where.stack.stage is not None:
             session.stage = hw.stage
             session.stage_jog = StageJog(where.stack.stage, hw.stage.position)
@@ -189,24 +187,13 @@ def _check_tube(stack: StackConfig, name: str | None) -> None:
 def _session(
     stack: StackConfig,
     campaign: CampaignConfig,
-    drive: Any,
-    reader: Any,
-    clock: Clock,
+    hw: Hardware,
     args: argparse.Namespace,
     targets: Path,
 ) -> Session:
     tick = 1.0 / args.rate
-    settings = rig_settings(campaign, stack, tick)
-    rig = ServoFbgRig.for_stack(drive, reader, stack, clock, settings)
-    chain = rig.zero()  # the sensor must be free now, as before a trial
-    model = Teleop(
-        stack.drive,
-        stack.tubes,
-        guards_for(campaign, stack, tick),
-        detector_for(campaign, chain),
-        tube_name=args.tube,
-    )
-    return Session(model, rig, clock, tick, targets, "palpate teleop")
+    model, rig = jog_session(stack, campaign, hw, tick, args.tube)
+    return Session(model, rig, hw.clock, tick, targets, "palpate teleop")
 
 
 def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
@@ -237,12 +224,7 @@ def _loop(stdscr: Any, s: Session) -> dict[str, Any]:
                 s.follow_tube()
                 if s.sim is not None:  # the operator swapped the tube
                     s.sim.tube = s.sim.stack.tube(effect.value)
-        obs = rig.observe(clock.now())
-        cmd = model.step(obs)
-        if obs.servo_fault is not None and model.state is State.RETRACTING and not recovered:
-            recovered = True  # one reboot so the sensor can be pulled back, as in a trial
-            rig.recover()
-        rig.command(cmd)
+        obs, recovered = jog_tick(model, rig, clock, recovered)
         if s.stage is not None and s.stage_jog is not None:
             if model.state is not State.IDLE and model.state is not State.POSITIONING:
                 s.stage_jog.goal = s.stage.position  # a stop or a fault: the stage holds too

@@ -164,14 +164,17 @@ class Teleop:
         )
 
     def _jog_advance(self, sign: float) -> None:
-        assert self.obs is not None
         assert self.goal is not None
+        self.advance_to(self.goal.translation + sign * self.step_size[0], sign)
+
+    def advance_to(self, goal: float, sign: float) -> None:
+        """The advance goal to ``goal`` (``sign``: its way) within the guards and a step."""
+        assert self.obs is not None and self.goal is not None  # noqa: PT018
         obs, step = self.obs, self.step_size[0]
         if sign > 0 and obs.stream_age > self.guards.stream_timeout:
             self.message = "no FBG frames: advancing is blocked (strains unknown)"
             return
         tol = self.settings.position_tolerance
-        goal = self.goal.translation + sign * step
         goal = min(max(goal, obs.advance - step - tol), obs.advance + step + tol)  # no runaway
         note = ""
         limit = self._travel_limit()
@@ -184,6 +187,11 @@ class Teleop:
         self.message = f"advance goal {goal * 1e3:.3f} mm" + (f" (at the {note})" if note else "")
 
     def _jog_roll(self, sign: float) -> None:
+        assert self.goal is not None
+        self.roll_to(self.goal.roll + sign * self.step_size[1])
+
+    def roll_to(self, goal: float) -> None:
+        """The roll goal to ``goal``: never in contact, within the limits and a step."""
         assert self.obs is not None
         assert self.goal is not None
         if self.obs.contact or self.x_contact is not None:
@@ -191,7 +199,6 @@ class Teleop:
             return
         obs, step = self.obs, self.step_size[1]
         tol = self.settings.roll_tolerance
-        goal = self.goal.roll + sign * step
         goal = min(max(goal, obs.roll - step - tol), obs.roll + step + tol)
         lo, hi = self.drive.roll_limits
         note = ""
