@@ -86,10 +86,15 @@ def beam_reading(
     estimator's beam state, ``estimation.beam.states``), NaN when they do not fit."""
     if length <= 0 or len(strains) != len(sensor.used_gratings):
         return math.nan, math.nan
+    rows = np.asarray([strains], dtype=float)
+    if not np.isfinite(rows).all() or not np.any(rows):  # unread, or exactly at rest (an ideal
+        return (math.nan, math.nan) if not np.isfinite(rows).all() else (0.0, 0.0)  # emulator)
     intervals = grating_intervals(sensor, length)
-    s = infer_states(
-        np.asarray([strains]), intervals, length, section.EA, section.fiber_offset, 1e-6
-    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        try:
+            s = infer_states(rows, intervals, length, section.EA, section.fiber_offset, 1e-6)
+        except ValueError:  # the strains fit no beam state (the elastica refuses them)
+            return math.nan, math.nan
     return float(s.P[0]), float(s.e[0])
 
 

@@ -82,17 +82,20 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _announce(name: str, label: str, out: Path, args: argparse.Namespace) -> None:
-    from palpate.ros.names import SERVICES, TOPICS
+    from palpate.ros.names import SERVICES, SUBSCRIPTIONS, TOPICS
 
     namespace = "/" + args.namespace.strip("/")
     topics = [t if t.startswith("/") else f"{namespace}/{t}" for t in TOPICS]
     services = [f"{namespace}/{s}" for s in SERVICES]
+    listens = [f"{namespace}/{s}" for s in SUBSCRIPTIONS]
     if args.json:
         facts = {"node": name, "topics": topics, "services": services, "out": str(out)}
+        facts["subscriptions"] = listens
         print(json.dumps(facts), flush=True)
         return
     print(f"ROS 2 node {name} ({label}); logs under {out}")
     print("services: " + ", ".join(services))
-    print("topics: " + ", ".join(topics), flush=True)
+    print("topics: " + ", ".join(topics))
+    print("teleop: " + ", ".join(listens), flush=True)
     where = "this machine and beyond" if args.network else "this machine only (--network opens it)"
     log.info("DDS: %s; Ctrl-C to stop", where)

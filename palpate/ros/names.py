@@ -52,6 +52,14 @@ TOPICS: dict[str, tuple[str, str]] = {
     ),
 }
 
+SUBSCRIPTIONS: dict[str, tuple[str, str]] = {
+    "joy": (
+        "sensor_msgs/msg/Joy",
+        "a gamepad (the `joy` node, remapped here): left stick up/down advances/retracts, "
+        "left/right rolls; A the emergency stop, B re-arms",
+    ),
+}
+
 SERVICES: dict[str, tuple[str, str]] = {
     "run_trial": (
         "std_srvs/srv/Trigger",
@@ -64,7 +72,8 @@ SERVICES: dict[str, tuple[str, str]] = {
     ),
     "stop": (
         "std_srvs/srv/Trigger",
-        "stop the running trial: it retracts at its next control tick and ends `aborted`",
+        "stop the running trial: it retracts at its next control tick and ends `aborted` (while "
+        "jogging: the emergency stop)",
     ),
 }
 
@@ -86,4 +95,4 @@ def grating_labels(strains: int) -> list[str]:
     return [f"grating_{k + 1}" for k in range(strains)]
 
 
-__all__ = ["JOINTS", "PARAMETERS", "SERVICES", "TOPICS", "grating_labels"]
+__all__ = ["JOINTS", "PARAMETERS", "SERVICES", "SUBSCRIPTIONS", "TOPICS", "grating_labels"]

@@ -28,13 +28,17 @@ import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
+from sensor_msgs.msg import Joy
 from std_srvs.srv import Trigger
 
 from palpate.config import InputError
+from palpate.config.scene import CampaignConfig
 from palpate.config.schema import StackConfig
+from palpate.lab.hardware import Hardware
 from palpate.live import View
 from palpate.simulation.trial import TrialOutcome, TrialSpec
 
+from .jog import RemoteJog
 from .view import RosView
 
 log = logging.getLogger(__name__)
@@ -51,6 +55,11 @@ class Runner(Protocol):
 
     @property
     def label(self) -> str: ...
+
+    @property
+    def campaign_config(self) -> CampaignConfig: ...
+
+    def jog_hardware(self) -> contextlib.AbstractContextManager[Hardware]: ...
 
     def spec(self, which: str) -> TrialSpec: ...
 
@@ -88,6 +97,9 @@ class PalpateNode:
         serve(Trigger, "run_trial", self._run_trial, callback_group=work)
         serve(Trigger, "run_survey", self._run_survey, callback_group=work)
         serve(Trigger, "stop", self._stop, callback_group=quick)
+        self.jog = RemoteJog(runner, self.view, self.busy)
+        listen = self.node.create_subscription
+        listen(Joy, "joy", self.jog.joy, 10, callback_group=quick)
         self.executor = MultiThreadedExecutor(num_threads=3, context=self.context)
         self.executor.add_node(self.node)
         self.running: str | None = None  # the trial running now (its id)
@@ -129,6 +141,7 @@ class PalpateNode:
             return
         self._closed = True
         self.stopping.set()
+        self.jog.close()  # torque off
         self.executor.shutdown(timeout_sec=SHUTDOWN_WAIT_S)
         if self._worker is not None:  # its spin ends with the executor
             self._worker.join(timeout=SHUTDOWN_WAIT_S)
@@ -168,7 +181,8 @@ class PalpateNode:
         """Run ``work`` (-> success, message) unless something runs already; bad input is an
         answer (success False, the message), a bug is logged with its traceback."""
         if not self.busy.acquire(blocking=False):
-            response.success, response.message = False, f"busy: {self.running or 'a survey'} runs"
+            holder = "teleop" if self.jog.active else self.running or "a survey"
+            response.success, response.message = False, f"busy: {holder} runs"
             return response
         try:
             self.stopping.clear()
@@ -183,6 +197,10 @@ class PalpateNode:
         return response
 
     def _stop(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        if self.jog.active:
+            self.jog.estop()
+            response.success, response.message = True, "emergency stop: retracting to home"
+            return response
         running = self.running
         self.stopping.set()
         response.success = running is not None

@@ -9,16 +9,20 @@ run over ROS 2 gives the estimate the command line gives::
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from palpate.config import InputError, load, load_stack, resolve
-from palpate.config.scene import SceneConfig
+from palpate.config.scene import CampaignConfig, SceneConfig
 from palpate.config.schema import StackConfig
+from palpate.lab.hardware import Hardware, open_hardware
 from palpate.live import View
+from palpate.sensor.clock import SystemClock
 from palpate.services.campaign import CampaignRequest, prepare
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
+from palpate.simulation.twin import SimulatedBench
 
 if TYPE_CHECKING:  # the maps import scikit-learn: only when asked for a survey
     from palpate.campaigns.survey import SurveyResult
@@ -43,6 +47,26 @@ class SimRunner:
     def label(self) -> str:
         n = 0 if self.campaign is None else len(self.campaign.specs)
         return f"simulator: scene {self.scene.name} ({n} trials, seed {self.seed})"
+
+    @property
+    def campaign_config(self) -> CampaignConfig:
+        """The scene's campaign settings (the guards' and detector's, for jogging)."""
+        return self.scene.campaign
+
+    @contextlib.contextmanager
+    def jog_hardware(self) -> Iterator[Hardware]:
+        """The robot to jog in real time: the scene's bench twin, its first sample in front
+        (as ``palpate teleop`` runs without hardware); torque off on the way out."""
+        with (
+            SimulatedBench(self.stack, self.scene, wire=False) as sim,
+            open_hardware(
+                self.stack,
+                clock=SystemClock(),
+                servo_port=sim.servo_port,
+                board_port=sim.board_port,
+            ) as hw,
+        ):
+            yield hw
 
     def spec(self, which: str) -> TrialSpec:
         """The trial ``which`` names (its id, or its index in the campaign), or the next one in

@@ -5,7 +5,9 @@
 
 Each service name is called once, in order; ``stop@N`` calls ``stop`` once the trial has
 published N joint states (a trial under way), while the previous call is still running;
-``name=value`` sets the node's parameter (an integer when it reads as one).
+``name=value`` sets the node's parameter (an integer when it reads as one); ``joy`` holds a
+gamepad's stick forward until the robot has advanced 1 mm, then goes quiet for 2 s of the
+node's clock while the joint states are recorded (``jogs``).
 """
 
 from __future__ import annotations
@@ -26,11 +28,14 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile
+from sensor_msgs.msg import JointState, Joy
 from std_srvs.srv import Trigger
 
-from palpate.ros.names import SERVICES, TOPICS
+from palpate.ros.names import JOINTS, SERVICES, TOPICS
 
-WAIT_S = 600.0  # wall time for a service to appear and answer (a busy machine)
+WAIT_S = float(
+    os.environ.get("CLIENT_WAIT_S", "600")
+)  # wall time for a service to appear and answer (a busy machine)
 
 
 def message_type(name: str) -> Any:
@@ -52,6 +57,7 @@ def main() -> None:
     last: dict[str, Any] = {}
     states: list[str] = []
     pushes: list[float] = []
+    joints: list[tuple[float, float]] = []  # (stamp s, advance m) of every joint state
     lock = threading.Lock()
 
     def subscriber(topic: str, kind: str) -> None:
@@ -67,6 +73,9 @@ def main() -> None:
                 header = getattr(message, "header", None)
                 if header is not None:
                     stamps[topic].append(header.stamp.sec + header.stamp.nanosec * 1e-9)
+                if topic == "measured_js":
+                    stamp = message.header.stamp
+                    joints.append((stamp.sec + stamp.nanosec * 1e-9, message.position[0]))
                 if topic == "measured_cf" and math.isfinite(message.wrench.force.z):
                     pushes.append(message.wrench.force.z)
                 if topic == "trial/state":
@@ -86,7 +95,43 @@ def main() -> None:
     answers: list[dict[str, Any]] = []
     pending: list[Any] = []
     parameters = AsyncParameterClient(node, f"{ns}/palpate")
+    joy = node.create_publisher(Joy, f"{ns}/joy", 10)
+    servo = node.create_publisher(JointState, f"{ns}/servo_jp", 10)
+
+    def jog(command: str) -> dict[str, Any]:
+        """Command until the robot has advanced 1 mm, then go quiet for 2 s of its clock."""
+        deadline = time.monotonic() + WAIT_S
+        start: float | None = None
+        while time.monotonic() < deadline:
+            with lock:
+                here = joints[-1][1] if joints else None
+            if start is None and here is not None and command == "servo":
+                start = here
+            if command == "joy":
+                joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))
+                if start is None and here is not None:
+                    start = here
+            elif start is not None:
+                servo.publish(JointState(name=list(JOINTS), position=[start + 1e-3, 0.0]))
+            if start is not None and here is not None and here >= start + 1e-3 - 20e-6:
+                break
+            time.sleep(0.05)
+        with lock:
+            quiet_from = len(joints)
+            stopped_at = joints[-1][0]
+        while time.monotonic() < deadline:
+            with lock:
+                if joints[-1][0] > stopped_at + 2.0:
+                    break
+            time.sleep(0.05)
+        with lock:
+            return {"start": start, "quiet": joints[quiet_from:]}
+
+    jogs: list[dict[str, Any]] = []
     for k, call in enumerate(args.calls):
+        if call in ("joy", "servo"):
+            jogs.append(jog(call))
+            continue
         if "=" in call:
             name, _, text = call.partition("=")
             value: Any = int(text) if text.lstrip("-").isdigit() else text
@@ -122,6 +167,7 @@ def main() -> None:
     with lock:
         out = {
             "answers": answers,
+            "jogs": jogs,
             "counts": dict(counts),
             "states": states,
             "stamps": dict(stamps.items()),

@@ -22,7 +22,8 @@ import pytest
 pytest.importorskip("rclpy", reason="the ros extra (ROS 2 wheels) is not installed")
 
 from palpate.api import load_scene, read_log, read_recording, simulate_trial
-from palpate.ros.names import PARAMETERS, SERVICES, TOPICS
+from palpate.ros.jog import COMMAND_TIMEOUT_S
+from palpate.ros.names import PARAMETERS, SERVICES, SUBSCRIPTIONS, TOPICS
 
 CLIENT = Path(__file__).with_name("client.py")
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "ros2.md"
@@ -157,7 +158,7 @@ def test_the_node_advertises_what_docs_ros2_lists(
     assert set(facts["topics"]) == topics
     assert set(facts["services"]) == {f"/palpate/{s}" for s in SERVICES}
     text = DOCS.read_text(encoding="utf-8")
-    for name, (kind, _) in {**TOPICS, **SERVICES, **PARAMETERS}.items():
+    for name, (kind, _) in {**TOPICS, **SUBSCRIPTIONS, **SERVICES, **PARAMETERS}.items():
         assert f"| `{name}` | `{kind}` |" in text, name
 
 
@@ -209,3 +210,20 @@ def test_sigterm_mid_trial_retracts_and_leaves_a_complete_log(
     assert log.end["state"] == "aborted"
     assert log.end["reason"] == "aborted: stop requested"
     assert read_recording(found[0].with_suffix(".mcap")).complete
+
+
+def test_a_gamepad_jogs_the_robot_and_its_silence_holds_it(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+) -> None:
+    seen = client(domain, "joy", "run_trial")
+    [jog] = seen["jogs"]
+    quiet = jog["quiet"]
+    assert quiet[0][1] >= jog["start"] + 1e-3 - 20e-6  # it moved 1 mm on command
+    # silent: within the command timeout (and a step's travel) it holds, and then stays put
+    held = [a for t, a in quiet if t > quiet[0][0] + COMMAND_TIMEOUT_S + 0.5]
+    assert held
+    assert max(held) - min(held) < 5e-6
+    assert max(held) - quiet[0][1] < 1.5e-3  # at most a step on from where the commands stopped
+    [busy] = seen["answers"]  # the jog holds the robot: no trial meanwhile
+    assert not busy["success"]
+    assert busy["message"] == "busy: teleop runs"

@@ -1,12 +1,11 @@
 """Jogging from a remote controller: a gamepad's ``sensor_msgs/Joy`` axes and buttons as the jog
-model's keys, a lab controller's position command (CRTK ``servo_jp``) as goals, and the hold
-when the commands stop coming. Pure logic on :class:`robot.teleop.Teleop`: the same guards, limits
-and emergency stop as the keyboard (``palpate ros`` feeds it)::
+model's keys, and the hold when the commands stop coming. Pure logic on
+:class:`robot.teleop.Teleop`: the same guards, limits and emergency stop as the keyboard
+(``palpate ros`` feeds it)::
 
     pad = JoyMapping()
     for key in pad.keys(axes, buttons):   # each Joy message
         model.press(key)
-    jog_to(model, advance=0.12, roll=0.3)  # each servo_jp message
     hold(model, "no command for 0.5 s")    # the commands went quiet
 """
 
@@ -54,20 +53,6 @@ def _axis(axes: Sequence[float], index: int) -> float:
     return float(axes[index]) if 0 <= index < len(axes) else 0.0
 
 
-def jog_to(model: Teleop, advance: float, roll: float) -> None:
-    """Move the goals toward a position command (m, rad) under the same guards as a key's jog, a
-    step at most ahead of where the robot is: a command stream that stops leaves the robot at
-    most a step on, and :func:`hold` stops it there."""
-    obs, goal = model.obs, model.goal
-    if model.state in LATCHED or obs is None or goal is None:
-        return
-    if abs(roll - obs.roll) > model.settings.roll_tolerance:
-        model.roll_to(roll)
-    now = model.goal.translation if model.goal is not None else goal.translation
-    if abs(advance - now) > model.settings.position_tolerance:
-        model.advance_to(advance, 1.0 if advance > now else -1.0)
-
-
 def hold(model: Teleop, why: str) -> None:
     """Stop where the robot is (its commands stopped coming): the goal becomes the last reading;
     a retraction, an emergency stop or a fault goes on as it was."""
@@ -80,4 +65,4 @@ def hold(model: Teleop, why: str) -> None:
     model.goal = here
 
 
-__all__ = ["JoyMapping", "hold", "jog_to"]
+__all__ = ["JoyMapping", "hold"]
