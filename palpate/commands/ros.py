@@ -71,8 +71,8 @@ def run(args: argparse.Namespace) -> int:
     runner = SimRunner(resolve(args.scene), seed=args.seed, out=out)
     node = PalpateNode(runner, namespace=args.namespace, rate=args.rate, network=args.network)
     try:
-        _announce(node.name, runner.label, out, args)
-        with terminate_as_interrupt():
+        with terminate_as_interrupt():  # before the announcement: a client may stop it next
+            _announce(node.name, runner.label, out, args)
             node.spin()
     except (KeyboardInterrupt, Terminated) as exc:
         log.warning("palpate ros: stopped (%s)", type(exc).__name__)

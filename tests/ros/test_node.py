@@ -56,8 +56,9 @@ def _node(tmp_path: Path, env: dict[str, str], scene: str) -> Iterator[tuple[dic
         yield facts, out
     finally:
         process.terminate()
-        assert process.wait(timeout=WAIT_S) == 0  # SIGTERM: a clean stop
+        code = process.wait(timeout=WAIT_S)
         process.stdout.close()
+        assert code == 0  # SIGTERM: a clean stop
 
 
 def client(env: dict[str, str], *calls: str) -> dict[str, Any]:
