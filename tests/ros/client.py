@@ -28,10 +28,10 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile
-from sensor_msgs.msg import JointState, Joy
+from sensor_msgs.msg import Joy
 from std_srvs.srv import Trigger
 
-from palpate.ros.names import JOINTS, SERVICES, TOPICS
+from palpate.ros.names import SERVICES, TOPICS
 
 WAIT_S = float(
     os.environ.get("CLIENT_WAIT_S", "600")
@@ -96,23 +96,18 @@ def main() -> None:
     pending: list[Any] = []
     parameters = AsyncParameterClient(node, f"{ns}/palpate")
     joy = node.create_publisher(Joy, f"{ns}/joy", 10)
-    servo = node.create_publisher(JointState, f"{ns}/servo_jp", 10)
 
-    def jog(command: str) -> dict[str, Any]:
-        """Command until the robot has advanced 1 mm, then go quiet for 2 s of its clock."""
+    def jog() -> dict[str, Any]:
+        """Hold the stick forward until the robot has advanced 1 mm, then go quiet for 2 s of
+        its clock."""
         deadline = time.monotonic() + WAIT_S
         start: float | None = None
         while time.monotonic() < deadline:
             with lock:
                 here = joints[-1][1] if joints else None
-            if start is None and here is not None and command == "servo":
+            joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))
+            if start is None and here is not None:
                 start = here
-            if command == "joy":
-                joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))
-                if start is None and here is not None:
-                    start = here
-            elif start is not None:
-                servo.publish(JointState(name=list(JOINTS), position=[start + 1e-3, 0.0]))
             if start is not None and here is not None and here >= start + 1e-3 - 20e-6:
                 break
             time.sleep(0.05)
@@ -129,8 +124,8 @@ def main() -> None:
 
     jogs: list[dict[str, Any]] = []
     for k, call in enumerate(args.calls):
-        if call in ("joy", "servo"):
-            jogs.append(jog(call))
+        if call == "joy":
+            jogs.append(jog())
             continue
         if "=" in call:
             name, _, text = call.partition("=")
