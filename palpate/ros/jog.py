@@ -88,7 +88,7 @@ class RemoteJog:
 
     def close(self) -> None:
         self.closing.set()
-        if self.thread is not None:
+        if self.thread is not None and self.thread.ident is not None:  # started
             self.thread.join()
 
     def _command(self, keys: list[str]) -> None:

@@ -143,8 +143,8 @@ class PalpateNode:
         self.stopping.set()
         self.jog.close()  # torque off
         self.executor.shutdown(timeout_sec=SHUTDOWN_WAIT_S)
-        if self._worker is not None:  # its spin ends with the executor
-            self._worker.join(timeout=SHUTDOWN_WAIT_S)
+        if self._worker is not None and self._worker.ident is not None:  # started (a signal
+            self._worker.join(timeout=SHUTDOWN_WAIT_S)  # may come before): ends with the executor
         self.node.destroy_node()
         if self.context.ok():
             rclpy.shutdown(context=self.context)
