@@ -4,7 +4,8 @@
     python tests/ros/client.py --namespace palpate run_trial stop ...
 
 Each service name is called once, in order; ``stop@N`` calls ``stop`` once the trial has
-published N joint states (a trial under way), while the previous call is still running;
+published N joint states (a trial under way), while the previous call is still running
+(``ready@N`` prints ``under way`` then instead of calling anything);
 ``name=value`` sets the node's parameter (an integer when it reads as one); ``joy`` holds a
 gamepad's stick forward until the robot has advanced 1 mm, then goes quiet for 2 s of the
 node's clock while the joint states are recorded (``jogs``).
@@ -33,6 +34,7 @@ from std_srvs.srv import Trigger
 
 from palpate.ros.names import SERVICES, TOPICS
 
+JOY_HZ = 20.0  # the joy node's repeat rate while a stick is held
 WAIT_S = float(
     os.environ.get("CLIENT_WAIT_S", "600")
 )  # wall time for a service to appear and answer (a busy machine)
@@ -58,7 +60,7 @@ def main() -> None:
     states: list[str] = []
     pushes: list[float] = []
     joints: list[tuple[float, float]] = []  # (stamp s, advance m) of every joint state
-    lock = threading.Lock()
+    lock = threading.Condition()  # every message and every answer notifies its waiters
 
     def subscriber(topic: str, kind: str) -> None:
         latched = topic.startswith(("trial/", "map/"))
@@ -81,6 +83,7 @@ def main() -> None:
                 if topic == "trial/state":
                     states.append(message.data)
                 last[topic] = message
+                lock.notify_all()
 
         name = topic if topic.startswith("/") else f"{ns}/{topic}"
         node.create_subscription(message_type(kind), name, seen, qos)
@@ -102,25 +105,31 @@ def main() -> None:
         its clock."""
         deadline = time.monotonic() + WAIT_S
         start: float | None = None
-        while time.monotonic() < deadline:
-            with lock:
-                here = joints[-1][1] if joints else None
-            joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))
-            if start is None and here is not None:
-                start = here
-            if start is not None and here is not None and here >= start + 1e-3 - 20e-6:
-                break
-            time.sleep(0.05)
+
+        def advanced() -> bool:
+            return start is not None and joints[-1][1] >= start + 1e-3 - 20e-6
+
         with lock:
-            quiet_from = len(joints)
-            stopped_at = joints[-1][0]
-        while time.monotonic() < deadline:
-            with lock:
-                if joints[-1][0] > stopped_at + 2.0:
+            while time.monotonic() < deadline:
+                joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))  # a held stick: 20 a second
+                if lock.wait_for(advanced, timeout=1.0 / JOY_HZ):
                     break
-            time.sleep(0.05)
-        with lock:
+                if start is None and joints:
+                    start = joints[-1][1]
+            quiet_from, stopped_at = len(joints), joints[-1][0]
+            lock.wait_for(lambda: joints[-1][0] > stopped_at + 2.0, timeout=WAIT_S)
             return {"start": start, "quiet": joints[quiet_from:]}
+
+    def answered(future: Any) -> Any:
+        """A service's or parameter call's result, waited for."""
+        future.add_done_callback(lambda _: notify())
+        with lock:
+            lock.wait_for(future.done, timeout=WAIT_S)
+        return future.result()
+
+    def notify() -> None:
+        with lock:
+            lock.notify_all()
 
     jogs: list[dict[str, Any]] = []
     for k, call in enumerate(args.calls):
@@ -133,33 +142,39 @@ def main() -> None:
             if not parameters.wait_for_services(timeout_sec=WAIT_S):
                 raise SystemExit("no parameter services")
             future = parameters.set_parameters([Parameter(name, value=value)])
-            deadline = time.monotonic() + WAIT_S
-            while not future.done() and time.monotonic() < deadline:
-                time.sleep(0.01)
-            [set_result] = future.result().results
+            [set_result] = answered(future).results
             answers.append({"call": call, "success": set_result.successful, "message": ""})
             continue
         service, _, after = call.partition("@")
+        if service == "ready":  # say when the running trial has published that many joints
+            with lock:
+                wanted = int(after)
+                lock.wait_for(lambda n=wanted: counts["measured_js"] >= n, timeout=WAIT_S)
+            print("under way", flush=True)
+            continue
         client = clients[service]
         if not client.wait_for_service(timeout_sec=WAIT_S):
             raise SystemExit(f"no service {service}")
         if after:
-            deadline = time.monotonic() + WAIT_S
-            while counts["measured_js"] < int(after) and time.monotonic() < deadline:
-                time.sleep(0.01)
+            with lock:
+                wanted = int(after)
+                lock.wait_for(lambda n=wanted: counts["measured_js"] >= n, timeout=WAIT_S)
         future = client.call_async(Trigger.Request())
         pending.append((call, future))
         if k + 1 < len(args.calls) and "@" in args.calls[k + 1]:
             continue  # the next call comes while this one runs: do not wait for it yet
         for name, f in pending:
-            deadline = time.monotonic() + WAIT_S
-            while not f.done() and time.monotonic() < deadline:
-                time.sleep(0.01)
-            result = f.result()
+            result = answered(f)
             answers.append({"call": name, "success": result.success, "message": result.message})
         pending.clear()
-    time.sleep(0.5)  # the last messages in flight (DDS delivers asynchronously)
+    rows = [json.loads(a["message"]) for a in answers if a["message"].startswith("{")]
+    ended = [r["state"] for r in rows if "state" in r]
+
+    def delivered() -> bool:  # DDS delivers asynchronously: each trial's result and last state
+        return counts["trial/result"] >= len(ended) and (not ended or states[-1:] == ended[-1:])
+
     with lock:
+        lock.wait_for(delivered, timeout=WAIT_S)
         out = {
             "answers": answers,
             "jogs": jogs,

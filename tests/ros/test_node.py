@@ -12,7 +12,6 @@ import random
 import re
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -191,26 +190,26 @@ def test_sigterm_mid_trial_retracts_and_leaves_a_complete_log(
     assert node.stdout is not None
     json.loads(node.stdout.readline())
     caller = subprocess.Popen(
-        [sys.executable, str(CLIENT), "run_trial"], env=domain, stdout=subprocess.DEVNULL
+        [sys.executable, str(CLIENT), "run_trial", "ready@20"],
+        env=domain,
+        stdout=subprocess.PIPE,
+        text=True,
     )
+    assert caller.stdout is not None
     try:
-        logs = out / "logs"
-        deadline = time.monotonic() + WAIT_S
-        while time.monotonic() < deadline:  # the trial under way: its log has ticks
-            found = list(logs.glob("*.jsonl")) if logs.exists() else []
-            if found and found[0].read_text(encoding="utf-8").count('"kind":"sample"') > 20:
-                break
-            time.sleep(0.05)
+        assert caller.stdout.readline().strip() == "under way"  # 20 joint states of the trial
         node.terminate()
         assert node.wait(timeout=WAIT_S) == 0
     finally:
         caller.kill()
         caller.wait()
+        caller.stdout.close()
         node.stdout.close()
-    log = read_log(found[0])
+    [found] = (out / "logs").glob("*.jsonl")
+    log = read_log(found)
     assert log.end["state"] == "aborted"
     assert log.end["reason"] == "aborted: stop requested"
-    assert read_recording(found[0].with_suffix(".mcap")).complete
+    assert read_recording(found.with_suffix(".mcap")).complete
 
 
 def test_a_gamepad_jogs_the_robot_and_its_silence_holds_it(
