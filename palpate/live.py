@@ -87,8 +87,10 @@ def beam_reading(
     if length <= 0 or len(strains) != len(sensor.used_gratings):
         return math.nan, math.nan
     rows = np.asarray([strains], dtype=float)
-    if not np.isfinite(rows).all() or not np.any(rows):  # unread, or exactly at rest (an ideal
-        return (math.nan, math.nan) if not np.isfinite(rows).all() else (0.0, 0.0)  # emulator)
+    if not np.isfinite(rows).all():
+        return math.nan, math.nan
+    if not np.any(rows):  # exactly at rest (an ideal emulator): no load, no shortening
+        return 0.0, 0.0
     intervals = grating_intervals(sensor, length)
     with np.errstate(invalid="ignore", divide="ignore"):
         try:

@@ -89,8 +89,13 @@ def _announce(name: str, label: str, out: Path, args: argparse.Namespace) -> Non
     services = [f"{namespace}/{s}" for s in SERVICES]
     listens = [f"{namespace}/{s}" for s in SUBSCRIPTIONS]
     if args.json:
-        facts = {"node": name, "topics": topics, "services": services, "out": str(out)}
-        facts["subscriptions"] = listens
+        facts = {
+            "node": name,
+            "topics": topics,
+            "services": services,
+            "subscriptions": listens,
+            "out": str(out),
+        }
         print(json.dumps(facts), flush=True)
         return
     print(f"ROS 2 node {name} ({label}); logs under {out}")

@@ -9,8 +9,6 @@ are ROS's own, absolute.
 
 from __future__ import annotations
 
-JOINTS = ("stage_translation", "outer_roll")  # m, rad: the recording's names (robot.records)
-
 TOPICS: dict[str, tuple[str, str]] = {
     "measured_js": (
         "sensor_msgs/msg/JointState",
@@ -95,4 +93,4 @@ def grating_labels(strains: int) -> list[str]:
     return [f"grating_{k + 1}" for k in range(strains)]
 
 
-__all__ = ["JOINTS", "PARAMETERS", "SERVICES", "SUBSCRIPTIONS", "TOPICS", "grating_labels"]
+__all__ = ["PARAMETERS", "SERVICES", "SUBSCRIPTIONS", "TOPICS", "grating_labels"]

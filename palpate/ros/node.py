@@ -27,6 +27,7 @@ from typing import Any, Protocol
 import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import Joy
 from std_srvs.srv import Trigger
@@ -159,7 +160,7 @@ class PalpateNode:
     def _trial(self, which: str) -> tuple[bool, str]:
         spec = self.runner.spec(which)
         if which:  # a named trial runs once; the next request runs the next one in order
-            self.node.set_parameters([rclpy.parameter.Parameter("trial", value="")])
+            self.node.set_parameters([Parameter("trial", value="")])
         self.running = spec.trial_id
         try:
             outcome = self.runner.run(spec, self.view, self.stopping.is_set)

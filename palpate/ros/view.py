@@ -35,9 +35,9 @@ from palpate.estimation.beam.stage import Stage
 from palpate.live import Publisher, beam_reading
 from palpate.robot.guards import Observation
 from palpate.robot.indentation import State
-from palpate.robot.records.ros2 import tip_transforms
+from palpate.robot.records.ros2 import JOINTS, nanoseconds, tip_transforms
 
-from .names import JOINTS, grating_labels
+from .names import grating_labels
 
 DEPTH = 100  # the streams' history: a subscriber a little behind the simulator loses nothing
 DIAGNOSTICS_PERIOD = 1.0  # s of the trial's clock
@@ -46,7 +46,7 @@ LATCHED = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 def stamp(t: float) -> Time:
     """Seconds (>= 0) as a ``builtin_interfaces/Time``."""
-    sec, nanosec = divmod(max(round(t * 1e9), 0), 1_000_000_000)
+    sec, nanosec = divmod(nanoseconds(t), 1_000_000_000)
     return Time(sec=sec, nanosec=nanosec)
 
 
