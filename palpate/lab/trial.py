@@ -29,7 +29,7 @@ from palpate.estimation.trial.estimate import EstimatorInputs, TrialEstimate, es
 from palpate.estimation.trial.inputs import belief_fields, probe_inputs
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial, plan_bench_trials
-from palpate.live import LiveView, Publisher
+from palpate.live import Publisher, View
 from palpate.robot.dynamixel.stats import BusStats
 from palpate.robot.indentation import PLANNED_ENDS
 from palpate.robot.plan import State
@@ -112,7 +112,7 @@ def run_bench_trials(
     *,
     sync_to_clock: bool = False,
     progress: Callable[[BenchOutcome], None] | None = None,
-    live: LiveView | None = None,
+    live: View | None = None,
     session: Session | None = None,
 ) -> list[BenchOutcome]:
     """Run ``trials`` in order on opened hardware; one log per trial in ``log_dir``; each
@@ -161,14 +161,16 @@ def run_bench_trial(
     log_dir: Path,
     *,
     sync_to_clock: bool = False,
-    live: LiveView | None = None,
+    live: View | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[BenchOutcome, ServoFbgRig]:
     """One trial on opened hardware with ``stack`` (the session's calibration), its log in
-    ``log_dir`` and its ticks on the ``live`` view; the outcome (with what the bus did) and
-    the rig (to release the servos)."""
+    ``log_dir`` and its ticks on the ``live`` view; ``stop`` asked every tick (True: retract,
+    ``aborted``); the outcome (with what the bus did) and the rig (to release the servos)."""
     publisher = None if live is None else live.trial(trial.stage)
     before = bus_stats(hw)
-    outcome, rig = _run_one(hw, trial, loaded, stack, log_dir, (sync_to_clock, publisher))
+    running = (sync_to_clock, publisher, stop)
+    outcome, rig = _run_one(hw, trial, loaded, stack, log_dir, running)
     outcome.bus = _bus_during(before, bus_stats(hw), rig.missed_reads)
     return outcome, rig
 
@@ -226,11 +228,12 @@ def _run_one(
     loaded: LoadedBench,
     stack: StackConfig,
     log_dir: Path,
-    running: tuple[bool, Publisher | None],
+    running: tuple[bool, Publisher | None, Callable[[], bool] | None],
 ) -> tuple[BenchOutcome, ServoFbgRig]:
     """Zero the strains, run one trial with its log, estimate; the outcome and the rig.
-    ``running``: whether to wait for each tick's frame on the clock, the live view's publisher."""
-    sync_to_clock, publisher = running
+    ``running``: whether to wait for each tick's frame on the clock, the live view's publisher,
+    the operator's stop."""
+    sync_to_clock, publisher, stop = running
     c = loaded.bench.campaign
     tick = 1.0 / loaded.bench.control_rate_hz
     settings = rig_settings(
@@ -266,6 +269,7 @@ def _run_one(
         header=_header(trial, loaded, section, inputs),
         prober=None if trial.stage.tube is None else prober_for(c, stack, trial.tube, radius),
         on_tick=publisher,
+        stop=stop,
     )
     done = run_session_trial(rig, hw.clock, setup)
     fields = outcome_fields(done.result, done.estimate, done.log_path)

@@ -5,7 +5,11 @@ state machine (``robot.indentation``) and teleoperation (``robot.teleop``) share
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from palpate.wire.frame import Frame
 
 STATE_TIMEOUT = 60.0  # s in any one state (a guard: a state that never ends is a fault)
 
@@ -46,6 +50,8 @@ class Observation:
     gate: bool | None = None
     # an ECG monitor's R-wave pulse in a frame of this tick (status bit 7): the heart's beat
     beat: bool = False
+    # the newest FBG frame as the board sent it (its peak wavelengths; None: none yet)
+    frame: Frame | None = field(default=None, compare=False, repr=False)
 
     @property
     def measured_advance(self) -> float:

@@ -208,6 +208,7 @@ class ServoFbgRig:
             joints_age=age,
             gate=None if self._frame is None else bool(self._frame.flags & Status.BREATH_HOLD),
             beat=any(f.flags & Status.CARDIAC_TRIGGER for f in frames),
+            frame=self._frame,
         )
 
     def _tip_force(self, f: Frame) -> float | None:

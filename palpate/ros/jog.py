@@ -1,15 +1,19 @@
-"""Teleop over ROS 2: a gamepad through the ``joy`` node (``sensor_msgs/Joy`` on ``joy``) jogs the
-robot in real time, through the jog model ``palpate teleop`` uses (the same guards, limits and
-emergency stop: ``robot.teleop``).
+"""Teleop over ROS 2: a gamepad through the ``joy`` node (``sensor_msgs/Joy`` on ``joy``), or a
+lab's own controller streaming joint goals (CRTK ``servo_jp``, ``sensor_msgs/JointState``),
+jogs the robot in real time through the jog model ``palpate teleop`` uses (the same guards,
+limits and emergency stop: ``robot.teleop``).
 
 The first command opens a jog session (the robot: in simulation the scene's bench twin, its
-sample in front) and holds the node's robot, so no trial starts meanwhile; each tick takes the
-commands that came since the last, and when none came for ``COMMAND_TIMEOUT_S`` the robot holds
-where it is. After ``IDLE_S`` without a command the session ends, torque off, and trials may
-run again. The ticks go to the node's topics as a trial's do::
+sample in front; on the bench the node's open hardware), zeroes the strains with the sensor
+free, and holds the node's robot, so no trial starts meanwhile; each tick takes the commands
+that came since the last, and when none came for ``COMMAND_TIMEOUT_S`` (a client gone quiet or
+disconnected) the robot holds where it is. After ``IDLE_S`` without a command the session
+ends, torque off, and trials may run again. The ticks go to the node's topics as a trial's do::
 
     jog = RemoteJog(runner, view, busy)
     jog.joy(message)          # a Joy message: its sticks and buttons as keys
+    jog.servo_jp(message)     # a JointState: the goal (within a step of where the robot is)
+    ok, answer = jog.zero()   # re-zero the strains now (the sensor free), its baseline as JSON
     jog.estop()               # the stop service while jogging
     jog.close()               # the node's shutdown: torque off
 """
@@ -18,13 +22,14 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import json
 import logging
 import math
 import threading
 import time
 from typing import Protocol
 
-from sensor_msgs.msg import Joy
+from sensor_msgs.msg import JointState, Joy
 
 from palpate.config.scene import CampaignConfig
 from palpate.config.schema import StackConfig
@@ -32,8 +37,12 @@ from palpate.estimation.beam.stage import Stage
 from palpate.lab.hardware import Hardware
 from palpate.lab.jog import jog_session, jog_tick
 from palpate.robot.indentation import State
-from palpate.robot.teleop import ESTOP_KEY
-from palpate.robot.teleop.remote import JoyMapping, hold
+from palpate.robot.records.ros2 import JOINTS
+from palpate.robot.rig import ServoFbgRig
+from palpate.robot.teleop import ESTOP_KEY, Teleop
+from palpate.robot.teleop.remote import JoyMapping, hold, servo_to
+from palpate.robot.trial.setup import detector_for
+from palpate.sensor.strain import StrainChain
 
 from .view import RosView
 
@@ -42,6 +51,7 @@ log = logging.getLogger(__name__)
 JOG_RATE_HZ = 100.0  # control ticks per second of wall time
 COMMAND_TIMEOUT_S = 0.5  # no command for this long: the robot holds where it is
 IDLE_S = 10.0  # no command for this long (and nothing moving): the session ends, torque off
+ZERO_WAIT_S = 60.0  # wall time a zero request waits for the session to take it
 
 
 class JogRobot(Protocol):
@@ -60,7 +70,21 @@ class _Commands:
     """What came since the last tick (under the lock)."""
 
     keys: list[str] = dataclasses.field(default_factory=list)
+    goal: tuple[float | None, float | None] | None = None  # servo_jp's newest: advance, roll
+    zero: list[_Zero] = dataclasses.field(default_factory=list)  # re-zero requests waiting
     last: float = -math.inf  # time.monotonic() of the last command
+
+
+@dataclasses.dataclass
+class _Zero:
+    """A re-zero request: set when answered (ok, the answer)."""
+
+    done: threading.Event = dataclasses.field(default_factory=threading.Event)
+    answer: tuple[bool, str] = (False, "the jog session ended before zeroing")
+
+    def reply(self, ok: bool, answer: str) -> None:
+        self.answer = (ok, answer)
+        self.done.set()
 
 
 class RemoteJog:
@@ -82,6 +106,31 @@ class RemoteJog:
         keys = self.pad.keys(list(message.axes), list(message.buttons))
         self._command(keys)
 
+    def servo_jp(self, message: JointState) -> None:
+        """CRTK ``servo_jp``: a joint goal by name (``stage_translation`` m, ``outer_roll``
+        rad; unnamed: in that order), met within a step of where the robot is each tick."""
+        names = list(message.name) or JOINTS[: len(message.position)]
+        goal = dict(zip(names, (float(p) for p in message.position), strict=False))
+        unknown = set(goal) - set(JOINTS)
+        if unknown:
+            log.warning("palpate ros: servo_jp: no joint %s (%s)", sorted(unknown), JOINTS)
+            return
+        with self.lock:
+            self.commands.goal = (goal.get(JOINTS[0]), goal.get(JOINTS[1]))
+        self._command([])
+
+    def zero(self) -> tuple[bool, str]:
+        """Re-zero the strains with the sensor free (a session opens if none is: its start
+        zeroes); the baseline's wavelengths as JSON, or why not."""
+        request = _Zero()
+        with self.lock:
+            self.commands.zero.append(request)
+        if not self._command([]):
+            return False, "busy: a trial or survey holds the robot"
+        if not request.done.wait(ZERO_WAIT_S):
+            return False, f"no zero within {ZERO_WAIT_S:g} s"
+        return request.answer
+
     def estop(self) -> None:
         """The emergency stop: retract to home and hold, until re-armed (button B)."""
         self._command([ESTOP_KEY])
@@ -91,17 +140,21 @@ class RemoteJog:
         if self.thread is not None and self.thread.ident is not None:  # started
             self.thread.join()
 
-    def _command(self, keys: list[str]) -> None:
+    def _command(self, keys: list[str]) -> bool:
+        """Queue ``keys`` (and what the caller queued) for the session, opening one if none
+        runs; False when a trial or survey holds the robot (the commands are dropped)."""
         with self.lock:
             self.commands.keys.extend(keys)
             self.commands.last = time.monotonic()
         if self.active or self.closing.is_set():
-            return
+            return True
         if not self.busy.acquire(blocking=False):
             log.warning("palpate ros: a trial or survey holds the robot; the jog is ignored")
-            return
+            self._take()
+            return False
         self.thread = threading.Thread(target=self._session, name="palpate-ros-jog")
         self.thread.start()
+        return True
 
     def _take(self) -> _Commands:
         with self.lock:
@@ -116,16 +169,27 @@ class RemoteJog:
         except Exception:
             log.exception("palpate ros: the jog session failed (torque off)")
         finally:
+            for request in self._take().zero:  # their answer says the session ended
+                request.done.set()
             self.busy.release()
 
     def _run(self, hw: Hardware) -> None:
         tick = 1.0 / JOG_RATE_HZ
         model, rig = jog_session(self.robot.stack, self.robot.campaign_config, hw, tick)
+        zeroed: StrainChain | None = rig.chain  # the session's start zeroed the strains
         publish = self.view.trial(Stage.on(model.tube, 0.0))
         t0, recovered, next_tick = hw.clock.now(), False, hw.clock.now()
+        moved = False  # a session opened only to zero ends once it has answered
         try:
             while not self.closing.is_set():
                 got = self._take()
+                self._zero(got.zero, model, rig, zeroed)
+                zeroed = None  # the start's zero answers what came before the first tick only
+                moved = moved or bool(got.keys) or got.goal is not None
+                if got.zero and not moved:
+                    break
+                if got.goal is not None:
+                    servo_to(model, *got.goal)
                 quiet = time.monotonic() - got.last
                 for key in got.keys:
                     effect = model.press(key)
@@ -144,5 +208,37 @@ class RemoteJog:
         finally:
             rig.release()
 
+    def _zero(
+        self, requests: list[_Zero], model: Teleop, rig: ServoFbgRig, zeroed: StrainChain | None
+    ) -> None:
+        """Answer ``requests``: with the zero the session's start took (``zeroed``), or a new
+        one taken now if the sensor is free and still."""
+        if not requests:
+            return
+        obs = model.obs
+        still = model.state in (State.IDLE, State.ABORTED)
+        if zeroed is None and not (still and obs is not None and not obs.contact):
+            for request in requests:
+                request.reply(False, f"not free and still ({model.state.value}): retract first")
+            return
+        if zeroed is None:
+            zeroed = rig.zero()
+            model.detector = detector_for(self.robot.campaign_config, zeroed)
+        answer = json.dumps(_baseline(zeroed))
+        for request in requests:
+            request.reply(True, answer)
 
-__all__ = ["COMMAND_TIMEOUT_S", "IDLE_S", "JogRobot", "RemoteJog"]
+
+def _baseline(chain: StrainChain) -> dict[str, object]:
+    """The zero's facts for the answer: the wavelengths at rest and their noise (m)."""
+    b = chain.baseline
+    assert b is not None, "the rig zeroes its chain"
+    return {
+        "zero_wavelengths_m": [float(w) for w in b.wavelengths],
+        "noise_m": [float(n) for n in b.noise],
+        "reference_m": b.reference,
+        "samples": b.samples,
+    }
+
+
+__all__ = ["COMMAND_TIMEOUT_S", "IDLE_S", "ZERO_WAIT_S", "JogRobot", "RemoteJog"]

@@ -27,6 +27,10 @@ TOPICS: dict[str, tuple[str, str]] = {
         "std_msgs/msg/Float64MultiArray",
         "the used gratings' strains (zeroed at rest), one dimension labelled by grating",
     ),
+    "fbg/wavelengths": (
+        "std_msgs/msg/Float64MultiArray",
+        "the peak wavelengths (m) of the board's newest frame: every grating, the reference last",
+    ),
     "trial/state": ("std_msgs/msg/String", "the trial's state on each change (latched)"),
     "trial/result": (
         "std_msgs/msg/String",
@@ -50,11 +54,18 @@ TOPICS: dict[str, tuple[str, str]] = {
     ),
 }
 
+SIMULATION_ONLY = frozenset({"/clock"})  # not published on the bench
+
 SUBSCRIPTIONS: dict[str, tuple[str, str]] = {
     "joy": (
         "sensor_msgs/msg/Joy",
         "a gamepad (the `joy` node, remapped here): left stick up/down advances/retracts, "
         "left/right rolls; A the emergency stop, B re-arms",
+    ),
+    "servo_jp": (
+        "sensor_msgs/msg/JointState",
+        "CRTK joint goal: `stage_translation` (m) and/or `outer_roll` (rad) by name, met within "
+        "a jog step of where the robot is (stream it); the teleop's guards",
     ),
 }
 
@@ -72,6 +83,11 @@ SERVICES: dict[str, tuple[str, str]] = {
         "std_srvs/srv/Trigger",
         "stop the running trial: it retracts at its next control tick and ends `aborted` (while "
         "jogging: the emergency stop)",
+    ),
+    "zero": (
+        "std_srvs/srv/Trigger",
+        "re-zero the FBG strains now, the sensor free and still (opens a jog session if none is "
+        "open); answers with the zero's wavelengths as JSON. Every trial zeroes at its start too",
     ),
 }
 
@@ -93,4 +109,17 @@ def grating_labels(strains: int) -> list[str]:
     return [f"grating_{k + 1}" for k in range(strains)]
 
 
-__all__ = ["PARAMETERS", "SERVICES", "SUBSCRIPTIONS", "TOPICS", "grating_labels"]
+def peak_labels(peaks: int) -> list[str]:
+    """The wavelengths topic's labels: the board's peaks in the order its frames give them."""
+    return [f"peak_{k + 1}" for k in range(peaks)]
+
+
+__all__ = [
+    "PARAMETERS",
+    "SERVICES",
+    "SIMULATION_ONLY",
+    "SUBSCRIPTIONS",
+    "TOPICS",
+    "grating_labels",
+    "peak_labels",
+]

@@ -11,7 +11,8 @@ the environment, for a lab that opens the robot to its network on purpose::
     node.close()
 
 A service that runs a trial answers when the trial has ended; ``stop`` answers at once, and
-the running trial retracts from its next control tick. Only one trial or survey runs at a time
+the running trial retracts from its next control tick, as it does when its caller leaves the
+ROS graph (the service has no client left). Only one trial or survey runs at a time
 (a second request while one runs is refused, not queued).
 """
 
@@ -22,6 +23,7 @@ import json
 import logging
 import os
 import threading
+import time
 from typing import Any, Protocol
 
 import rclpy
@@ -29,7 +31,7 @@ from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallb
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
-from sensor_msgs.msg import Joy
+from sensor_msgs.msg import JointState, Joy
 from std_srvs.srv import Trigger
 
 from palpate.config import InputError
@@ -37,7 +39,6 @@ from palpate.config.scene import CampaignConfig
 from palpate.config.schema import StackConfig
 from palpate.lab.hardware import Hardware
 from palpate.live import View
-from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 from .jog import RemoteJog
 from .view import RosView
@@ -46,10 +47,12 @@ log = logging.getLogger(__name__)
 
 LOCALHOST = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
 SHUTDOWN_WAIT_S = 120.0  # wall time a running trial has to retract and close its log
+CALLER_CHECK_S = 0.5  # wall time between looks for a running trial's caller in the ROS graph
 
 
 class Runner(Protocol):
-    """What the node runs (``palpate.ros.runner.SimRunner``)."""
+    """What the node runs (``palpate.ros.runner``: ``SimRunner``, ``BenchRunner``); its trials
+    are the runner's own (a simulated ``TrialSpec``, a ``BenchTrial``), named by ``trial_id``."""
 
     simulated: bool
     stack: StackConfig
@@ -62,9 +65,9 @@ class Runner(Protocol):
 
     def jog_hardware(self) -> contextlib.AbstractContextManager[Hardware]: ...
 
-    def spec(self, which: str) -> TrialSpec: ...
+    def spec(self, which: str) -> Any: ...
 
-    def run(self, spec: TrialSpec, view: View, stop: Any) -> TrialOutcome: ...
+    def run(self, spec: Any, view: View, stop: Any) -> Any: ...
 
     def survey(self, view: View, max_probes: int | None) -> Any: ...
 
@@ -98,9 +101,11 @@ class PalpateNode:
         serve(Trigger, "run_trial", self._run_trial, callback_group=work)
         serve(Trigger, "run_survey", self._run_survey, callback_group=work)
         serve(Trigger, "stop", self._stop, callback_group=quick)
+        serve(Trigger, "zero", self._zero, callback_group=quick)
         self.jog = RemoteJog(runner, self.view, self.busy)
         listen = self.node.create_subscription
         listen(Joy, "joy", self.jog.joy, 10, callback_group=quick)
+        listen(JointState, "servo_jp", self.jog.servo_jp, 10, callback_group=quick)
         self.executor = MultiThreadedExecutor(num_threads=3, context=self.context)
         self.executor.add_node(self.node)
         self.running: str | None = None  # the trial running now (its id)
@@ -163,7 +168,7 @@ class PalpateNode:
             self.node.set_parameters([Parameter("trial", value="")])
         self.running = spec.trial_id
         try:
-            outcome = self.runner.run(spec, self.view, self.stopping.is_set)
+            outcome = self.runner.run(spec, self.view, CallerWatch(self, "run_trial"))
         finally:
             self.running = None
         row = json.dumps(outcome.as_dict(), default=_plain)
@@ -197,6 +202,10 @@ class PalpateNode:
             self.busy.release()
         return response
 
+    def _zero(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        response.success, response.message = self.jog.zero()
+        return response
+
     def _stop(self, _: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
         if self.jog.active:
             self.jog.estop()
@@ -211,6 +220,30 @@ class PalpateNode:
             else "no trial running"
         )
         return response
+
+
+class CallerWatch:
+    """A running trial's stop: the ``stop`` service, or the caller gone. The ROS graph is asked
+    every ``CALLER_CHECK_S`` of wall time for the service's clients; none left (the caller
+    disconnected or died) stops the trial as the stop service would."""
+
+    def __init__(self, node: PalpateNode, service: str) -> None:
+        self.node, self.service = node, service
+        self.due = time.monotonic() + CALLER_CHECK_S
+
+    def __call__(self) -> bool:
+        n = self.node
+        if n.stopping.is_set():
+            return True
+        if time.monotonic() < self.due:
+            return False
+        self.due = time.monotonic() + CALLER_CHECK_S
+        name = f"{n.node.get_namespace().rstrip('/')}/{self.service}"
+        if n.node.count_clients(name) == 0:
+            log.warning("palpate ros: %s's caller left: stopping %s", self.service, n.running)
+            n.stopping.set()
+            return True
+        return False
 
 
 def _plain(value: Any) -> Any:

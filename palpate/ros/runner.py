@@ -1,26 +1,38 @@
-"""What the node runs when asked: a simulated scene's campaign, a trial at a time, and its
-survey when it is a map scene. The same trials as ``palpate sim`` with the same seed, so a trial
-run over ROS 2 gives the estimate the command line gives::
+"""What the node runs when asked, a trial at a time, and a survey.
+
+In simulation (:class:`SimRunner`) a scene's campaign: the same trials as ``palpate sim`` with
+the same seed, so a trial run over ROS 2 gives the estimate the command line gives. On the bench
+(:class:`BenchRunner`) a bench file's trials and map, as ``palpate trial`` runs them, on
+hardware the runner holds open while the node serves (the ports from the bench file)::
 
     runner = SimRunner(Path("config/scenes/robot.yaml"), seed=0, out=Path("out/ros"))
     spec = runner.spec("")                       # the next trial ("3" or a trial id: that one)
     outcome = runner.run(spec, view, stop=lambda: False)
+
+    with BenchRunner(Path("config/bench.yaml"), out=Path("out/ros")) as bench:   # opens ports
+        outcome = bench.run(bench.spec(""), view, stop=lambda: False)
 """
 
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable, Iterator
+import dataclasses
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from types import TracebackType
+from typing import TYPE_CHECKING, Protocol, Self, TypeVar
 
 from palpate.config import InputError, load, load_stack, resolve
+from palpate.config.bench import load_bench
 from palpate.config.scene import CampaignConfig, SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.lab.hardware import Hardware, open_hardware
+from palpate.lab.plan import plan_session
+from palpate.lab.trial import PLANNED, BenchOutcome, BenchTrial, Session, run_bench_trial
 from palpate.live import View
 from palpate.sensor.clock import SystemClock
 from palpate.services.campaign import CampaignRequest, prepare
+from palpate.services.lab import with_ports
 from palpate.simulation.trial import TrialOutcome, TrialSpec, run_sim_trial
 from palpate.simulation.twin import SimulatedBench
 
@@ -28,7 +40,44 @@ if TYPE_CHECKING:  # the maps import scikit-learn: only when asked for a survey
     from palpate.campaigns.survey import SurveyResult
 
 
-class SimRunner:
+class _Trial(Protocol):
+    @property
+    def trial_id(self) -> str: ...
+
+
+T = TypeVar("T", bound=_Trial)
+
+
+def pick(trials: Sequence[T], which: str, following: int, where: str) -> T:
+    """The trial ``which`` names (its id, or its index), or the one at ``following`` for '';
+    an ``InputError`` for a name ``where`` (the scene, the bench file) lacks, or past the end."""
+    if which == "":
+        if following >= len(trials):
+            raise InputError(f"all {len(trials)} trials of {where} have run")
+        return trials[following]
+    if which.isdigit() and int(which) < len(trials):
+        return trials[int(which)]
+    for trial in trials:
+        if trial.trial_id == which:
+            return trial
+    raise InputError(
+        f"trial: no trial {which!r} in {where} (an id, or an index 0-{len(trials) - 1})"
+    )
+
+
+class _NoContext:
+    """A runner with nothing held between requests (``with`` accepted, nothing to close)."""
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        return None
+
+
+class SimRunner(_NoContext):
     """A scene's campaign (checked as ``palpate sim`` checks it), its trials on request; logs
     and recordings under ``out`` (None: none)."""
 
@@ -73,20 +122,7 @@ class SimRunner:
         order for ''; an ``InputError`` for a name the campaign does not have, or past the end."""
         if self.campaign is None:
             raise InputError(f"run_trial: scene {self.scene.name!r} is a map scene: run_survey")
-        specs = self.campaign.specs
-        if which == "":
-            if self.next >= len(specs):
-                raise InputError(f"all {len(specs)} trials of the campaign have run")
-            return specs[self.next]
-        if which.isdigit() and int(which) < len(specs):
-            return specs[int(which)]
-        for spec in specs:
-            if spec.trial_id == which:
-                return spec
-        raise InputError(
-            f"trial: no trial {which!r} in scene {self.scene.name!r} (an id, or an "
-            f"index 0-{len(specs) - 1})"
-        )
+        return pick(self.campaign.specs, which, self.next, f"scene {self.scene.name!r}")
 
     def run(self, spec: TrialSpec, view: View, stop: Callable[[], bool]) -> TrialOutcome:
         """One trial, its ticks on ``view``; ``stop`` asked every tick."""
@@ -117,4 +153,99 @@ class SimRunner:
         )
 
 
-__all__ = ["SimRunner"]
+class BenchRunner:
+    """A bench file's trials and map on the bench it names (``servo_port``, ``board_port``:
+    instead of the file's, e.g. ``palpate emulate``'s ptys), as ``palpate trial`` runs them;
+    logs under ``out``. The hardware opens on ``with`` and stays open (torque on, the robot
+    held) until the block ends: then torque off and the ports closed."""
+
+    simulated = False
+
+    def __init__(
+        self,
+        config: str | Path,
+        *,
+        servo_port: str | None = None,
+        board_port: str | None = None,
+        out: Path,
+    ) -> None:
+        self.loaded = with_ports(load_bench(config), servo_port, board_port)
+        self.trials, self.template = plan_session(self.loaded, None)
+        self.stack: StackConfig = self.loaded.stack
+        self.session = Session(self.stack)
+        self.log_dir, self.next = out / "logs", 0
+        self._held = contextlib.ExitStack()
+        self._hw: Hardware | None = None
+
+    def __enter__(self) -> BenchRunner:
+        key = str(self.loaded.path)
+        self._hw = self._held.enter_context(
+            open_hardware(
+                self.stack, servo_key=f"servos.port in {key}", board_key=f"board.port in {key}"
+            )
+        )
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self._hw = None
+        self._held.close()  # torque off, ports closed
+
+    @property
+    def hw(self) -> Hardware:
+        if self._hw is None:
+            raise RuntimeError("BenchRunner: open it with `with` first")
+        return self._hw
+
+    @property
+    def label(self) -> str:
+        s = self.stack
+        where = f"servos {s.servos.port}, board {s.board.port}"
+        return f"bench: {self.loaded.path} ({len(self.trials)} trials; {where})"
+
+    @property
+    def campaign_config(self) -> CampaignConfig:
+        return self.loaded.bench.campaign
+
+    def jog_hardware(self) -> contextlib.AbstractContextManager[Hardware]:
+        """The open bench (a jog session ends with torque off; the next trial turns it on)."""
+        return contextlib.nullcontext(self.hw)
+
+    def spec(self, which: str) -> BenchTrial:
+        """The bench file's trial ``which`` names (see :func:`pick`)."""
+        return pick(self.trials, which, self.next, str(self.loaded.path))
+
+    def run(self, spec: BenchTrial, view: View, stop: Callable[[], bool]) -> BenchOutcome:
+        """One trial with the session's calibration so far; ``stop`` asked every tick."""
+        self.next = self.trials.index(spec) + 1
+        self.log_dir.mkdir(parents=True, exist_ok=True)
+        self.hw.drive.bus.set_torque(True)  # a jog, a fault or a release may have turned it off
+        outcome, rig = run_bench_trial(
+            self.hw, spec, self.loaded, self.session.stack, self.log_dir, live=view, stop=stop
+        )
+        self.session.add(spec, outcome)
+        if outcome.state in PLANNED and self.loaded.bench.after_trial == "release":
+            rig.release()
+        return outcome
+
+    def survey(self, view: View, max_probes: int | None = None) -> SurveyResult:
+        """The bench file's map on the x-y stage (at most ``max_probes``; None: the file's)."""
+        from palpate.services.benchmap import run_bench_map
+
+        m, loaded = self.loaded.bench.map, self.loaded
+        if self.template is None or m is None:
+            raise InputError(f"run_survey: {loaded.path} has no map: section")
+        if max_probes is not None:
+            bench = dataclasses.replace(
+                loaded.bench, map=dataclasses.replace(m, max_probes=max_probes)
+            )
+            loaded = dataclasses.replace(loaded, bench=bench)
+        self.log_dir.mkdir(parents=True, exist_ok=True)
+        self.hw.drive.bus.set_torque(True)
+        return run_bench_map(
+            self.hw, self.template, loaded, self.session.stack, self.log_dir, live=view
+        )
+
+
+__all__ = ["BenchRunner", "SimRunner", "pick"]

@@ -36,8 +36,9 @@ from palpate.live import Publisher, beam_reading
 from palpate.robot.guards import Observation
 from palpate.robot.indentation import State
 from palpate.robot.records.ros2 import JOINTS, nanoseconds, tip_transforms
+from palpate.wire.frame import FM, Frame
 
-from .names import grating_labels
+from .names import grating_labels, peak_labels
 
 DEPTH = 100  # the streams' history: a subscriber a little behind the simulator loses nothing
 DIAGNOSTICS_PERIOD = 1.0  # s of the trial's clock
@@ -65,6 +66,7 @@ class RosView:
         self.pose = make(PoseStamped, "measured_cp", DEPTH)
         self.wrench = make(WrenchStamped, "measured_cf", DEPTH)
         self.strains = make(Float64MultiArray, "fbg/strains", DEPTH)
+        self.wavelengths = make(Float64MultiArray, "fbg/wavelengths", DEPTH)
         self.state = make(String, "trial/state", LATCHED)
         self.result = make(String, "trial/result", LATCHED)
         self.diagnostics = make(DiagnosticArray, "/diagnostics", 10)
@@ -139,12 +141,9 @@ class _Feed:
         joints = JointState(name=list(JOINTS), position=[obs.advance, obs.roll])
         joints.header.stamp, joints.header.frame_id = now, "stage"
         v.joints.publish(joints)
-        n = len(obs.strains)
-        strains = Float64MultiArray(data=[float(s) for s in obs.strains])
-        strains.layout.dim = [
-            MultiArrayDimension(label=",".join(grating_labels(n)), size=n, stride=n)
-        ]
-        v.strains.publish(strains)
+        v.strains.publish(_array([float(s) for s in obs.strains], grating_labels(len(obs.strains))))
+        if obs.frame is not None:
+            v.wavelengths.publish(_wavelengths(obs.frame))
         if not (math.isfinite(obs.advance) and math.isfinite(obs.roll)):
             return
         length = self.stage.exposed_length(obs.advance)
@@ -176,6 +175,24 @@ class _Feed:
         p.x, p.y, p.z = (float(c) for c in at)
         q.x, q.y, q.z, q.w = x, y, z, w
         return pose
+
+
+def _array(data: list[float], labels: list[str]) -> Float64MultiArray:
+    """A one-dimensional array whose dimension's label lists its entries' names."""
+    message = Float64MultiArray(data=data)
+    n = len(data)
+    message.layout.dim = [MultiArrayDimension(label=",".join(labels), size=n, stride=n)]
+    return message
+
+
+def _wavelengths(frame: Frame) -> Float64MultiArray:
+    """A frame's peak wavelengths (m), every grating the board reports, its reference last."""
+    peaks = [fm * FM for fm in frame.peak_fm]
+    labels = peak_labels(len(peaks))
+    if frame.reference_fm is not None:
+        peaks.append(frame.reference_fm * FM)
+        labels.append("reference")
+    return _array(peaks, labels)
 
 
 def _diagnostics(obs: Observation, t: float) -> DiagnosticArray:

@@ -33,7 +33,7 @@ from palpate.config.schema import StackConfig
 from palpate.lab.hardware import Hardware
 from palpate.lab.plan import BenchTrial
 from palpate.lab.trial import PLANNED, BenchOutcome, run_bench_trial
-from palpate.live import LiveView
+from palpate.live import View
 from palpate.maps import Probe
 from palpate.robot.trial.outcome import probe_of
 from palpate.robot.xystage import StageMoveError
@@ -55,7 +55,7 @@ def run_bench_map(
     *,
     sync_to_clock: bool = False,
     progress: Callable[[BenchOutcome], None] | None = None,
-    live: LiveView | None = None,
+    live: View | None = None,
 ) -> SurveyResult:
     """Survey the bench file's ``map:`` patch on opened hardware with ``stack`` (the session's
     calibration); the trial logs and ``probes.jsonl`` in ``log_dir``. The lab time is the

@@ -5,10 +5,12 @@
 
 Each service name is called once, in order; ``stop@N`` calls ``stop`` once the trial has
 published N joint states (a trial under way), while the previous call is still running
-(``ready@N`` prints ``under way`` then instead of calling anything);
+(``ready@N`` prints ``under way`` then instead of calling anything); ``result`` waits for the
+last trial's latched ``trial/result`` and answers with it;
 ``name=value`` sets the node's parameter (an integer when it reads as one); ``joy`` holds a
 gamepad's stick forward until the robot has advanced 1 mm, then goes quiet for 2 s of the
-node's clock while the joint states are recorded (``jogs``).
+node's clock while the joint states are recorded (``jogs``); ``servo`` does the same with CRTK
+``servo_jp`` goals (an empty one first: it opens the jog session, whose joint states then flow).
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile
-from sensor_msgs.msg import Joy
+from sensor_msgs.msg import JointState, Joy
 from std_srvs.srv import Trigger
 
 from palpate.ros.names import SERVICES, TOPICS
@@ -90,7 +92,7 @@ def main() -> None:
 
     for topic, (kind, _) in TOPICS.items():
         subscriber(topic, kind)
-    clients = {s: node.create_client(Trigger, f"{ns}/{s}") for s in SERVICES}
+    clients: dict[str, Any] = {}  # made when first called: a client is a caller in the graph
     executor = MultiThreadedExecutor(num_threads=2)
     executor.add_node(node)
     spinning = threading.Thread(target=executor.spin)
@@ -99,10 +101,19 @@ def main() -> None:
     pending: list[Any] = []
     parameters = AsyncParameterClient(node, f"{ns}/palpate")
     joy = node.create_publisher(Joy, f"{ns}/joy", 10)
+    servo_jp = node.create_publisher(JointState, f"{ns}/servo_jp", 10)
 
-    def jog() -> dict[str, Any]:
-        """Hold the stick forward until the robot has advanced 1 mm, then go quiet for 2 s of
-        its clock."""
+    def command(how: str, start: float | None) -> None:
+        if how == "joy":  # a held stick
+            joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))
+        elif start is None:  # no reading yet: an empty goal opens the session
+            servo_jp.publish(JointState())
+        else:
+            servo_jp.publish(JointState(name=["stage_translation"], position=[start + 1e-3]))
+
+    def jog(how: str) -> dict[str, Any]:
+        """Hold the stick forward (or stream the goal 1 mm on) until the robot has advanced
+        1 mm, then go quiet for 2 s of its clock."""
         deadline = time.monotonic() + WAIT_S
         start: float | None = None
 
@@ -111,7 +122,7 @@ def main() -> None:
 
         with lock:
             while time.monotonic() < deadline:
-                joy.publish(Joy(axes=[0.0, 1.0], buttons=[0, 0]))  # a held stick: 20 a second
+                command(how, start)  # 20 a second, as the joy node repeats
                 if lock.wait_for(advanced, timeout=1.0 / JOY_HZ):
                     break
                 if start is None and joints:
@@ -133,8 +144,8 @@ def main() -> None:
 
     jogs: list[dict[str, Any]] = []
     for k, call in enumerate(args.calls):
-        if call == "joy":
-            jogs.append(jog())
+        if call in ("joy", "servo"):
+            jogs.append(jog(call))
             continue
         if "=" in call:
             name, _, text = call.partition("=")
@@ -145,6 +156,12 @@ def main() -> None:
             [set_result] = answered(future).results
             answers.append({"call": call, "success": set_result.successful, "message": ""})
             continue
+        if call == "result":  # the latched result of the last trial, once there is one
+            with lock:
+                lock.wait_for(lambda: "trial/result" in last, timeout=WAIT_S)
+                data = last["trial/result"].data
+            answers.append({"call": call, "success": True, "message": data})
+            continue
         service, _, after = call.partition("@")
         if service == "ready":  # say when the running trial has published that many joints
             with lock:
@@ -152,6 +169,10 @@ def main() -> None:
                 lock.wait_for(lambda n=wanted: counts["measured_js"] >= n, timeout=WAIT_S)
             print("under way", flush=True)
             continue
+        if service not in SERVICES:
+            raise SystemExit(f"no service {service} in palpate.ros.names")
+        if service not in clients:
+            clients[service] = node.create_client(Trigger, f"{ns}/{service}")
         client = clients[service]
         if not client.wait_for_service(timeout_sec=WAIT_S):
             raise SystemExit(f"no service {service}")

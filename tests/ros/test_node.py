@@ -43,9 +43,12 @@ def node(tmp_path: Path, domain: dict[str, str]) -> Iterator[tuple[dict[str, Any
     yield from _node(tmp_path, domain, "scenes/robot.yaml")
 
 
-def _node(tmp_path: Path, env: dict[str, str], scene: str) -> Iterator[tuple[dict[str, Any], Path]]:
+def _node(
+    tmp_path: Path, env: dict[str, str], scene: str, *where: str
+) -> Iterator[tuple[dict[str, Any], Path]]:
+    """The node on ``scene``, or where ``where`` says (``--config BENCH ...``)."""
     out = tmp_path / "node"
-    command = [sys.executable, "-m", "palpate", "ros", "--scene", scene, "--json"]
+    command = [sys.executable, "-m", "palpate", "ros", *(where or ("--scene", scene)), "--json"]
     process = subprocess.Popen(
         [*command, "--out", str(out)], env=env, stdout=subprocess.PIPE, text=True
     )
@@ -88,7 +91,8 @@ def test_a_trial_over_ros2_is_the_trial_palpate_sim_runs(
     assert Path(row["log"]).is_relative_to(node[1])
     assert read_log(row["log"]).end["state"] == "done"
     # every stream and the latched topics reached a subscriber in another process
-    streams = ("measured_js", "measured_cp", "measured_cf", "fbg/strains", "/clock")
+    streams = ["measured_js", "measured_cp", "measured_cf", "fbg/strains", "fbg/wavelengths"]
+    streams.append("/clock")
     assert all(seen["counts"].get(t, 0) > 20 for t in streams), seen["counts"]
     assert seen["counts"]["/diagnostics"] >= 1
     assert seen["counts"]["trial/result"] == 1
@@ -212,18 +216,103 @@ def test_sigterm_mid_trial_retracts_and_leaves_a_complete_log(
     assert read_recording(found.with_suffix(".mcap")).complete
 
 
+def _moved_and_held(jog: dict[str, Any]) -> None:
+    """The jog moved 1 mm on command; silent, within the command timeout (and a step's travel)
+    it held, and then stayed put."""
+    quiet = jog["quiet"]
+    assert quiet[0][1] >= jog["start"] + 1e-3 - 20e-6
+    held = [a for t, a in quiet if t > quiet[0][0] + COMMAND_TIMEOUT_S + 0.5]
+    assert held
+    assert max(held) - min(held) < 5e-6
+    assert max(held) - quiet[0][1] < 1.5e-3  # at most a step on from where the commands stopped
+
+
+def test_servo_jp_moves_the_robot_and_zero_takes_the_strains_zero_at_rest(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+) -> None:
+    """A lab controller's CRTK joint goals move the robot through the jog's guards; ``zero``
+    answers with the zero its session took, then takes a new one where the robot rests."""
+    seen = client(domain, "zero", "servo", "zero")
+    first, second = seen["answers"]
+    assert first["success"], first["message"]
+    assert second["success"], second["message"]
+    zeros = [json.loads(a["message"]) for a in (first, second)]
+    peaks = {len(z["zero_wavelengths_m"]) for z in zeros} | {len(z["noise_m"]) for z in zeros}
+    assert len(peaks) == 1 and peaks != {0}  # noqa: PT018  (one peak count, and peaks)
+    assert all(1.4e-6 < w < 1.7e-6 for z in zeros for w in z["zero_wavelengths_m"])
+    assert zeros[0] != zeros[1]  # a new zero (new frames), not the first one again
+    _moved_and_held(seen["jogs"][0])
+
+
+def test_a_trial_whose_caller_dies_retracts(
+    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+) -> None:
+    """The client that asked for a trial is terminated mid-trial (its rclpy leaves the DDS graph
+    on SIGTERM): the node sees the service's last client gone and stops the trial; it retracts
+    and ends ``aborted``."""
+    caller = subprocess.Popen(
+        [sys.executable, str(CLIENT), "run_trial", "ready@20"],
+        env=domain,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert caller.stdout is not None
+    try:
+        assert caller.stdout.readline().strip() == "under way"
+    finally:
+        caller.terminate()
+        caller.wait()
+        caller.stdout.close()
+    [result] = client(domain, "result")["answers"]
+    row = json.loads(result["message"])
+    assert row["state"] == "aborted"
+    assert row["reason"] == "aborted: stop requested"
+    assert read_log(row["log"]).end["state"] == "aborted"
+
+
 def test_a_gamepad_jogs_the_robot_and_its_silence_holds_it(
     node: tuple[dict[str, Any], Path], domain: dict[str, str]
 ) -> None:
     seen = client(domain, "joy", "run_trial")
     [jog] = seen["jogs"]
-    quiet = jog["quiet"]
-    assert quiet[0][1] >= jog["start"] + 1e-3 - 20e-6  # it moved 1 mm on command
-    # silent: within the command timeout (and a step's travel) it holds, and then stays put
-    held = [a for t, a in quiet if t > quiet[0][0] + COMMAND_TIMEOUT_S + 0.5]
-    assert held
-    assert max(held) - min(held) < 5e-6
-    assert max(held) - quiet[0][1] < 1.5e-3  # at most a step on from where the commands stopped
+    _moved_and_held(jog)
     [busy] = seen["answers"]  # the jog holds the robot: no trial meanwhile
     assert not busy["success"]
     assert busy["message"] == "busy: teleop runs"
+
+
+def test_on_the_bench_the_node_runs_the_bench_files_trials_on_its_ports(
+    tmp_path: Path, domain: dict[str, str]
+) -> None:
+    """``palpate ros --config bench.yaml`` on ``palpate emulate``'s ptys (the SDK and pyserial
+    path of the hardware, in real time): the zero at rest, a trial of the bench file that a
+    stop retracts, its log the bench's."""
+    emulate = [sys.executable, "-m", "palpate", "emulate", "--scene", "scenes/robot.yaml"]
+    emulator = subprocess.Popen(
+        [*emulate, "--seconds", str(WAIT_S), "--json"], stdout=subprocess.PIPE, text=True
+    )
+    assert emulator.stdout is not None
+    try:
+        ports = json.loads(emulator.stdout.readline())
+        where = ("--config", "bench.yaml", "--servo-port", ports["dynamixel"])
+        for facts, _ in _node(tmp_path, domain, "", *where, "--board-port", ports["board"]):
+            assert "/clock" not in facts["topics"]  # the bench's clock is the wall's
+            seen = client(domain, "zero", "run_trial", "stop@30")
+    finally:
+        emulator.terminate()
+        emulator.communicate(timeout=WAIT_S)
+    zero, trial, stop = seen["answers"]
+    assert zero["success"], zero["message"]
+    assert len(json.loads(zero["message"])["zero_wavelengths_m"]) >= 1
+    assert stop["success"]
+    row = json.loads(trial["message"])
+    assert row["trial"] == "01-example-downward-S7"  # the bench file's first
+    assert row["state"] == "aborted"
+    assert row["reason"] == "aborted: stop requested"
+    assert Path(row["log"]).is_relative_to(tmp_path / "node")
+    log = read_log(row["log"])
+    assert log.header["source"] == "bench"
+    assert log.header["ports"]["servos"] == ports["dynamixel"]
+    assert log.end["state"] == "aborted"
+    assert seen["counts"]["fbg/wavelengths"] > 20
+    assert "/clock" not in seen["counts"]

@@ -6,6 +6,7 @@ model's keys, and the hold when the commands stop coming. Pure logic on
     pad = JoyMapping()
     for key in pad.keys(axes, buttons):   # each Joy message
         model.press(key)
+    servo_to(model, 0.004, None)           # a joint goal (servo_jp): advance 4 mm, roll as is
     hold(model, "no command for 0.5 s")    # the commands went quiet
 """
 
@@ -53,6 +54,21 @@ def _axis(axes: Sequence[float], index: int) -> float:
     return float(axes[index]) if 0 <= index < len(axes) else 0.0
 
 
+def servo_to(model: Teleop, advance: float | None, roll: float | None) -> None:
+    """A joint goal (m, rad; None: that joint as it is) through the jog's guards: refused
+    while latched or before a reading, each joint within a step of where the robot is."""
+    if model.state in LATCHED:
+        model.message = f"{model.state.value}: re-arm before moving"
+        return
+    if model.obs is None or model.goal is None:
+        model.message = "no reading from the drive yet"
+        return
+    if roll is not None and roll != model.goal.roll:
+        model.roll_to(roll)
+    if advance is not None and advance != model.goal.translation:
+        model.advance_to(advance, 1.0 if advance > model.goal.translation else -1.0)
+
+
 def hold(model: Teleop, why: str) -> None:
     """Stop where the robot is (its commands stopped coming): the goal becomes the last reading;
     a retraction, an emergency stop or a fault goes on as it was."""
@@ -65,4 +81,4 @@ def hold(model: Teleop, why: str) -> None:
     model.goal = here
 
 
-__all__ = ["JoyMapping", "hold"]
+__all__ = ["JoyMapping", "hold", "servo_to"]
