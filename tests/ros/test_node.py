@@ -6,6 +6,7 @@ the ones docs/ros2.md lists. Every test's DDS domain is its own, on the loopback
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import random
@@ -61,6 +62,26 @@ def _node(
         code = process.wait(timeout=WAIT_S)
         process.stdout.close()
         assert code == 0  # SIGTERM: a clean stop
+
+
+@contextlib.contextmanager
+def _trial_under_way(env: dict[str, str]) -> Iterator[subprocess.Popen[str]]:
+    """A client that has asked for a trial, once the trial has published 20 joint states."""
+    caller = subprocess.Popen(
+        [sys.executable, str(CLIENT), "run_trial", "ready@20"],
+        env=env,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert caller.stdout is not None
+    try:
+        assert caller.stdout.readline().strip() == "under way"
+        yield caller
+    finally:
+        if caller.poll() is None:
+            caller.kill()
+        caller.wait()
+        caller.stdout.close()
 
 
 def client(env: dict[str, str], *calls: str) -> dict[str, Any]:
@@ -193,21 +214,11 @@ def test_sigterm_mid_trial_retracts_and_leaves_a_complete_log(
     node = subprocess.Popen(command, env=domain, stdout=subprocess.PIPE, text=True)
     assert node.stdout is not None
     json.loads(node.stdout.readline())
-    caller = subprocess.Popen(
-        [sys.executable, str(CLIENT), "run_trial", "ready@20"],
-        env=domain,
-        stdout=subprocess.PIPE,
-        text=True,
-    )
-    assert caller.stdout is not None
     try:
-        assert caller.stdout.readline().strip() == "under way"  # 20 joint states of the trial
-        node.terminate()
-        assert node.wait(timeout=WAIT_S) == 0
+        with _trial_under_way(domain):
+            node.terminate()
+            assert node.wait(timeout=WAIT_S) == 0
     finally:
-        caller.kill()
-        caller.wait()
-        caller.stdout.close()
         node.stdout.close()
     [found] = (out / "logs").glob("*.jsonl")
     log = read_log(found)
@@ -250,19 +261,9 @@ def test_a_trial_whose_caller_dies_retracts(
     """The client that asked for a trial is terminated mid-trial (its rclpy leaves the DDS graph
     on SIGTERM): the node sees the service's last client gone and stops the trial; it retracts
     and ends ``aborted``."""
-    caller = subprocess.Popen(
-        [sys.executable, str(CLIENT), "run_trial", "ready@20"],
-        env=domain,
-        stdout=subprocess.PIPE,
-        text=True,
-    )
-    assert caller.stdout is not None
-    try:
-        assert caller.stdout.readline().strip() == "under way"
-    finally:
+    with _trial_under_way(domain) as caller:
         caller.terminate()
-        caller.wait()
-        caller.stdout.close()
+        caller.wait(timeout=WAIT_S)
     [result] = client(domain, "result")["answers"]
     row = json.loads(result["message"])
     assert row["state"] == "aborted"
