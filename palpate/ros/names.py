@@ -94,8 +94,8 @@ SERVICES: dict[str, tuple[str, str]] = {
 PARAMETERS: dict[str, tuple[str, str]] = {
     "trial": (
         "string",
-        "the trial `run_trial` runs next: a trial id or an index of the campaign ('' the next "
-        "in order)",
+        "the trial `run_trial` runs next: a trial id, an index of the campaign or, on the "
+        "bench, a stored target's name ('' the next in order)",
     ),
     "max_probes": (
         "integer",

@@ -213,7 +213,11 @@ class BenchRunner:
         return contextlib.nullcontext(self.hw)
 
     def spec(self, which: str) -> BenchTrial:
-        """The bench file's trial ``which`` names (see :func:`pick`)."""
+        """The bench file's trial ``which`` names (see :func:`pick`), or the first at the
+        stored target of that name."""
+        at_target = [t for t in self.trials if t.target.name == which]
+        if at_target and which not in {t.trial_id for t in self.trials}:
+            return at_target[0]
         return pick(self.trials, which, self.next, str(self.loaded.path))
 
     def run(self, spec: BenchTrial, view: View, stop: Callable[[], bool]) -> BenchOutcome:

@@ -286,8 +286,8 @@ def test_on_the_bench_the_node_runs_the_bench_files_trials_on_its_ports(
     tmp_path: Path, domain: dict[str, str]
 ) -> None:
     """``palpate ros --config bench.yaml`` on ``palpate emulate``'s ptys (the SDK and pyserial
-    path of the hardware, in real time): the zero at rest, a trial of the bench file that a
-    stop retracts, its log the bench's."""
+    path of the hardware, in real time): the zero at rest, the bench file's trial at a stored
+    target named in the parameter, which a stop retracts; its log the bench's."""
     emulate = [sys.executable, "-m", "palpate", "emulate", "--scene", "scenes/robot.yaml"]
     emulator = subprocess.Popen(
         [*emulate, "--seconds", str(WAIT_S), "--json"], stdout=subprocess.PIPE, text=True
@@ -298,16 +298,16 @@ def test_on_the_bench_the_node_runs_the_bench_files_trials_on_its_ports(
         where = ("--config", "bench.yaml", "--servo-port", ports["dynamixel"])
         for facts, _ in _node(tmp_path, domain, "", *where, "--board-port", ports["board"]):
             assert "/clock" not in facts["topics"]  # the bench's clock is the wall's
-            seen = client(domain, "zero", "run_trial", "stop@30")
+            seen = client(domain, "zero", "trial=example-downward", "run_trial", "stop@30")
     finally:
         emulator.terminate()
         emulator.communicate(timeout=WAIT_S)
-    zero, trial, stop = seen["answers"]
+    zero, _, trial, stop = seen["answers"]
     assert zero["success"], zero["message"]
     assert len(json.loads(zero["message"])["zero_wavelengths_m"]) >= 1
     assert stop["success"]
     row = json.loads(trial["message"])
-    assert row["trial"] == "01-example-downward-S7"  # the bench file's first
+    assert row["trial"] == "01-example-downward-S7"  # the first at that stored target
     assert row["state"] == "aborted"
     assert row["reason"] == "aborted: stop requested"
     assert Path(row["log"]).is_relative_to(tmp_path / "node")
