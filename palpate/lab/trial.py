@@ -114,6 +114,7 @@ def run_bench_trials(
     progress: Callable[[BenchOutcome], None] | None = None,
     live: View | None = None,
     session: Session | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> list[BenchOutcome]:
     """Run ``trials`` in order on opened hardware; one log per trial in ``log_dir``; each
     trial's ticks go to the ``live`` view when there is one (``palpate.live``).
@@ -122,7 +123,8 @@ def run_bench_trials(
     hardware it stays False. With ``stop_on_fault`` a trial that does not complete ends the
     session: the rest are reported as skipped, torque is off. A trial on a rigid reference
     calibrates the compliance of its tube (the stage) for the session's later trials (and,
-    with a ``session`` given, for what the caller runs after them).
+    with a ``session`` given, for what the caller runs after them). ``stop`` is asked every
+    tick (True: the trial retracts and ends ``aborted``).
     """
     bench = loaded.bench
     outcomes: list[BenchOutcome] = []
@@ -138,7 +140,14 @@ def run_bench_trials(
             hw.drive.bus.set_torque(True)
             torque_on = True
         outcome, rig = run_bench_trial(
-            hw, trial, loaded, session.stack, log_dir, sync_to_clock=sync_to_clock, live=live
+            hw,
+            trial,
+            loaded,
+            session.stack,
+            log_dir,
+            sync_to_clock=sync_to_clock,
+            live=live,
+            stop=stop,
         )
         session.add(trial, outcome)
         outcomes.append(outcome)

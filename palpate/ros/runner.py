@@ -28,7 +28,7 @@ from palpate.config.scene import CampaignConfig, SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.lab.hardware import Hardware, open_hardware
 from palpate.lab.plan import plan_session
-from palpate.lab.trial import PLANNED, BenchOutcome, BenchTrial, Session, run_bench_trial
+from palpate.lab.trial import BenchOutcome, BenchTrial, Session, run_bench_trials
 from palpate.live import View
 from palpate.sensor.clock import SystemClock
 from palpate.services.campaign import CampaignRequest, prepare
@@ -221,16 +221,14 @@ class BenchRunner:
         return pick(self.trials, which, self.next, str(self.loaded.path))
 
     def run(self, spec: BenchTrial, view: View, stop: Callable[[], bool]) -> BenchOutcome:
-        """One trial with the session's calibration so far; ``stop`` asked every tick."""
+        """One trial with the session's calibration so far, as ``palpate trial`` runs each
+        (``lab.trial.run_bench_trials``: the calibration kept, the file's ``after_trial``);
+        ``stop`` asked every tick."""
         self.next = self.trials.index(spec) + 1
-        self.log_dir.mkdir(parents=True, exist_ok=True)
-        self.hw.drive.bus.set_torque(True)  # a jog, a fault or a release may have turned it off
-        outcome, rig = run_bench_trial(
-            self.hw, spec, self.loaded, self.session.stack, self.log_dir, live=view, stop=stop
+        hw, session = self._ready(), self.session
+        [outcome] = run_bench_trials(
+            hw, [spec], self.loaded, self.log_dir, live=view, session=session, stop=stop
         )
-        self.session.add(spec, outcome)
-        if outcome.state in PLANNED and self.loaded.bench.after_trial == "release":
-            rig.release()
         return outcome
 
     def survey(self, view: View, max_probes: int | None = None) -> SurveyResult:
@@ -245,11 +243,16 @@ class BenchRunner:
                 loaded.bench, map=dataclasses.replace(m, max_probes=max_probes)
             )
             loaded = dataclasses.replace(loaded, bench=bench)
+        return run_bench_map(
+            self._ready(), self.template, loaded, self.session.stack, self.log_dir, live=view
+        )
+
+    def _ready(self) -> Hardware:
+        """The open bench, torque on (a jog, a fault or a release may have turned it off), the
+        log folder made."""
         self.log_dir.mkdir(parents=True, exist_ok=True)
         self.hw.drive.bus.set_torque(True)
-        return run_bench_map(
-            self.hw, self.template, loaded, self.session.stack, self.log_dir, live=view
-        )
+        return self.hw
 
 
 __all__ = ["BenchRunner", "SimRunner", "pick"]

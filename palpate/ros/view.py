@@ -36,7 +36,7 @@ from palpate.live import Publisher, beam_reading
 from palpate.robot.guards import Observation
 from palpate.robot.indentation import State
 from palpate.robot.records.ros2 import JOINTS, nanoseconds, tip_transforms
-from palpate.wire.frame import FM, Frame
+from palpate.wire.frame import Frame
 
 from .names import grating_labels, peak_labels
 
@@ -187,10 +187,10 @@ def _array(data: list[float], labels: list[str]) -> Float64MultiArray:
 
 def _wavelengths(frame: Frame) -> Float64MultiArray:
     """A frame's peak wavelengths (m), every grating the board reports, its reference last."""
-    peaks = [fm * FM for fm in frame.peak_fm]
+    peaks = [float(w) for w in frame.wavelengths]
     labels = peak_labels(len(peaks))
-    if frame.reference_fm is not None:
-        peaks.append(frame.reference_fm * FM)
+    if frame.reference is not None:
+        peaks.append(frame.reference)
         labels.append("reference")
     return _array(peaks, labels)
 
