@@ -16,14 +16,14 @@ TICK = 4e-3
 
 
 def record(
-    drift: float, noise: float = 0.05e-3, seed: int = 0
+    drift: float, noise: float = 0.05e-3, seed: int = 0, retract: float = 5e-3
 ) -> tuple[list[str], np.ndarray, list[float | None], np.ndarray]:
     """A trial against a surface at 10 mm drifting ``drift`` m/s toward the sensor: approach
-    at 1 mm/s from 8 mm, indent at 0.5 mm/s to 12 mm, retract at 5 mm/s."""
+    at 1 mm/s from 8 mm, indent at 0.5 mm/s to 12 mm, retract at ``retract`` m/s."""
     rng = np.random.default_rng(seed)
     u_in = np.arange(8e-3, 12e-3, 1e-3 * TICK)
     states = ["approach" if u < 10e-3 else "indenting" for u in u_in]
-    u_out = np.arange(12e-3, 8e-3, -5e-3 * TICK)
+    u_out = np.arange(12e-3, 8e-3, -retract * TICK)
     u = np.concatenate([u_in, u_out])
     states += ["retracting"] * u_out.size
     t = np.arange(u.size) * TICK
@@ -50,6 +50,14 @@ def test_a_drifting_surface_moves_by_its_drift_between_touch_and_release() -> No
     away = surface_motion(*record(-0.2e-3))
     assert away is not None
     assert away.moved < -50e-6
+
+
+def test_a_retraction_too_fast_for_the_small_loads_is_read_through_a_wider_band() -> None:
+    # at 80 mm/s the way out crosses the small loads in one or two records
+    states, u, f, t = record(0.2e-3, retract=80e-3)
+    motion = surface_motion(states, u, f, t)
+    assert motion is not None
+    assert motion.moved == pytest.approx(0.2e-3 * (motion.release - motion.touch), abs=40e-6)
 
 
 def test_no_motion_without_an_approach_or_a_release() -> None:

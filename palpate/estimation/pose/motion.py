@@ -35,8 +35,9 @@ from numpy.typing import ArrayLike
 from ..detect.contact import difference_sigma
 
 LEVEL_SIGMAS = (5.0, 15.0)  # the band of loads read, in the load's noise above its zero
-PEAK_SHARE = 0.25  # the band reaches this share of the peak load at least (a fast retraction
-# passes a stiff tissue's 15 sigma in a record or two)
+PEAK_SHARES = (0.25, 0.5)  # the band reaches this share of the peak load at least, the second
+# where a branch has too few records in the first (a fast retraction passes a stiff tissue's 15
+# sigma in a record or two; the heart's beat can hurry it further)
 FREE_ROWS = 5  # the approach's records the zero and the noise need at least
 FREE_STATE = "approach"
 OUT_STATE = "retracting"
@@ -85,24 +86,37 @@ def surface_motion(
     if free is None:
         return None
     zero, sigma = free
-    lo, hi = (zero + k * sigma for k in LEVEL_SIGMAS)
-    hi = max(hi, zero + PEAK_SHARE * (float(np.max(f[keep])) - zero))
-    band = keep & (f >= lo) & (f <= hi)
+    lo = zero + LEVEL_SIGMAS[0] * sigma
     out = s == OUT_STATE
     before_out = np.arange(s.size) < (int(np.argmax(out)) if out.any() else s.size)
-    loading = band & before_out
-    past = np.flatnonzero(keep & (f > hi) & before_out)
-    if past.size:  # the first pass through the band: up to the load's first rise past it
-        loading &= np.arange(s.size) < past[0]
-    unloading = band & out
-    if np.count_nonzero(loading) < MIN_ROWS or np.count_nonzero(unloading) < MIN_ROWS:
-        return None
+    for share in PEAK_SHARES:
+        hi = max(zero + LEVEL_SIGMAS[1] * sigma, zero + share * (float(np.max(f[keep])) - zero))
+        band = keep & (f >= lo) & (f <= hi)
+        loading = band & before_out
+        past = np.flatnonzero(keep & (f > hi) & before_out)
+        if past.size:  # the first pass through the band: up to the load's first rise past it
+            loading &= np.arange(s.size) < past[0]
+        unloading = band & out
+        if min(np.count_nonzero(loading), np.count_nonzero(unloading)) >= MIN_ROWS:
+            return _between(u, t if times is not None else None, f, (loading, unloading), lo, hi)
+    return None
+
+
+def _between(
+    u: np.ndarray,
+    t: np.ndarray | None,
+    f: np.ndarray,
+    branches: tuple[np.ndarray, np.ndarray],
+    lo: float,
+    hi: float,
+) -> Motion:
+    """The motion between the loading and the unloading branch's lines at the band's middle."""
     middle = 0.5 * (lo + hi)
-    (u_in, se_in), (u_out, se_out) = (_at(u[b], f[b], middle) for b in (loading, unloading))
+    (u_in, se_in), (u_out, se_out) = (_at(u[b], f[b], middle) for b in branches)
     sigma = math.hypot(se_in, se_out)
-    if times is None:
+    if t is None:
         return Motion(u_in - u_out, sigma=sigma)
-    touch, release = (_at(t[b], f[b], middle)[0] for b in (loading, unloading))
+    touch, release = (_at(t[b], f[b], middle)[0] for b in branches)
     return Motion(u_in - u_out, touch, release, sigma)
 
 

@@ -215,7 +215,7 @@ def fit_rows(
     drift = inputs.motion_tolerance is not None  # taken out where the campaign expects it
     raw, (rows, motion, heart) = rows, still_record(rows, times, tip_forces, beats, drift, joint)
     fitted = fit(rows)
-    envelope = motion_envelope(fitted.joint, raw, times, motion, heart, drift, joint)
+    envelope = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)
     fitted = dataclasses.replace(fitted, joint=envelope, motion=motion, heart=heart)
     if inputs.rigid:
         return fitted

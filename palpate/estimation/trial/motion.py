@@ -29,8 +29,9 @@ JointOf = Callable[[list[Row]], JointFit | None]
 DRIFT_SIGMAS = 3.0
 HEART_SCALES = (0.6, 2.0)  # of the least squares' amplitude (which reads 10-40 % small)
 HEART_STEP = 0.05  # of it: the residual's curvature is read this far either side
-HEART_FLOOR = 0.05  # the amplitude's standard error at least (of it): the residual's minimum
-# lies 0-10 % below the true amplitude on the scenes of docs/invivo.md (drift, the law's form)
+HEART_FLOOR = 0.10  # the amplitude's standard error at least (of it): the residual's minimum
+# lies 0-10 % below the true amplitude on the scenes of docs/invivo.md (the law's form), up to
+# 25 % below where the hold's drift is as fast as the indentation (a soft sample's long contact)
 HEART_ROWS = ("contact", "indenting")  # rows whose load is the tissue's (not the buckled beam's)
 
 
@@ -145,19 +146,32 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
 
 
 def heart_envelope(
-    joint: JointFit | None,
-    rows: list[Row],
-    times: Sequence[float],
-    heart: Heartbeat,
-    fit: JointOf,
+    joint: JointFit | None, heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]
 ) -> JointFit | None:
-    """``joint`` with its interval spanning the fits ``fit`` gives of ``rows`` (as recorded)
-    taken against ``heart`` at ``DRIFT_SIGMAS`` standard errors of its amplitude either side."""
+    """``joint`` with its interval spanning the fits ``fit`` gives of the record taken against
+    ``heart`` at ``DRIFT_SIGMAS`` standard errors of its amplitude either side (``fit`` measures
+    the drift again at each, as the amplitude's search did: the two move together)."""
     if joint is None or joint.ci_low is None or joint.ci_high is None or heart.amplitude <= 0:
         return joint
     sigmas = (-DRIFT_SIGMAS, DRIFT_SIGMAS)
     factors = [max(0.0, 1.0 + k * heart.sigma / heart.amplitude) for k in sigmas]
-    return spanning(joint, [fit(beating_rows(rows, times, heart.scaled(f))) for f in factors])
+    return spanning(joint, [fit(heart.scaled(f)) for f in factors])
+
+
+def steady_rows(
+    rows: list[Row],
+    times: Sequence[float] | None,
+    tip_forces: Sequence[float | None] | None,
+    beat: Heartbeat | None,
+    drift: bool,
+) -> tuple[list[Row], Motion | None]:
+    """The rows taken against ``beat`` (where given) and then (with ``drift``) against the drift
+    measured on them between touch and release; the motion as measured after the beat."""
+    still = rows if beat is None or times is None else beating_rows(rows, times, beat)
+    motion = record_motion(still, tip_forces, times)
+    if motion is not None and times is not None and drift:
+        still = still_rows(still, times, motion.velocity, motion.touch)
+    return still, motion
 
 
 def still_record(
@@ -172,46 +186,35 @@ def still_record(
     ECG's R waves, then (with ``drift``, where the campaign expects the tissue to move) the
     drift measured between touch and release; the motion as measured (after the beat) and the
     beat. ``fit``: the joint fit of rows (the beat's amplitude is set by its residual)."""
-
-    def steady(beat: Heartbeat | None) -> tuple[list[Row], Motion | None]:
-        still = rows if beat is None or times is None else beating_rows(rows, times, beat)
-        motion = record_motion(still, tip_forces, times)
-        if motion is not None and times is not None and drift:
-            still = still_rows(still, times, motion.velocity, motion.touch)
-        return still, motion
-
     heart = record_heart(rows, tip_forces, times, pulses)
     if heart is not None:
-        heart = fitted_heart(heart, lambda beat: fit(steady(beat)[0]))
-    return (*steady(heart), heart)
+        heart = fitted_heart(
+            heart, lambda beat: fit(steady_rows(rows, times, tip_forces, beat, drift)[0])
+        )
+    return (*steady_rows(rows, times, tip_forces, heart, drift), heart)
 
 
 def motion_envelope(
     joint: JointFit | None,
     raw: list[Row],
     times: Sequence[float] | None,
-    motion: Motion | None,
-    heart: Heartbeat | None,
+    tip_forces: Sequence[float | None] | None,
+    found: tuple[Motion | None, Heartbeat | None],
     drift: bool,
     fit: JointOf,
 ) -> JointFit | None:
     """``joint`` (the fit of :func:`still_record`'s rows of ``raw``) with its interval spanning
-    the fits at the drift's velocity and at the beat's amplitude ``DRIFT_SIGMAS`` standard
-    errors either side (each with the other taken out as measured)."""
+    the fits at the drift's velocity ``DRIFT_SIGMAS`` standard errors either side (the beat
+    taken out as found) and at the beat's amplitude as many either side (the drift measured
+    again at each). ``found``: the motion and the beat :func:`still_record` gave."""
+    motion, heart = found
     if times is None:
         return joint
-    drifting = drift and motion is not None
-    beating = raw if heart is None else beating_rows(raw, times, heart)
-    if drifting:
-        assert motion is not None
+    if drift and motion is not None:
+        beating = raw if heart is None else beating_rows(raw, times, heart)
         joint = drift_envelope(joint, beating, times, motion, fit)
     if heart is not None:
-
-        def still(rows: list[Row]) -> JointFit | None:
-            if not drifting:
-                return fit(rows)
-            assert motion is not None
-            return fit(still_rows(rows, times, motion.velocity, motion.touch))
-
-        joint = heart_envelope(joint, raw, times, heart, still)
+        joint = heart_envelope(
+            joint, heart, lambda beat: fit(steady_rows(raw, times, tip_forces, beat, drift)[0])
+        )
     return joint
