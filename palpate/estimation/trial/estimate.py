@@ -197,10 +197,12 @@ def fit_rows(
     beside them the load's lean from the rows before buckling (``estimation.trial.lean``) and, with
     each row's time (s) and a hold in the rows, the relaxation (``estimation.trial.relaxed``). With
     each row's tip-grating load (N), the joint fit reads the load from it; with the ticks (s)
-    of an ECG's R-wave pulses, in a gated trial (its rows wait for a breath hold), the heart's beat
-    is taken out (``estimation.trial.motion``)."""
+    of an ECG's R-wave pulses, in a gated trial (``inputs.gated``; for a log that predates it,
+    rows that wait for a breath hold), the heart's beat is taken out
+    (``estimation.trial.motion``)."""
     rows = list(rows)
-    beats = beats if any(r[0] == WAITING for r in rows) else None  # in a breath hold only
+    held = inputs.gated if inputs.gated is not None else any(r[0] == WAITING for r in rows)
+    beats = beats if held else None  # in a breath hold only (a trial may arrive in one)
     rows, times, tip_forces = last_attempt(rows, times, tip_forces)  # of a gated trial
     gratings = len(stack.sensor.used_gratings)
 

@@ -63,6 +63,9 @@ class EstimatorInputs:
             then carries the finite-strain departure, ``estimation.contact.finite_strain``).
         tip_contact: the believed tip contact, ``"frictionless"`` or ``"sticking"``;
             tip_contact_options: both when the friction is ``unknown``, None otherwise.
+        gated: the trial waited for a breath hold (the campaign's gate) and indented in it, so
+            an ECG's R waves are taken out as the heart's beat; None (a log that predates it):
+            as the rows show, a gated trial's waiting rows.
         version: the inputs' format (VERSION; 1 for logs that predate it).
     """
 
@@ -92,6 +95,7 @@ class EstimatorInputs:
     material: str = "linear"
     tip_contact: str = "frictionless"
     tip_contact_options: tuple[str, ...] | None = None
+    gated: bool | None = None
     version: int = VERSION
 
     @property
