@@ -7,6 +7,8 @@ nothing of it runs."""
 from __future__ import annotations
 
 import dataclasses
+import json
+from pathlib import Path
 
 import pytest
 
@@ -75,3 +77,25 @@ def test_without_a_heart_nothing_of_it_runs(tmp_path_factory: pytest.TempPathFac
     assert not any(r.get("beat") for r in read_log(outcome.log_path).of_kind("sample"))
     assert outcome.verdict is not None
     assert not any(r.startswith("heartbeat") for r in outcome.verdict.reasons)
+
+
+def arrived_in_a_hold(log: str | Path, out: Path, *, gated: bool | None) -> Path:
+    """``log`` as a trial that arrived in a breath hold writes it (no waiting rows), its
+    estimator told ``gated`` (None: a log that predates it)."""
+    header, *records = (json.loads(line) for line in Path(log).read_text().splitlines())
+    header["estimator"].pop("gated", None)
+    if gated is not None:
+        header["estimator"]["gated"] = gated
+    kept = [r for r in records if not (r["kind"] == "sample" and r["state"] == "waiting")]
+    out.write_text("".join(json.dumps(r) + "\n" for r in [header, *kept]))
+    return out
+
+
+def test_a_gated_trial_that_arrives_in_a_hold_takes_the_beat_out(
+    beating: TrialOutcome, tmp_path: Path
+) -> None:
+    assert beating.log_path is not None
+    told = replay(arrived_in_a_hold(beating.log_path, tmp_path / "told.jsonl", gated=True))
+    assert told["joint"]["modulus"] == pytest.approx(2e3, rel=0.1)
+    older = replay(arrived_in_a_hold(beating.log_path, tmp_path / "older.jsonl", gated=None))
+    assert older["joint"]["modulus"] < 0.8 * 2e3  # the beat left in: the estimate reads low
