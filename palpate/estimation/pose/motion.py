@@ -8,7 +8,8 @@ the release is then the advance at the first touch less the surface's displaceme
 sensor. So the motion is measured, not assumed: through a band of small loads
 (``LEVEL_SIGMAS``: 5 to 15 times the load's noise above its zero, both from the approach's
 records, the sensor free after the last zero; up to a quarter of the peak load at least, so a
-fast retraction from stiff tissue still leaves records in it) a line of advance against load
+fast retraction from stiff tissue still leaves records in it, and half of it where a branch
+still has too few) a line of advance against load
 on the way in (the first pass) and one on the way out (the retraction), the two advances at
 the band's middle load apart. A line through the band, not one crossing: one record's noise
 would move a crossing by its share of the band.

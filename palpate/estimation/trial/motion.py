@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -131,7 +132,9 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
         return float(joint.rms) ** 2
 
     lo, hi = HEART_SCALES
-    found = minimize_scalar(score, bounds=(lo, hi), method="bounded", options={"xatol": 0.01})
+    with warnings.catch_warnings():  # a failed fit scores inf: the search steps around it
+        warnings.simplefilter("ignore", RuntimeWarning)
+        found = minimize_scalar(score, bounds=(lo, hi), method="bounded", options={"xatol": 0.01})
     if not math.isfinite(found.fun):
         return heart
     best, step = float(found.x), HEART_STEP
