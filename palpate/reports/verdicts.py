@@ -10,6 +10,7 @@ import statistics
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
+from palpate.estimation.jointfit import JointFit
 from palpate.estimation.verdict import STATUSES
 from palpate.simulation.trial import TrialOutcome
 
@@ -187,20 +188,38 @@ def relaxed_tally(outcomes: Iterable[TrialOutcome]) -> RelaxedTally:
 
 def classified(outcomes: Iterable[TrialOutcome], threshold: float) -> dict[str, object]:
     """How the joint fit's numbers sort the samples at a diagnostic ``threshold`` (Pa): of the
-    trials with a number (ok, suspect), how many fall on the true side, and of the ok ones."""
+    trials with a number (ok, suspect), how many fall on the true side, and of the ok ones; and
+    of those whose 95 % interval lies wholly on one side (``decided``: the trial's own call;
+    the others say the side is not known), how many on the true side."""
     rows = [
-        (o.status, o.joint.modulus, o.spec.modulus)
+        (o.status, o.joint, o.joint.modulus, o.spec.modulus)
         for o in estimating(outcomes)
         if o.status != "none" and o.joint is not None and o.joint.modulus is not None
     ]
-    right = [s for s, m, true in rows if (m >= threshold) == (true >= threshold)]
+    calls = [
+        (s, modulus >= threshold, true >= threshold, _side(j, threshold))
+        for s, j, modulus, true in rows
+    ]
+    right = [s for s, m, true, _ in calls if m == true]
+    decided = [(side, true) for _, _, true, side in calls if side is not None]
     return {
         "threshold_kpa": threshold / 1e3,
         "with_number": len(rows),
         "right_side": len(right),
-        "ok": sum(1 for s, _, _ in rows if s == "ok"),
+        "ok": sum(1 for s, *_ in rows if s == "ok"),
         "ok_right_side": sum(1 for s in right if s == "ok"),
+        "decided": len(decided),
+        "decided_right_side": sum(1 for side, true in decided if side == true),
     }
+
+
+def _side(joint: JointFit, threshold: float) -> bool | None:
+    """True: the interval lies above ``threshold``, False: below, None: across it (or none)."""
+    if joint.ci_low is None or joint.ci_high is None:
+        return None
+    if joint.ci_low >= threshold:
+        return True
+    return False if joint.ci_high < threshold else None
 
 
 def classified_line(outcomes: Sequence[TrialOutcome], threshold: float | None) -> list[str]:
@@ -211,7 +230,8 @@ def classified_line(outcomes: Sequence[TrialOutcome], threshold: float | None) -
     return [
         f"at the scene's threshold of {c['threshold_kpa']:g} kPa: {c['right_side']}/"
         f"{c['with_number']} trials with a number on the true side ({c['ok_right_side']}/"
-        f"{c['ok']} ok)"
+        f"{c['ok']} ok); {c['decided_right_side']}/{c['decided']} of those whose interval lies "
+        "on one side (the others' intervals cross it)"
     ]
 
 
