@@ -148,6 +148,12 @@ class CampaignConfig:
     # "board": wait at the stand-off for the ventilator's breath hold (frame status bit 6, the
     # world's fidelity.breathing.gate), indent within it (robot/indentation.py); "none": go.
     gate: Literal["none", "board"] = "none"
+
+    @property
+    def gated(self) -> bool:
+        """A trial waits for the board's breath-hold gate and indents in the hold."""
+        return self.gate == "board"
+
     # The orthogonal contact must lie this close to where the plan aimed (on the sample).
     miss_tolerance_mm: float = field(default=30.0, metadata=limits(gt=0, le=500))
     probe_points: int = field(default=4, metadata=limits(ge=3, le=9))  # touches; >= 5: spheres

@@ -224,7 +224,7 @@ def bench_inputs(trial: BenchTrial, loaded: LoadedBench, stack: StackConfig) -> 
         compliance_calibrated=calibrated,
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
         motion_tolerance=c.motion_tolerance,
-        gated=c.gate == "board",
+        gated=c.gated,
         travel_window=c.max_travel_past_contact_mm * MM,
         designed_range=stack.sensor.designed_range,
         rigid=trial.rigid,

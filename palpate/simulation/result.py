@@ -180,7 +180,7 @@ def estimator_inputs(
         compliance_calibrated=calibrated,
         misalignment_tolerance=math.radians(c.misalignment_tolerance_deg),
         motion_tolerance=c.motion_tolerance,
-        gated=c.gate == "board",
+        gated=c.gated,
         travel_window=c.max_travel_past_contact,
         designed_range=stack.sensor.designed_range,
         rigid=sample.rigid,

@@ -88,10 +88,11 @@ def surface_motion(
         return None
     zero, sigma = free
     lo = zero + LEVEL_SIGMAS[0] * sigma
+    peak = float(np.max(f[keep])) - zero
     out = s == OUT_STATE
     before_out = np.arange(s.size) < (int(np.argmax(out)) if out.any() else s.size)
     for share in PEAK_SHARES:
-        hi = max(zero + LEVEL_SIGMAS[1] * sigma, zero + share * (float(np.max(f[keep])) - zero))
+        hi = zero + max(LEVEL_SIGMAS[1] * sigma, share * peak)
         band = keep & (f >= lo) & (f <= hi)
         loading = band & before_out
         past = np.flatnonzero(keep & (f > hi) & before_out)

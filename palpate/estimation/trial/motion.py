@@ -177,6 +177,18 @@ def steady_rows(
     return still, motion
 
 
+def beat_fit(
+    rows: list[Row],
+    times: Sequence[float] | None,
+    tip_forces: Sequence[float | None] | None,
+    drift: bool,
+    fit: JointOf,
+) -> Callable[[Heartbeat], JointFit | None]:
+    """The joint fit ``fit`` of ``rows`` taken against a beat (:func:`steady_rows`: the drift
+    measured again after it): what the amplitude's search and its interval both read."""
+    return lambda beat: fit(steady_rows(rows, times, tip_forces, beat, drift)[0])
+
+
 def still_record(
     rows: list[Row],
     times: Sequence[float] | None,
@@ -191,9 +203,7 @@ def still_record(
     beat. ``fit``: the joint fit of rows (the beat's amplitude is set by its residual)."""
     heart = record_heart(rows, tip_forces, times, pulses)
     if heart is not None:
-        heart = fitted_heart(
-            heart, lambda beat: fit(steady_rows(rows, times, tip_forces, beat, drift)[0])
-        )
+        heart = fitted_heart(heart, beat_fit(rows, times, tip_forces, drift, fit))
     return (*steady_rows(rows, times, tip_forces, heart, drift), heart)
 
 
@@ -217,7 +227,5 @@ def motion_envelope(
         beating = raw if heart is None else beating_rows(raw, times, heart)
         joint = drift_envelope(joint, beating, times, motion, fit)
     if heart is not None:
-        joint = heart_envelope(
-            joint, heart, lambda beat: fit(steady_rows(raw, times, tip_forces, beat, drift)[0])
-        )
+        joint = heart_envelope(joint, heart, beat_fit(raw, times, tip_forces, drift, fit))
     return joint

@@ -208,7 +208,7 @@ def trial_plan(
         indent_speed=campaign.indent_speed_mm_per_s * MM,
         position_tolerance=position_tolerance(stack),
         hold_time=campaign.hold_s,
-        gated=campaign.gate == "board",
+        gated=campaign.gated,
     )
 
 
