@@ -146,6 +146,23 @@ def best_roll(tube: TubeConfig, normal: Vector) -> tuple[float, float]:
     return roll, math.acos(max(-1.0, min(1.0, cos_res)))
 
 
+def body_points(tube: TubeConfig, roll: float, translation: float, n: int = 24) -> Vector:
+    """Points (k, 3) along what the robot puts in front of its base at a joint state: the
+    tube's straight part, its arc (``n`` points each) and the sensor out to its tip sphere's
+    centre, for checking that they keep clear of tissue (``robot.positioner``)."""
+    a, ls, la = tube.tip_angle, tube.straight_length, tube.arc_length
+    straight = np.outer(np.linspace(0.0, ls, n), (1.0, 0.0, 0.0))
+    s = np.linspace(0.0, la, n + 1)[1:]
+    theta = a * s / la if la > 0 else np.zeros_like(s)
+    sin_over = np.sinc(theta / math.pi)  # sin(theta)/theta, the arc with its radius la/a
+    one_minus_cos_over = 0.5 * theta * np.sinc(theta / (2.0 * math.pi)) ** 2
+    arc = np.column_stack([ls + s * sin_over, np.zeros_like(s), -s * one_minus_cos_over])
+    pose = forward(tube, 0.0, translation)
+    steps = np.linspace(0.0, max(pose.exposed_length, 0.0), n + 1)[1:, None]
+    sensor = pose.tube_tip + steps * pose.tangent
+    return np.asarray(np.vstack([straight, arc, sensor]) @ _rot_x(roll).T)
+
+
 def apex(tube: TubeConfig) -> Vector | None:
     """The point (3,) of the x axis every tip tangent line of a bent tube passes through, at any
     roll (None for a straight tube, whose only line is the x axis itself)."""
@@ -192,10 +209,11 @@ def solve_for_tube(
     return dataclasses.replace(sol, status=status)
 
 
-def _roll_for(
+def roll_for(
     tube: TubeConfig, n: Vector, roll_limits: tuple[float, float]
 ) -> tuple[float, float, int]:
-    """(roll, residual, status 0 or 4) of the best roll for the outward normal ``n``."""
+    """(roll, residual, status 0 or 4) of the best roll within ``roll_limits`` for the outward
+    normal ``n``: :func:`best_roll`, turned by whole turns into the limits (status 4 if none)."""
     roll, residual = best_roll(tube, n)
     fitted = _fit_roll(roll, roll_limits)
     return (roll, residual, 4) if fitted is None else (fitted, residual, 0)
@@ -204,7 +222,7 @@ def _roll_for(
 def _on_plane(
     tube: TubeConfig, p: Vector, n: Vector, tip_radius: float, roll_limits: tuple[float, float]
 ) -> IKSolution:
-    roll, residual, status = _roll_for(tube, n, roll_limits)
+    roll, residual, status = roll_for(tube, n, roll_limits)
     pose = forward(tube, roll, tube.flush_translation)
     approach = float(n @ pose.tangent)  # = -cos(residual)
     if approach > -1e-12:
@@ -225,7 +243,7 @@ def _on_sphere(
     centre_of_sphere = surface.centre
     x = apex(tube)
     towards = surface.normal if x is None else _unit(x - centre_of_sphere)
-    roll, _, status = _roll_for(tube, towards, roll_limits)
+    roll, _, status = roll_for(tube, towards, roll_limits)
     pose = forward(tube, roll, tube.flush_translation)
     exposed = surface.offset(tip_radius).ray_hit(pose.tube_tip, pose.tangent)
     if not math.isfinite(exposed):
