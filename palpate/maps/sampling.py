@@ -147,12 +147,7 @@ class Active:
         return [(floor, 1.0), (min(low, m.background - math.log1p(MIN_RISE)), -1.0)]
 
     def _known(self, mean: FloatArray, sd: FloatArray, t: float, sign: float = 1.0) -> bool:
-        p = above(sign * mean, sd, sign * t).reshape(GRID, GRID)
-        cell = self.patch.area / (GRID - 1) ** 2
-        band = float(np.count_nonzero((p > 0.05) & (p < 0.95))) * cell
-        region = p > 0.5
-        edge = region & ~_interior(region)
-        length = float(np.count_nonzero(edge)) * math.sqrt(cell)
+        band, length = level_band(self.patch, mean, sd, t, sign)
         return band <= self.tolerance * max(length, self.tolerance)
 
     def _too_close(self, probes: Sequence[Probe]) -> NDArray[np.bool_]:
@@ -171,6 +166,20 @@ class Active:
                 return point
         self.stopped = f"fewer than {MIN_PROBES} probes gave a number"
         return None
+
+
+def level_band(
+    patch: Patch, mean: FloatArray, sd: FloatArray, t: float, sign: float = 1.0
+) -> tuple[float, float]:
+    """How well the level ``t`` of log E is known over ``patch`` (``mean`` and ``sd`` on its
+    :data:`GRID` points): the area still uncertain, 0.05 < P(past t) < 0.95 (m^2), and the
+    length of the region's boundary, P > 0.5 (m); past is above for ``sign`` 1, below for -1."""
+    p = above(sign * mean, sd, sign * t).reshape(GRID, GRID)
+    cell = patch.area / (GRID - 1) ** 2
+    band = float(np.count_nonzero((p > 0.05) & (p < 0.95))) * cell
+    region = p > 0.5
+    edge = region & ~_interior(region)
+    return band, float(np.count_nonzero(edge)) * math.sqrt(cell)
 
 
 def _interior(region: NDArray[np.bool_]) -> NDArray[np.bool_]:
