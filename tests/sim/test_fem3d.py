@@ -31,6 +31,13 @@ def layer_forces() -> np.ndarray:
     return load_table(SMALL.layer()).forces
 
 
+@pytest.fixture(scope="module")
+def below_ratios() -> np.ndarray:
+    """The factor of the sphere under the tip (``BELOW``) on the small layer, solved once for
+    the checks that read it."""
+    return solve_ratios(_with(BELOW)).ratios
+
+
 def _with(*inclusions: Inclusion, **changes: object) -> InclusionProblem:
     return dataclasses.replace(SMALL, inclusions=inclusions, **changes)
 
@@ -47,8 +54,10 @@ def test_without_inclusions_the_3d_solve_is_the_axisymmetric_layer(layer_forces)
 
 
 @pytest.mark.slow
-def test_on_the_axis_the_world_matches_an_axisymmetric_solve_holding_it(layer_forces) -> None:
-    ratios = solve_ratios(_with(BELOW)).ratios
+def test_on_the_axis_the_world_matches_an_axisymmetric_solve_holding_it(
+    layer_forces, below_ratios
+) -> None:
+    ratios = below_ratios
     held = solve_indentation(SMALL.layer(inclusion=(1.0, 0.5, 5.0, 0.45)))
     assert held.success
     effect = held.forces / layer_forces
@@ -58,13 +67,12 @@ def test_on_the_axis_the_world_matches_an_axisymmetric_solve_holding_it(layer_fo
 
 
 @pytest.mark.slow
-def test_the_factor_is_mesh_converged() -> None:
+def test_the_factor_is_mesh_converged(below_ratios) -> None:
     coarse = solve_ratios(_with(BELOW, fine=0.14))
-    fine = solve_ratios(_with(BELOW, fine=0.1))
-    change = np.abs(coarse.ratios / fine.ratios - 1.0)
+    change = np.abs(coarse.ratios / below_ratios - 1.0)  # against fine = 0.1
     # 1 % once the contact spans 3 elements of the coarser patch (delta >= 0.09 R); below it
     # the factor moves by 2 % on forces 30 times smaller than at the trial's depth
-    assert np.max(change[fine.depths >= 0.09]) < 0.01, change
+    assert np.max(change[coarse.depths >= 0.09]) < 0.01, change
     assert np.max(change) < 0.03, change
 
 
@@ -99,14 +107,15 @@ def test_an_inclusion_turned_about_the_vertical_is_the_same_solve() -> None:
     assert [i.x for i in a[1]] == pytest.approx([i.x for i in b[1]])
 
 
-@pytest.mark.slow
 def test_a_contrast_of_one_is_exactly_the_layer() -> None:
-    assert np.array_equal(solve_ratios(_with(Inclusion(0, 0, 1.0, 0.5, 1.0))).ratios, np.ones(6))
+    plain = _with(Inclusion(0, 0, 1.0, 0.5, 1.0), fine=0.2)
+    assert np.array_equal(solve_ratios(plain).ratios, np.ones(6))
 
 
-@pytest.mark.slow
 def test_stiffer_inclusions_push_back_harder_and_softer_ones_less() -> None:
-    factors = [solve_ratios(_with(dataclasses.replace(BELOW, contrast=c))).ratios[-1]
+    # the order, not the converged value (test_the_factor_is_mesh_converged's): a coarser patch
+    # moves each factor by under 1 % and solves in a twentieth of the time
+    factors = [solve_ratios(_with(dataclasses.replace(BELOW, contrast=c), fine=0.2)).ratios[-1]
                for c in (0.2, 2.0, 5.0, 30.0)]  # fmt: skip
     assert factors[0] < 1.0 < factors[1] < factors[2] < factors[3]
 
@@ -139,15 +148,14 @@ def test_an_inclusion_outside_the_layer_is_refused(bad) -> None:
 
 
 @pytest.mark.slow
-def test_the_world_law_is_the_layer_times_the_factor(monkeypatch, tmp_path) -> None:
+def test_the_world_law_is_the_layer_times_the_factor(monkeypatch, tmp_path, below_ratios) -> None:
     monkeypatch.setenv("PALPATE_CACHE_DIR", str(tmp_path))
     layer = LayerProblem(2.0, 4.0, depth_max=0.36, n_depths=6)
     world = InclusionWorld(layer, _with(BELOW))
     law = FeTissueLaw(world, modulus=1.0e3, tip_radius=1.0e-3)
     plain = FeTissueLaw(layer, modulus=1.0e3, tip_radius=1.0e-3)
     depths = np.asarray(layer.depths()) * 1e-3
-    ratios = solve_ratios(_with(BELOW)).ratios
-    assert law.force(depths) == pytest.approx(plain.force(depths) * ratios, rel=1e-9)
+    assert law.force(depths) == pytest.approx(plain.force(depths) * below_ratios, rel=1e-9)
     assert law.key != plain.key
     assert list(tmp_path.glob("inclusion-*.npz"))
 
