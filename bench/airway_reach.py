@@ -25,7 +25,7 @@ import numpy as np
 from palpate.config import load_stack
 from palpate.config.schema import TubeConfig
 from palpate.maps.surfaces import Lumen
-from palpate.robot.positioner import MAX_RESIDUAL, PLACE_REASONS, Positioner, place
+from palpate.robot.positioner import MAX_RESIDUAL, PLACE_REASONS, Approach, Positioner, place
 
 MM = 1e-3
 
@@ -53,21 +53,19 @@ def reach(
     airway = Lumen(origin=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), radius=radius)
     lateral = (-args.lateral_mm * MM, args.lateral_mm * MM)
     stage = Positioner(x=(-0.2, 0.2), y=lateral, z=lateral)
+    how = Approach(
+        tip_radius=tip_radius,
+        exposed_length=args.exposed_mm * MM,
+        standoff=args.standoff_mm * MM,
+        translation_limits=limits,
+        surface=airway,
+        body_radius=args.body_mm * MM,
+    )
     counts: collections.Counter[str] = collections.Counter()
     residuals = []
     for u in np.linspace(20 * MM, 60 * MM, args.rings):
         for turn in np.linspace(0.0, 2.0 * math.pi, args.around, endpoint=False):
-            p = place(
-                tubes,
-                airway.at(float(u), float(turn) * radius),
-                stage,
-                tip_radius=tip_radius,
-                exposed_length=args.exposed_mm * MM,
-                standoff=args.standoff_mm * MM,
-                translation_limits=limits,
-                surface=airway,
-                body_radius=args.body_mm * MM,
-            )
+            p = place(tubes, airway.at(float(u), float(turn) * radius), stage, how)
             counts[PLACE_REASONS[p.status]] += 1
             if p.status in (0, 1):
                 residuals.append(math.degrees(p.residual))

@@ -19,16 +19,14 @@ arithmetic runs (about a minute for 24 surveys), no trial.
 
 from __future__ import annotations
 
-import argparse
 import itertools
-import json
 import math
 import statistics
 import sys
 from typing import Any
 
 import numpy as np
-from map_worlds import truths  # type: ignore[import-not-found]
+from map_worlds import read_study, truths  # type: ignore[import-not-found]
 from numpy.typing import NDArray
 
 from palpate.campaigns.surveyloop import LENGTH_SCALE_TIPS, inclusion_scores, map_of
@@ -106,14 +104,7 @@ def judge(surveys: list[list[dict[str, Any]]], a: float, k: int, area: float) ->
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("study", help="the JSON of `palpate map --worlds N --whole --json`")
-    parser.add_argument("--patch-mm", type=float, nargs=4, default=(-10, -10, 10, 10))
-    parser.add_argument("--tip-mm", type=float, default=3.5, help="the sensor's tip radius")
-    args = parser.parse_args(argv)
-    with open(args.study, encoding="utf-8") as fh:
-        study = json.load(fh)
-    patch = Patch.from_mm(tuple(args.patch_mm))
+    study, patch, args = read_study(__doc__, argv)
     scale = LENGTH_SCALE_TIPS * args.tip_mm * MM
     surveys = [
         replay(row, study["seed"] * 1000 + row["world"], patch, scale) for row in study["rows"]

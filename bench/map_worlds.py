@@ -57,15 +57,23 @@ def firsts(
     return first, every
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def read_study(
+    doc: str | None, argv: list[str] | None
+) -> tuple[dict[str, Any], Patch, argparse.Namespace]:
+    """A study script's arguments (the study's JSON, its patch and the sensor's tip radius),
+    the study read and its patch."""
+    parser = argparse.ArgumentParser(description=(doc or "").splitlines()[0])
     parser.add_argument("study", help="the JSON `palpate map --worlds N --whole --json` printed")
     parser.add_argument("--patch-mm", type=float, nargs=4, default=(-10, -10, 10, 10))
     parser.add_argument("--tip-mm", type=float, default=3.5, help="the sensor's tip radius")
     args = parser.parse_args(argv)
     with open(args.study, encoding="utf-8") as fh:
         study = json.load(fh)
-    patch = Patch.from_mm(tuple(args.patch_mm))
+    return study, Patch.from_mm(tuple(args.patch_mm)), args
+
+
+def main(argv: list[str] | None = None) -> int:
+    study, patch, args = read_study(__doc__, argv)
     single, every, used = [], [], []
     for row in study["rows"]:
         seed = study["seed"] * 1000 + row["world"]  # the survey's (campaigns.mapstudy)

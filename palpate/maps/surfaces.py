@@ -51,6 +51,15 @@ def _frame(axis: Vector, first: ArrayLike | None) -> tuple[Vector, Vector]:
     return e1, np.cross(axis, e1)
 
 
+def _set_axis(shape: object, axis: ArrayLike, radius: float, first: ArrayLike | None) -> None:
+    """A dome's or a lumen's checked radius, unit axis ``_a`` and frame about it ``_e``."""
+    if not radius > 0:
+        raise ValueError(f"radius must be > 0 m, got {radius!r}")
+    a = _unit(axis, "axis")
+    object.__setattr__(shape, "_a", a)
+    object.__setattr__(shape, "_e", _frame(a, first))
+
+
 @dataclass(frozen=True)
 class SurfacePoint:
     """A point on the tissue (3,) and the outward unit normal there (3,), m."""
@@ -104,11 +113,7 @@ class Dome:
     _e: tuple[Vector, Vector] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        if not self.radius > 0:
-            raise ValueError(f"radius must be > 0 m, got {self.radius!r}")
-        a = _unit(self.axis, "axis")
-        object.__setattr__(self, "_a", a)
-        object.__setattr__(self, "_e", _frame(a, self.first))
+        _set_axis(self, self.axis, self.radius, self.first)
 
     @property
     def centre(self) -> Vector:
@@ -142,11 +147,7 @@ class Lumen:
     _e: tuple[Vector, Vector] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        if not self.radius > 0:
-            raise ValueError(f"radius must be > 0 m, got {self.radius!r}")
-        a = _unit(self.axis, "axis")
-        object.__setattr__(self, "_a", a)
-        object.__setattr__(self, "_e", _frame(a, self.first))
+        _set_axis(self, self.axis, self.radius, self.first)
 
     def at(self, u: float, v: float) -> SurfacePoint:
         turn = v / self.radius

@@ -25,8 +25,10 @@ The tube with the smallest residual among those that pass wins; a point no tube 
 with a verdict that says so, or skip it. Statuses index :data:`PLACE_REASONS`::
 
     airway = Lumen(origin=(0, 0, 0), axis=(1, 0, 0), radius=6e-3)
-    p = place(tubes, airway.at(12e-3, 0.0), stage, tip_radius=1.3e-3, exposed_length=4e-3,
-              standoff=1e-3, translation_limits=(0.0, 0.03), surface=airway)
+    stage = Positioner(x=(-0.05, 0.05), y=(-4e-3, 4e-3), z=(-4e-3, 4e-3))
+    how = Approach(tip_radius=1.3e-3, exposed_length=4e-3, standoff=1e-3,
+                   translation_limits=(0.0, 0.03), surface=airway)
+    p = place(stack.tubes, airway.at(12e-3, 0.0), stage, how)
     p.reachable, p.tube, math.degrees(p.residual), p.base
 """
 
@@ -105,82 +107,67 @@ class Placement:
         return PLACE_REASONS[self.status]
 
 
+@dataclass(frozen=True)
+class Approach:
+    """How the sensor meets a point: its tip sphere's radius, how far it is out at contact
+    (``exposed_length``), how far clear it starts (``standoff``, along the normal), the drive's
+    translation limits and roll limits, the tissue to keep clear of (``surface``, None: no
+    check) and the tube's and sensor's own radius there (``body_radius``), and the largest
+    angle to the normal that counts as square on (``max_residual``); SI."""
+
+    tip_radius: float
+    exposed_length: float
+    standoff: float
+    translation_limits: Limits
+    surface: Surface | None = None
+    body_radius: float = 0.0
+    roll_limits: Limits = (-math.pi, math.pi)
+    max_residual: float = MAX_RESIDUAL
+
+    def __post_init__(self) -> None:
+        if not (self.tip_radius > 0 and min(self.exposed_length, self.standoff) >= 0):
+            raise ValueError("tip_radius must be > 0 m and exposed_length, standoff >= 0 m")
+        if not self.body_radius >= 0:
+            raise ValueError(f"body_radius must be >= 0 m, got {self.body_radius!r}")
+
+
 def place_with_tube(
-    tube: TubeConfig,
-    target: SurfacePoint,
-    stage: Positioner,
-    *,
-    tip_radius: float,
-    exposed_length: float,
-    standoff: float,
-    translation_limits: Limits,
-    surface: Surface | None = None,
-    body_radius: float = 0.0,
-    roll_limits: Limits = (-math.pi, math.pi),
-    max_residual: float = MAX_RESIDUAL,
+    tube: TubeConfig, target: SurfacePoint, stage: Positioner, how: Approach
 ) -> Placement:
     """:func:`place` with one tube."""
-    if not (tip_radius > 0 and exposed_length >= 0 and standoff >= 0 and body_radius >= 0):
-        raise ValueError("tip_radius must be > 0 and exposed_length, standoff, body_radius >= 0")
     n = np.asarray(target.normal, dtype=np.float64)
-    roll, residual, status = roll_for(tube, n, roll_limits)
-    contact = tube.flush_translation + exposed_length
+    roll, residual, status = roll_for(tube, n, how.roll_limits)
+    contact = tube.flush_translation + how.exposed_length
     pose = forward(tube, roll, contact)
     approach = -float(n @ pose.tangent)  # cos(residual)
-    base = np.asarray(target.point + tip_radius * n - pose.sensor_tip, dtype=np.float64)
-    start = contact - standoff / approach if approach > 1e-9 else math.nan
+    base = np.asarray(target.point + how.tip_radius * n - pose.sensor_tip, dtype=np.float64)
+    start = contact - how.standoff / approach if approach > 1e-9 else math.nan
     clearance = math.inf
     if status == 0 and approach <= 1e-9:
         status = 6
-    lo, hi = translation_limits
+    lo, hi = how.translation_limits
     if status == 0 and not (lo <= start and contact <= hi):
         status = 3
     if status == 0 and not stage.holds(base):
         status = 2
-    if surface is not None and math.isfinite(start):
-        clearance = _clearance(tube, roll, start, base, surface, tip_radius, body_radius)
+    if how.surface is not None and math.isfinite(start):
+        clearance = _clearance(tube, roll, start, base, how)
         if status == 0 and clearance < 0.0:
             status = 5
-    if status == 0 and residual > max_residual:
+    if status == 0 and residual > how.max_residual:
         status = 1
     return Placement(tube.name, roll, base, start, contact, residual, clearance, status)
 
 
 def place(
-    tubes: Sequence[TubeConfig],
-    target: SurfacePoint,
-    stage: Positioner,
-    *,
-    tip_radius: float,
-    exposed_length: float,
-    standoff: float,
-    translation_limits: Limits,
-    surface: Surface | None = None,
-    body_radius: float = 0.0,
-    roll_limits: Limits = (-math.pi, math.pi),
-    max_residual: float = MAX_RESIDUAL,
+    tubes: Sequence[TubeConfig], target: SurfacePoint, stage: Positioner, how: Approach
 ) -> Placement:
     """The tube, roll and stage pose for ``target`` (the module docstring): the reachable
     placement with the smallest residual (ties: the tube listed first); else the oblique one
-    (status 1) with the smallest; else the first tube's refusal with the smallest residual."""
+    (status 1) with the smallest; else the refusal with the smallest residual."""
     if not tubes:
         raise ValueError("placing the robot needs at least one tube")
-    found = [
-        place_with_tube(
-            t,
-            target,
-            stage,
-            tip_radius=tip_radius,
-            exposed_length=exposed_length,
-            standoff=standoff,
-            translation_limits=translation_limits,
-            surface=surface,
-            body_radius=body_radius,
-            roll_limits=roll_limits,
-            max_residual=max_residual,
-        )
-        for t in tubes
-    ]
+    found = [place_with_tube(t, target, stage, how) for t in tubes]
     for wanted in ((0,), (1,), tuple(PLACE_REASONS)):
         pool = [p for p in found if p.status in wanted]
         if pool:
@@ -189,18 +176,14 @@ def place(
 
 
 def _clearance(
-    tube: TubeConfig,
-    roll: float,
-    translation: float,
-    base: Vector,
-    surface: Surface,
-    tip_radius: float,
-    body_radius: float,
+    tube: TubeConfig, roll: float, translation: float, base: Vector, how: Approach
 ) -> float:
-    """The least clearance (m) of the tube and sensor (less ``body_radius``) and of the tip
-    sphere (less ``tip_radius``) from the tissue, at ``translation`` with the stage at ``base``."""
+    """The least clearance (m) of the tube and sensor (less the body's radius) and of the tip
+    sphere (less its radius) from ``how.surface``, at ``translation`` with the stage at
+    ``base``."""
+    assert how.surface is not None
     body = body_points(tube, roll, translation) + base
     sphere = forward(tube, roll, translation).sensor_tip + base
-    along = float(np.min(surface.clearance(body[:-1]))) - body_radius
-    tip = float(surface.clearance(sphere)[0]) - tip_radius
+    along = float(np.min(how.surface.clearance(body[:-1]))) - how.body_radius
+    tip = float(how.surface.clearance(sphere)[0]) - how.tip_radius
     return min(along, tip)

@@ -11,7 +11,7 @@ import pytest
 from palpate.config.schema import TubeConfig
 from palpate.maps.surfaces import Dome, Lumen, TiltedPlane
 from palpate.robot.kinematics import body_points, forward, tube_tip_in_bend_plane
-from palpate.robot.positioner import MAX_RESIDUAL, Positioner, place, place_with_tube
+from palpate.robot.positioner import MAX_RESIDUAL, Approach, Positioner, place, place_with_tube
 
 R = 1.3e-3  # the lumen sensor's tip radius
 PAPER = [
@@ -35,7 +35,12 @@ LUMEN90 = TubeConfig(
 )
 AIRWAY = Lumen(origin=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), radius=6e-3)
 STAGE = Positioner(x=(-0.05, 0.05), y=(-4e-3, 4e-3), z=(-4e-3, 4e-3))
-KW = {"tip_radius": R, "standoff": 0.5e-3, "translation_limits": (0.0, 0.2)}
+
+
+def how(exposed: float, surface: object = AIRWAY, **changes: object) -> Approach:
+    """The lumen sensor's approach, ``exposed`` m out at contact, 0.5 mm clear at the start."""
+    kw: dict = {"standoff": 0.5e-3, "translation_limits": (0.0, 0.2), **changes}
+    return Approach(tip_radius=R, exposed_length=exposed, surface=surface, **kw)
 
 
 def test_each_surface_puts_its_points_where_its_coordinates_say_and_faces_out() -> None:
@@ -79,7 +84,7 @@ def test_body_points_run_along_the_tube_to_the_sensor_tip() -> None:
 @pytest.mark.parametrize("turn", [0.0, 1.0, 2.5, 4.0, 5.9])
 def test_a_right_angle_tube_meets_an_airway_wall_along_its_normal(turn: float) -> None:
     target = AIRWAY.at(20e-3, turn * 6e-3)
-    p = place([*PAPER, LUMEN90], target, STAGE, exposed_length=2e-3, surface=AIRWAY, **KW)
+    p = place([*PAPER, LUMEN90], target, STAGE, how(2e-3, AIRWAY))
     assert p.reachable, p.reason
     assert p.tube == "lumen90"
     assert p.residual == pytest.approx(0.0, abs=1e-9)
@@ -94,11 +99,11 @@ def test_a_right_angle_tube_meets_an_airway_wall_along_its_normal(turn: float) -
 
 def test_the_papers_tubes_do_not_meet_an_airway_wall_square_on_and_say_so() -> None:
     target = AIRWAY.at(20e-3, 1.0e-3)
-    p = place(PAPER, target, STAGE, exposed_length=2e-3, surface=AIRWAY, **KW)
+    p = place(PAPER, target, STAGE, how(2e-3, AIRWAY))
     assert not p.reachable
     assert p.residual > math.radians(30)
     wide = Positioner(x=(-0.1, 0.1), y=(-0.1, 0.1), z=(-0.1, 0.1))
-    q = place(PAPER[:2], target, wide, exposed_length=2e-3, surface=AIRWAY, **KW)
+    q = place(PAPER[:2], target, wide, how(2e-3, AIRWAY))
     assert q.status == 1
     assert "oblique" in q.reason
     assert q.residual > math.radians(70)
@@ -106,10 +111,10 @@ def test_the_papers_tubes_do_not_meet_an_airway_wall_square_on_and_say_so() -> N
 
 def test_a_sensor_longer_than_the_airway_is_wide_is_refused() -> None:
     target = AIRWAY.at(20e-3, 0.0)
-    p = place_with_tube(LUMEN90, target, STAGE, exposed_length=42e-3, surface=AIRWAY, **KW)
+    p = place_with_tube(LUMEN90, target, STAGE, how(42e-3, AIRWAY))
     assert p.status in (2, 5)  # the stage cannot back it off, or it would cut the far wall
     wide = Positioner(x=(-0.05, 0.05), y=(-0.1, 0.1), z=(-0.1, 0.1))
-    q = place_with_tube(LUMEN90, target, wide, exposed_length=42e-3, surface=AIRWAY, **KW)
+    q = place_with_tube(LUMEN90, target, wide, how(42e-3, AIRWAY))
     assert q.status == 5
     assert q.clearance < 0.0
 
@@ -117,10 +122,9 @@ def test_a_sensor_longer_than_the_airway_is_wide_is_refused() -> None:
 def test_the_stage_and_translation_limits_are_guards() -> None:
     target = AIRWAY.at(20e-3, 0.0)
     short = Positioner(x=(-1e-3, 1e-3), y=(-4e-3, 4e-3), z=(-4e-3, 4e-3))
-    p = place_with_tube(LUMEN90, target, short, exposed_length=2e-3, surface=AIRWAY, **KW)
+    p = place_with_tube(LUMEN90, target, short, how(2e-3, AIRWAY))
     assert p.status == 2
-    tight = dict(KW, translation_limits=(0.0, 1e-3))
-    q = place_with_tube(LUMEN90, target, STAGE, exposed_length=2e-3, surface=AIRWAY, **tight)
+    q = place_with_tube(LUMEN90, target, STAGE, how(2e-3, translation_limits=(0.0, 1e-3)))
     assert q.status == 3
 
 
@@ -129,7 +133,7 @@ def test_a_tilted_plane_is_met_square_on_by_the_tube_whose_cone_holds_its_normal
     n = np.array([-math.cos(math.radians(30)), 0.0, math.sin(math.radians(30))])
     plane = TiltedPlane(origin=(0.09, 0.0, -0.03), normal=n)
     wide = Positioner(x=(-0.1, 0.1), y=(-0.1, 0.1), z=(-0.1, 0.1))
-    p = place(PAPER, plane.at(1e-3, -2e-3), wide, exposed_length=20e-3, surface=plane, **KW)
+    p = place(PAPER, plane.at(1e-3, -2e-3), wide, how(20e-3, plane))
     assert p.reachable
     assert p.tube == "bent30"
     assert p.residual < MAX_RESIDUAL
@@ -137,6 +141,8 @@ def test_a_tilted_plane_is_met_square_on_by_the_tube_whose_cone_holds_its_normal
 
 def test_no_tube_is_a_clear_error() -> None:
     with pytest.raises(ValueError, match="at least one tube"):
-        place([], AIRWAY.at(0.0, 0.0), STAGE, exposed_length=1e-3, **KW)
+        place([], AIRWAY.at(0.0, 0.0), STAGE, how(1e-3))
+    with pytest.raises(ValueError, match="tip_radius"):
+        Approach(tip_radius=0.0, exposed_length=1e-3, standoff=0.0, translation_limits=(0, 1))
     with pytest.raises(ValueError, match="travel"):
         Positioner(x=(1.0, -1.0))
