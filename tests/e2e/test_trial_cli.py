@@ -7,6 +7,7 @@ PALPATE_HW_BOARD_PORT name its ports, and never move the stage.
 
 from __future__ import annotations
 
+import dataclasses
 import errno
 import json
 import math
@@ -375,6 +376,9 @@ def test_port_errors_say_what_to_do() -> None:
 def test_a_silent_servo_bus_is_reported_with_the_port(tmp_path: Path) -> None:
     """A pty nobody answers on: the port opens, no servo replies, torque was never on."""
     loaded = load_bench(bench_file(tmp_path, ONE))
+    # the bench file's 2 s reply timeout, for a busy host, would spend 20 s of silence here
+    servos = dataclasses.replace(loaded.stack.servos, timeout_ms=50.0)
+    stack = dataclasses.replace(loaded.stack, servos=servos)
     clock = VirtualClock()
     with simulated(loaded, clock) as sim:
         master, slave = os.openpty()
@@ -382,7 +386,7 @@ def test_a_silent_servo_bus_is_reported_with_the_port(tmp_path: Path) -> None:
             with (
                 pytest.raises(HardwareError, match="do not answer") as info,
                 open_hardware(
-                    loaded.stack,
+                    stack,
                     servo_port=os.ttyname(slave),
                     board_port=sim.board_port,
                     clock=clock,
