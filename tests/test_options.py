@@ -64,6 +64,7 @@ ACCEPTS: dict[tuple[str, str], frozenset[str]] = {
     ("teleop", "--live"): frozenset({"0"}),
     ("ros", "--seed"): frozenset({"0"}),
     ("ros", "--rate"): frozenset(),
+    ("ros", "--pace"): frozenset(),
 }
 
 # What each command needs besides the option under test, so only that option can be wrong.

@@ -56,6 +56,13 @@ def register(parser: argparse.ArgumentParser) -> None:
         default=50.0,
         help="messages per second of the trial's clock on the streams (measured_js, ...)",
     )
+    parser.add_argument(
+        "--pace",
+        type=positive_float,
+        default=None,
+        help="with --scene: simulated trials at PACE times real time, their streams in step "
+        "with the wall clock (default: as fast as they compute)",
+    )
     parser.add_argument("--namespace", default="palpate", help="the node's namespace")
     parser.add_argument(
         "--out",
@@ -73,6 +80,8 @@ def register(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not NAMESPACE.fullmatch(args.namespace):
         raise InputError(f"--namespace: {args.namespace!r} is not a ROS 2 namespace")
+    if args.config is not None and args.pace is not None:
+        raise InputError("--pace: only with --scene (the bench runs in real time)")
     if args.config is None and (args.servo_port or args.board_port):
         raise InputError("--servo-port/--board-port: only with --config (a bench file)")
     try:  # the node's own dependency (the [ros] extra), loaded only here
@@ -91,7 +100,13 @@ def run(args: argparse.Namespace) -> int:
     else:
         runner = SimRunner(resolve(args.scene or "scenes/robot.yaml"), seed=args.seed, out=out)
     with terminate_as_interrupt(), runner:  # the bench's ports open here (torque off on exit)
-        node = PalpateNode(runner, namespace=args.namespace, rate=args.rate, network=args.network)
+        node = PalpateNode(
+            runner,
+            namespace=args.namespace,
+            rate=args.rate,
+            network=args.network,
+            pace=args.pace,
+        )
         try:  # the signals are ours before the announcement: a client may stop it next
             _announce(node.name, runner, out, args)
             node.spin()

@@ -74,7 +74,8 @@ class Runner(Protocol):
 
 class PalpateNode:
     """The node ``palpate`` in ``namespace``, its topics at ``rate`` per second of the trial's
-    clock, serving ``runner``'s trials."""
+    clock, serving ``runner``'s trials; a simulated trial at ``pace`` times real time (None: as
+    fast as it computes)."""
 
     def __init__(
         self,
@@ -83,6 +84,7 @@ class PalpateNode:
         namespace: str = "palpate",
         rate: float = 50.0,
         network: bool = False,
+        pace: float | None = None,
     ) -> None:
         if not network:
             os.environ.update(LOCALHOST)
@@ -93,7 +95,9 @@ class PalpateNode:
         self.node = rclpy.create_node("palpate", namespace=namespace, context=self.context)
         self.node.declare_parameter("trial", "")
         self.node.declare_parameter("max_probes", 0)
-        self.view = RosView(self.node, runner.stack, rate=rate, sim_time=runner.simulated)
+        self.view = RosView(
+            self.node, runner.stack, rate=rate, sim_time=runner.simulated, pace=pace
+        )
         self.stopping = threading.Event()
         self.busy = threading.Lock()
         work, quick = MutuallyExclusiveCallbackGroup(), ReentrantCallbackGroup()

@@ -14,6 +14,7 @@ last one's end, so the node's time never runs back (a simulated trial's clock st
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -55,10 +56,21 @@ class RosView:
     """The node's publishers, and the publisher of each trial (:meth:`trial`) and map
     (:meth:`cloud`) on them."""
 
-    def __init__(self, node: Node, stack: StackConfig, *, rate: float, sim_time: bool) -> None:
+    def __init__(
+        self,
+        node: Node,
+        stack: StackConfig,
+        *,
+        rate: float,
+        sim_time: bool,
+        pace: float | None = None,
+    ) -> None:
         if not rate > 0:
             raise ValueError(f"rate must be > 0, got {rate}")
+        if pace is not None and not pace > 0:
+            raise ValueError(f"pace must be > 0, got {pace}")
         self.node, self.stack, self.period = node, stack, 1.0 / rate
+        self.pace = pace  # trial seconds per wall second; None: as fast as the trial computes
         self.section = sensor_section(stack.sensor)
         self.elapsed = 0.0  # s: the last stamp published (the next trial starts after it)
         make = node.create_publisher
@@ -116,10 +128,13 @@ class _Feed:
     state: State | None = None
     due: float = -math.inf  # the trial's clock: the streams' next message
     diagnostics_due: float = -math.inf
+    wall_start: float | None = None  # monotonic s at the trial's 0, when paced
 
     def publish(self, obs: Observation, state: State) -> None:
         v = self.view
         t = self.base + obs.t
+        if v.pace is not None:
+            self._keep_pace(obs.t, v.pace)
         v.elapsed = max(v.elapsed, t)
         if state is not self.state:
             self.state = state
@@ -133,6 +148,15 @@ class _Feed:
         gap = obs.t - self.due
         self.due = (self.due if gap < v.period else obs.t) + v.period
         self._streams(obs, t)
+
+    def _keep_pace(self, t: float, pace: float) -> None:
+        """Wait until the wall clock has caught up with the trial's ``t`` (s) at ``pace``."""
+        now = time.monotonic()
+        if self.wall_start is None:
+            self.wall_start = now - t / pace
+        ahead = self.wall_start + t / pace - now
+        if ahead > 0.0:
+            time.sleep(ahead)
 
     def _streams(self, obs: Observation, t: float) -> None:
         v, now = self.view, stamp(t)

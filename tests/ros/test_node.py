@@ -28,6 +28,7 @@ from palpate.ros.names import PARAMETERS, SERVICES, SUBSCRIPTIONS, TOPICS
 CLIENT = Path(__file__).with_name("client.py")
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "ros2.md"
 WAIT_S = 600.0  # a bound on waiting for a process (a busy machine), never a measured time
+PACE = 2.0  # trial seconds per wall second for the tests that stop a trial under way
 
 
 @pytest.fixture
@@ -44,12 +45,22 @@ def node(tmp_path: Path, domain: dict[str, str]) -> Iterator[tuple[dict[str, Any
     yield from _node(tmp_path, domain, "scenes/robot.yaml")
 
 
+@pytest.fixture
+def paced_node(tmp_path: Path, domain: dict[str, str]) -> Iterator[tuple[dict[str, Any], Path]]:
+    """The node with its simulated trials at PACE times real time: a trial asked to stop, or
+    whose caller leaves, is still running when the stop arrives, however busy the machine."""
+    yield from _node(tmp_path, domain, "scenes/robot.yaml", pace=PACE)
+
+
 def _node(
-    tmp_path: Path, env: dict[str, str], scene: str, *where: str
+    tmp_path: Path, env: dict[str, str], scene: str, *where: str, pace: float | None = None
 ) -> Iterator[tuple[dict[str, Any], Path]]:
-    """The node on ``scene``, or where ``where`` says (``--config BENCH ...``)."""
+    """The node on ``scene`` (at ``pace`` times real time, None: as fast as it computes), or
+    where ``where`` says (``--config BENCH ...``)."""
     out = tmp_path / "node"
     command = [sys.executable, "-m", "palpate", "ros", *(where or ("--scene", scene)), "--json"]
+    if pace is not None:
+        command += ["--pace", str(pace)]
     process = subprocess.Popen(
         [*command, "--out", str(out)], env=env, stdout=subprocess.PIPE, text=True
     )
@@ -127,7 +138,7 @@ def test_a_trial_over_ros2_is_the_trial_palpate_sim_runs(
 
 
 def test_stop_retracts_the_running_trial(
-    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+    paced_node: tuple[dict[str, Any], Path], domain: dict[str, str]
 ) -> None:
     seen = client(domain, "run_trial", "stop@30")
     trial, stop = seen["answers"]
@@ -256,7 +267,7 @@ def test_servo_jp_moves_the_robot_and_zero_takes_the_strains_zero_at_rest(
 
 
 def test_a_trial_whose_caller_dies_retracts(
-    node: tuple[dict[str, Any], Path], domain: dict[str, str]
+    paced_node: tuple[dict[str, Any], Path], domain: dict[str, str]
 ) -> None:
     """The client that asked for a trial is terminated mid-trial (its rclpy leaves the DDS graph
     on SIGTERM): the node sees the service's last client gone and stops the trial; it retracts
