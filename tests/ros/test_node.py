@@ -28,6 +28,7 @@ from palpate.ros.names import PARAMETERS, SERVICES, SUBSCRIPTIONS, TOPICS
 CLIENT = Path(__file__).with_name("client.py")
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "ros2.md"
 WAIT_S = 600.0  # a bound on waiting for a process (a busy machine), never a measured time
+LATENCY_S = 1.0  # wall s a jog's commands and joint states may take between node and client
 PACE = 0.2  # trial seconds per wall second for the tests that stop a trial under way: its
 # 4 s last about 19 s of wall time, against the 0.5-2 s a stop or a departed caller takes to land
 
@@ -244,10 +245,13 @@ def _moved_and_held(jog: dict[str, Any]) -> None:
     it held, and then stayed put."""
     quiet = jog["quiet"]
     assert quiet[0][1] >= jog["start"] + 1e-3 - 20e-6
-    held = [a for t, a in quiet if t > quiet[0][0] + COMMAND_TIMEOUT_S + 0.5]
+    # the node holds COMMAND_TIMEOUT_S after the last command it *received*; the client's quiet
+    # starts when it has *seen* 1 mm: DDS delivery and the two processes' scheduling add up to
+    # some hundreds of ms either way (0.8 s of jogging on was seen once, in a fresh clone's CI)
+    held = [a for t, a in quiet if t > quiet[0][0] + COMMAND_TIMEOUT_S + LATENCY_S]
     assert held
     assert max(held) - min(held) < 5e-6
-    assert max(held) - quiet[0][1] < 1.5e-3  # at most a step on from where the commands stopped
+    assert max(held) - quiet[0][1] < 2.5e-3  # 1.3 s of the jog's 2 mm/s at most, not on and on
 
 
 def test_servo_jp_moves_the_robot_and_zero_takes_the_strains_zero_at_rest(
