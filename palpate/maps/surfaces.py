@@ -51,15 +51,6 @@ def _frame(axis: Vector, first: ArrayLike | None) -> tuple[Vector, Vector]:
     return e1, np.cross(axis, e1)
 
 
-def _set_axis(shape: object, axis: ArrayLike, radius: float, first: ArrayLike | None) -> None:
-    """A dome's or a lumen's checked radius, unit axis ``_a`` and frame about it ``_e``."""
-    if not radius > 0:
-        raise ValueError(f"radius must be > 0 m, got {radius!r}")
-    a = _unit(axis, "axis")
-    object.__setattr__(shape, "_a", a)
-    object.__setattr__(shape, "_e", _frame(a, first))
-
-
 @dataclass(frozen=True)
 class SurfacePoint:
     """A point on the tissue (3,) and the outward unit normal there (3,), m."""
@@ -101,11 +92,11 @@ class TiltedPlane:
         return np.asarray((x - np.asarray(self.origin, float)) @ self._n)
 
 
-@dataclass(frozen=True)
-class Dome:
-    """A convex sphere of ``radius`` whose ``apex`` faces along ``axis`` (outward there)."""
+@dataclass(frozen=True, kw_only=True)
+class _AboutAnAxis:
+    """A shape of ``radius`` about ``axis`` (unit: ``_a``), with a frame ``_e`` about it whose
+    first direction is ``first`` (projected off the axis; any if None): a dome's, a lumen's."""
 
-    apex: ArrayLike
     axis: ArrayLike
     radius: float
     first: ArrayLike | None = None
@@ -113,7 +104,18 @@ class Dome:
     _e: tuple[Vector, Vector] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        _set_axis(self, self.axis, self.radius, self.first)
+        if not self.radius > 0:
+            raise ValueError(f"radius must be > 0 m, got {self.radius!r}")
+        a = _unit(self.axis, "axis")
+        object.__setattr__(self, "_a", a)
+        object.__setattr__(self, "_e", _frame(a, self.first))
+
+
+@dataclass(frozen=True)
+class Dome(_AboutAnAxis):
+    """A convex sphere of ``radius`` whose ``apex`` faces along ``axis`` (outward there)."""
+
+    apex: ArrayLike
 
     @property
     def centre(self) -> Vector:
@@ -135,19 +137,11 @@ class Dome:
 
 
 @dataclass(frozen=True)
-class Lumen:
+class Lumen(_AboutAnAxis):
     """The inside wall of a straight tube of ``radius`` about the line through ``origin``
     along ``axis``; ``v`` runs round the wall from ``first`` (right-handed about the axis)."""
 
     origin: ArrayLike
-    axis: ArrayLike
-    radius: float
-    first: ArrayLike | None = None
-    _a: Vector = field(init=False, repr=False)
-    _e: tuple[Vector, Vector] = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        _set_axis(self, self.axis, self.radius, self.first)
 
     def at(self, u: float, v: float) -> SurfacePoint:
         turn = v / self.radius

@@ -28,7 +28,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 import transforms3d
@@ -101,13 +101,20 @@ def _rot_x(phi: float) -> NDArray[np.float64]:
     return np.asarray(transforms3d.axangles.axangle2mat((1.0, 0.0, 0.0), phi))
 
 
+def _bend(along: Any, angle: Any) -> tuple[Any, Any]:
+    """How far the arc has gone forward (x) and down (z) ``along`` its length (m) where it has
+    turned by ``angle`` (rad): ``along`` sin(a)/a and -``along`` (1 - cos a)/a, written with
+    ``np.sinc`` so a straight arc (a -> 0) is exact; floats or arrays alike."""
+    forward_x = along * np.sinc(angle / math.pi)  # sin(a)/a, 1 at a = 0
+    down_z = -along * (0.5 * angle * np.sinc(angle / (2.0 * math.pi)) ** 2)  # (1-cos a)/a
+    return forward_x, down_z
+
+
 def tube_tip_in_bend_plane(tube: TubeConfig) -> tuple[Vector, Vector]:
     """Tube tip position and tangent at roll 0, ``(3,)`` each: the arc bends toward -z."""
     a = tube.tip_angle
-    ls, la = tube.straight_length, tube.arc_length
-    sin_over_a = float(np.sinc(a / math.pi))  # sin(a)/a, 1 at a = 0
-    one_minus_cos_over_a = 0.5 * a * float(np.sinc(a / (2.0 * math.pi))) ** 2  # (1-cos a)/a
-    position = np.array([ls + la * sin_over_a, 0.0, -la * one_minus_cos_over_a])
+    dx, dz = _bend(tube.arc_length, a)
+    position = np.array([tube.straight_length + float(dx), 0.0, float(dz)])
     tangent = np.array([math.cos(a), 0.0, -math.sin(a)])
     return position, tangent
 
@@ -150,13 +157,11 @@ def body_points(tube: TubeConfig, roll: float, translation: float, n: int = 24) 
     """Points (k, 3) along what the robot puts in front of its base at a joint state: the
     tube's straight part, its arc (``n`` points each) and the sensor out to its tip sphere's
     centre, for checking that they keep clear of tissue (``robot.positioner``)."""
-    a, ls, la = tube.tip_angle, tube.straight_length, tube.arc_length
+    ls, la = tube.straight_length, tube.arc_length
     straight = np.outer(np.linspace(0.0, ls, n), (1.0, 0.0, 0.0))
     s = np.linspace(0.0, la, n + 1)[1:]
-    theta = a * s / la if la > 0 else np.zeros_like(s)
-    sin_over = np.sinc(theta / math.pi)  # sin(theta)/theta, the arc with its radius la/a
-    one_minus_cos_over = 0.5 * theta * np.sinc(theta / (2.0 * math.pi)) ** 2
-    arc = np.column_stack([ls + s * sin_over, np.zeros_like(s), -s * one_minus_cos_over])
+    dx, dz = _bend(s, tube.tip_angle * s / la if la > 0 else np.zeros_like(s))
+    arc = np.column_stack([ls + dx, np.zeros_like(s), dz])
     pose = forward(tube, 0.0, translation)
     steps = np.linspace(0.0, max(pose.exposed_length, 0.0), n + 1)[1:, None]
     sensor = pose.tube_tip + steps * pose.tangent

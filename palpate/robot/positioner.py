@@ -182,8 +182,6 @@ def _clearance(
     sphere (less its radius) from ``how.surface``, at ``translation`` with the stage at
     ``base``."""
     assert how.surface is not None
-    body = body_points(tube, roll, translation) + base
-    sphere = forward(tube, roll, translation).sensor_tip + base
-    along = float(np.min(how.surface.clearance(body[:-1]))) - how.body_radius
-    tip = float(how.surface.clearance(sphere)[0]) - how.tip_radius
-    return min(along, tip)
+    body = body_points(tube, roll, translation) + base  # its last point: the sphere's centre
+    gaps = how.surface.clearance(body)
+    return min(float(np.min(gaps[:-1])) - how.body_radius, float(gaps[-1]) - how.tip_radius)
