@@ -196,17 +196,21 @@ def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
 
 def whole_lines(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """The rates of a study on worlds drawn whole: every true inclusion found (of its kind),
-    worlds with a false one, the centre's error and interval per found inclusion, soft ones
-    read as soft."""
+    worlds with a false one, the centre's and the depth's error and interval per found
+    inclusion (the depth where it was read), soft ones read as soft."""
     per = [i for r in rows for i in r.get("per_inclusion", [])]
     found = [i for i in per if i["found"]]
     soft = [i for i in per if i["kind"] == "soft"]
+    deep = [i for i in found if "depth_error_mm" in i]
     return {
         "inclusions_true": len(per),
         "inclusions_found": len(found),
         "worlds_with_a_false_one": sum(r.get("false_inclusions", 0) > 0 for r in rows),
         "center_error_mm_median": _median([i["center_error_mm"] for i in found]),
         "center_in_ci": sum(i["center_in_ci"] for i in found),
+        "depth_read": len(deep),
+        "depth_error_mm_median": _median([i["depth_error_mm"] for i in deep]),
+        "depth_in_ci": sum(i["depth_in_ci"] for i in deep),
         "soft_true": len(soft),
         "soft_found_as_soft": sum(i["found"] for i in soft),
     }

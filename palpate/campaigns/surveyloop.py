@@ -191,7 +191,8 @@ def inclusion_scores(found: Sequence[Inclusion], truths: Sequence[Truth]) -> dic
     """Every true inclusion against the map's list: matched to the nearest reported one of its
     kind whose centre is within its radius (at least 2 mm) of its own; the reported ones no
     true inclusion took are false. Per true inclusion: found, the centre's error (mm), whether
-    the centre's interval holds it."""
+    the centre's interval holds it, and where the map read its sphere the depth's error (of its
+    centre, mm) and whether the depth's interval holds it."""
     free = list(found)
     rows: list[dict[str, Any]] = []
     for t in truths:
@@ -205,9 +206,17 @@ def inclusion_scores(found: Sequence[Inclusion], truths: Sequence[Truth]) -> dic
         free.remove(f)
         (x0, x1), (y0, y1) = f.centre_ci
         held = x0 <= t.centre[0] <= x1 and y0 <= t.centre[1] <= y1
-        rows.append(
-            {"kind": t.kind, "found": True, "center_error_mm": min(dist) / MM, "center_in_ci": held}
-        )
+        row = {
+            "kind": t.kind,
+            "found": True,
+            "center_error_mm": min(dist) / MM,
+            "center_in_ci": held,
+        }
+        if f.depth is not None:
+            lo, hi = f.depth.depth_ci
+            row["depth_error_mm"] = abs(f.depth.depth - t.depth) / MM
+            row["depth_in_ci"] = lo <= t.depth <= hi
+        rows.append(row)
     return {
         "inclusions_found": sum(r["found"] for r in rows),
         "inclusions_true": len(truths),

@@ -11,22 +11,24 @@ centroid of the region past it weighted by how far past, the equal-area radius, 
 intervals from joint posterior draws, each draw's region taken near the inclusion (within its
 radius and one length scale of the map). The first of the list is the summary's own inclusion,
 with its extent (the disc through the tip's contact) where it has one; the rest by how far
-their extreme reads from the background. Depth is not read from a single modulus a probe:
-``depth_mm`` is null until the probes carry their modulus against depth (issue 57)::
+their extreme reads from the background. Each inclusion's depth, sphere and contrast are then
+read from the probes about it (:mod:`maps.depth`; ``depth`` None where too few probes are near
+it)::
 
     found = find_inclusions(StiffnessMap.fit(probes), patch, summary)
-    [(f.kind, f.centre, f.radius) for f in found]
+    [(f.kind, f.centre, f.radius, f.depth and f.depth.depth) for f in found]
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage  # type: ignore[import-untyped,unused-ignore]
 
+from .depth import DepthReading, read_depth
 from .gp import MM, Patch, StiffnessMap
 from .region import (
     DRAW_GRID,
@@ -53,6 +55,8 @@ class Inclusion:
         radius, radius_ci: its radius and 95 % interval.
         extreme: the map's highest (stiff) or lowest (soft) modulus in it.
         probability: how sure the map is that its most certain point is past the level.
+        depth: its sphere read from the probes about it (depth, radius, contrast), None if
+            too few probes are near it.
     """
 
     kind: str
@@ -62,8 +66,10 @@ class Inclusion:
     radius_ci: Interval
     extreme: float
     probability: float
+    depth: DepthReading | None = None
 
     def as_dict(self) -> dict[str, object]:
+        sphere = self.depth.as_dict() if self.depth is not None else {}
         return {
             "kind": self.kind,
             "center_mm": [self.centre[0] / MM, self.centre[1] / MM],
@@ -74,6 +80,7 @@ class Inclusion:
             "depth_ci_mm": None,
             "extreme_kpa": self.extreme / 1e3,
             "probability": self.probability,
+            **sphere,
         }
 
 
@@ -102,7 +109,18 @@ def find_inclusions(
                 if best >= found_probability:
                     found.append(_read(kind, sign, m, patch, points, mean, mask, near, draws, best))
     found.sort(key=lambda f: -abs(math.log(f.extreme) - m.background))
-    return _summary_first(found, summary)
+    return with_depths(_summary_first(found, summary), m)
+
+
+def with_depths(found: list[Inclusion], m: StiffnessMap) -> list[Inclusion]:
+    """Each inclusion with its sphere read from the map's probes about it, the others'
+    probes left to them."""
+    out = []
+    for f in found:
+        others = [g.centre for g in found if g is not f]
+        reading = read_depth(m.used, f.centre, m.background, f.kind, others)
+        out.append(replace(f, depth=reading))
+    return out
 
 
 PEAK_CELLS = 5  # a peak is the highest point of the 5 x 5 cells about it (2 mm on 20 mm)
