@@ -15,34 +15,16 @@ if it was run before it.
 from __future__ import annotations
 
 import json
-import math
 import statistics
 import sys
 from typing import Any
 
 from map_worlds import read_study, truths
 
-from palpate.campaigns.surveyloop import LENGTH_SCALE_TIPS, map_of
+from palpate.campaigns.surveyloop import LENGTH_SCALE_TIPS, map_of, matches
 from palpate.maps import Probe
 
 MM = 1e-3
-
-
-def matched(row: dict[str, Any], inclusions: Any) -> list[tuple[Any, Any]]:
-    """Each true inclusion with the reported one of its kind nearest it, within its radius (at
-    least 2 mm), as ``inclusion_scores`` matches them; unmatched ones left out."""
-    free = list(inclusions)
-    out = []
-    for t in truths(row):
-        same = [f for f in free if f.kind == t.kind]
-        if not same:
-            continue
-        f = min(same, key=lambda f: math.dist(f.centre, t.centre))
-        if math.dist(f.centre, t.centre) > max(t.radius, 2 * MM):
-            continue
-        free.remove(f)
-        out.append((t, f))
-    return out
 
 
 def scores(t: Any, f: Any) -> dict[str, Any]:
@@ -78,7 +60,9 @@ def main(argv: list[str] | None = None) -> int:
         summary, _ = map_of(probes, patch, None, seed, scale)
         if summary is None:
             continue
-        for t, f in matched(row, summary.inclusions):
+        for t, f in matches(summary.inclusions, truths(row))[0]:
+            if f is None:
+                continue
             if f.depth is None:
                 unread += 1
                 continue

@@ -187,31 +187,42 @@ class SurveyResult:
         }
 
 
-def inclusion_scores(found: Sequence[Inclusion], truths: Sequence[Truth]) -> dict[str, Any]:
-    """Every true inclusion against the map's list: matched to the nearest reported one of its
-    kind whose centre is within its radius (at least 2 mm) of its own; the reported ones no
-    true inclusion took are false. Per true inclusion: found, the centre's error (mm), whether
-    the centre's interval holds it, and where the map read its sphere the depth's error (of its
-    centre, mm) and whether the depth's interval holds it."""
+def matches(
+    found: Sequence[Inclusion], truths: Sequence[Truth]
+) -> tuple[list[tuple[Truth, Inclusion | None]], list[Inclusion]]:
+    """Every true inclusion with the reported one of its kind nearest it whose centre is
+    within its radius (at least 2 mm) of its own (None: not found), each reported one taken
+    once; and the reported ones no true inclusion took (false)."""
     free = list(found)
-    rows: list[dict[str, Any]] = []
+    pairs: list[tuple[Truth, Inclusion | None]] = []
     for t in truths:
         reach = max(t.radius, 2 * MM)
         same = [f for f in free if f.kind == t.kind]
         dist = [math.hypot(f.centre[0] - t.centre[0], f.centre[1] - t.centre[1]) for f in same]
         if not same or min(dist) > reach:
-            rows.append({"kind": t.kind, "found": False})
+            pairs.append((t, None))
             continue
         f = same[int(np.argmin(dist))]
         free.remove(f)
+        pairs.append((t, f))
+    return pairs, free
+
+
+def inclusion_scores(found: Sequence[Inclusion], truths: Sequence[Truth]) -> dict[str, Any]:
+    """Every true inclusion against the map's list (:func:`matches`). Per true inclusion:
+    found, the centre's error (mm), whether the centre's interval holds it, and where the map
+    read its sphere the depth's error (of its centre, mm) and whether the depth's interval
+    holds it."""
+    pairs, false = matches(found, truths)
+    rows: list[dict[str, Any]] = []
+    for t, f in pairs:
+        if f is None:
+            rows.append({"kind": t.kind, "found": False})
+            continue
         (x0, x1), (y0, y1) = f.centre_ci
         held = x0 <= t.centre[0] <= x1 and y0 <= t.centre[1] <= y1
-        row = {
-            "kind": t.kind,
-            "found": True,
-            "center_error_mm": min(dist) / MM,
-            "center_in_ci": held,
-        }
+        error = math.hypot(f.centre[0] - t.centre[0], f.centre[1] - t.centre[1]) / MM
+        row = {"kind": t.kind, "found": True, "center_error_mm": error, "center_in_ci": held}
         if f.depth is not None:
             lo, hi = f.depth.depth_ci
             row["depth_error_mm"] = abs(f.depth.depth - t.depth) / MM
@@ -220,7 +231,7 @@ def inclusion_scores(found: Sequence[Inclusion], truths: Sequence[Truth]) -> dic
     return {
         "inclusions_found": sum(r["found"] for r in rows),
         "inclusions_true": len(truths),
-        "false_inclusions": len(free),
+        "false_inclusions": len(false),
         "per_inclusion": rows,
     }
 

@@ -14,6 +14,7 @@ from typing import Any
 
 from palpate.campaigns.surveyloop import SurveyResult
 from palpate.maps import MapSummary
+from palpate.maps.inclusions import Inclusion
 
 
 def write_map_results(
@@ -58,6 +59,7 @@ def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) ->
                 f"[x {x0 * 1e3:+.2f}..{x1 * 1e3:+.2f}, y {y0 * 1e3:+.2f}..{y1 * 1e3:+.2f}], "
                 f"radius {s.radius * 1e3:.2f} mm{_radius_note(s)}"
             )
+        lines += [inclusion_line(k + 1, f) for k, f in enumerate(s.inclusions)]
     if result.truth is not None:
         t = result.truth
         lines.append(
@@ -79,6 +81,33 @@ SCORE_NAMES = {
     "center_in_ci": "centre in its 95 % box",
     "radius_in_ci": "radius in its 95 % interval",
 }
+
+
+def inclusion_line(number: int, f: Inclusion) -> str:
+    """One inclusion of the map as a person reads it: kind, centre, radius and, where the map
+    read its sphere, how deep it lies and how stiff, with 95 % intervals (mm).
+
+    >>> box = ((3.8e-3, 4.2e-3), (-4.2e-3, -3.8e-3))
+    >>> nodule = Inclusion("stiff", (4e-3, -4e-3), box, 2.6e-3, (2e-3, 3e-3), 9e5, 1.0)
+    >>> for part in inclusion_line(1, nodule).split("; "):
+    ...     print(part)
+    inclusion 1 (stiff): centre (+4.00, -4.00) mm, radius 2.60 mm
+    depth not read (too few probes about it)
+    """
+    text = (
+        f"inclusion {number} ({f.kind}): centre ({f.centre[0] * 1e3:+.2f}, "
+        f"{f.centre[1] * 1e3:+.2f}) mm, radius {f.radius * 1e3:.2f} mm"
+    )
+    d = f.depth
+    if d is None:
+        return text + "; depth not read (too few probes about it)"
+    bounded = " (bounded on one side only)" if "depth" in d.open else ""
+    return (
+        f"{text}; centre {d.depth * 1e3:.1f} mm deep [{d.depth_ci[0] * 1e3:.1f}.."
+        f"{d.depth_ci[1] * 1e3:.1f}]{bounded}, top {d.top * 1e3:.1f} mm "
+        f"[{d.top_ci[0] * 1e3:.1f}..{d.top_ci[1] * 1e3:.1f}], {d.contrast:.2g}x the tissue "
+        f"[{d.contrast_ci[0]:.2g}..{d.contrast_ci[1]:.2g}]"
+    )
 
 
 def score_text(scores: dict[str, object]) -> str:
