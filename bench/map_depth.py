@@ -38,6 +38,7 @@ def scores(t: Any, f: Any) -> dict[str, Any]:
     }
     out: dict[str, Any] = {"kind": t.kind, "contrast_true": t.contrast, "open": list(d.open)}
     for key, (value, (lo, hi)) in read.items():
+        out[f"{key}_mm"] = value / MM
         out[f"{key}_error_mm"] = (value - true[key]) / MM
         out[f"{key}_in_ci"] = lo <= true[key] <= hi
         out[f"{key}_width_mm"] = (hi - lo) / MM

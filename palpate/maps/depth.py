@@ -11,31 +11,31 @@ not taken from the world (``sim.fem3d`` solves finite elements):
 - the energy density of the tip's field is the incompressible Boussinesq point load's (a radial
   stress ~ cos(theta) / r^2), its source set a height ``b`` above the surface so that the
   contact's width smooths it: ``u ~ Z^2 / (rho^2 + Z^2)^3`` with ``Z = z + b``, whose integral
-  over the half-space is ``pi / (2 b)``; ``b = KAPPA a^WIDENING`` with lengths in the probes'
-  median contact radius (a contact wider than the median reaches deeper than in proportion);
+  over the half-space is ``pi / (2 b)``, with ``b = KAPPA a``;
 - ``s`` is its integral over the sphere (a fixed quadrature of the unit ball), over that;
 - the modulus's factor is Eshelby's dilute sphere, ``1 + GAIN s (c - 1) / (1 + BETA (c - 1))``
   (BETA is 0.4 for an incompressible sphere in an incompressible matrix).
 
-KAPPA, WIDENING, GAIN and BETA were fitted to the finite-element world's factor for one patch
-of four spheres (tops 0.5-2.5 mm, radii 2-3.5 mm, 0.3x to 8x; offsets 0-4 mm; depths of
-indentation 0.05-1.3 mm under the 3.5 mm tip), and to how it changes with the indentation
-(the shallow ratio, ``jointfit.shallow``): 2.4 % rms in log E, 1.8 % in the ratio. On a second
-patch of four others: 3.6 % and 2.5 % (:data:`MODEL_SD` and :data:`RATIO_SD`, added to every
-probe's own sd). ``bench/depth_model.py`` fits and checks them. docs/maps.md, "Depth".
+KAPPA, GAIN and BETA were fitted to the finite-element world's factor for one patch of four
+spheres (tops 0.5-2.5 mm, radii 2-3.5 mm, 0.3x to 8x; offsets 0-4 mm; depths of indentation
+0.05-1.3 mm under the 3.5 mm tip): 2.7 % rms in log E. On a second patch of four others it is
+4.2 % (:data:`MODEL_SD`, added to every probe's own sd). ``bench/depth_model.py`` fits and
+checks them. docs/maps.md, "Depth".
+
+Depth is read from the lateral profile, not from how each record's modulus changes with the
+indentation: the joint fit's free contact point absorbs that change (a modulus that rises with
+depth looks like a later contact), so the loading's first half reads the whole's modulus to
+within 0.01 over every inclusion of a study (docs/maps.md).
 
 The fit: each usable probe within :data:`REACH` contact radii of the centre and nearer to it
-than to any other inclusion gives log E at its contact's effective radius (a fit over depths up
-to D reads the law at about 0.8 D), and its shallow ratio where it has one: the factor's at the
-half's effective radius over the whole's, which the background cancels. Top depth, radius (both
-on grids scaled by the probes' median contact radius) and contrast (stiff above one, soft below)
-are gridded; an offset of the background in log E is profiled in closed form, with a prior sd of
+than to any other inclusion gives log E at its contact radius. Top depth, radius (both on grids
+scaled by the probes' median contact radius) and contrast (stiff above one, soft below) are
+gridded; an offset of the background in log E is profiled in closed form, with a prior sd of
 :data:`BACKGROUND_SD` about the map's background (the map's is the median over the whole patch,
 which large inclusions lift). Intervals are profile-likelihood: the grid values whose best
-chi^2 lies within 3.84 s^2 of the least, s^2 the reduced chi^2 where above one. The values are
-the posterior's means over the grid (flat in top and radius up to 3.5 median contact radii and
-in log contrast; a flat valley of chi^2 leaves the least's grid point anywhere along it). Depth
-and radius trade off, so their intervals are wide where the probes cannot tell them apart; an
+chi^2 lies within 3.84 s^2 of the least, s^2 the reduced chi^2 where above one; the values
+are the least's grid point (top and radius up to 3.5 median contact radii). Depth and radius
+trade off, so their intervals are wide where the probes cannot tell them apart; an
 interval that reaches its grid's end says that the probes bound the value on one side only
 (:attr:`DepthReading.open`)::
 
@@ -58,18 +58,14 @@ from .probes import Probe
 FloatArray = NDArray[np.float64]
 Interval = tuple[float, float]
 
-KAPPA = 0.88  # the source's height over the surface, in contact radii (at the median's)
-WIDENING = 1.458  # the height goes as the contact radius to this power
-GAIN = 2.154  # the share's weight on the force
+KAPPA = 0.766  # the source's height over the surface, in contact radii
+GAIN = 2.058  # the share's weight on the force
 BETA = 0.366  # Eshelby's strain concentration: (c - 1) / (1 + BETA (c - 1))
-MODEL_SD = 0.036  # the model's error in log E on the patch it was not fitted to
-RATIO_SD = 0.025  # and in the shallow ratio's log
+MODEL_SD = 0.042  # the model's error in log E on the patch it was not fitted to
 BACKGROUND_SD = 0.1  # prior sd of the background's offset from the map's (log E)
 REACH = 4.5  # probes within this many contact radii of the centre are read
 MIN_PROBES = 5  # fewer usable probes about an inclusion: no reading
 CHI2_95 = 3.841458820694124  # one degree of freedom
-EFFECTIVE_DEPTH = 0.8  # a fit over depths up to D reads the law at about 0.8 D (weights ~ delta^3)
-HALF = 0.5  # the shallow ratio's half: depths up to this share of the deepest (jointfit.shallow)
 
 TOPS = np.linspace(0.05, 3.5, 50)  # top depths, in median contact radii
 RADII = np.linspace(0.5, 3.5, 21)  # radii, in median contact radii
@@ -79,7 +75,7 @@ CONTRASTS = {
 }
 
 
-def _unit_ball(shells: int = 6, directions: int = 64) -> tuple[FloatArray, FloatArray]:
+def _unit_ball(shells: int = 8, directions: int = 96) -> tuple[FloatArray, FloatArray]:
     """Points of the unit ball and their volume shares (summing to one): shells of equal
     thickness at their volume-mean radii, each with Fibonacci directions."""
     k = np.arange(directions) + 0.5
@@ -110,7 +106,7 @@ def energy_share(
     """
     x = BALL * radius
     rho2 = (x[:, 0, None] + offset[None, :]) ** 2 + x[:, 1, None] ** 2  # (Q, N)
-    source = KAPPA * contact_radius**WIDENING  # (N,)
+    source = KAPPA * contact_radius  # (N,)
     z = top[:, None, None] + radius + x[None, :, 2, None] + source[None, None, :]  # (T, Q, N)
     density = z**2 / (rho2[None] + z**2) ** 3
     volume = 4.0 / 3.0 * math.pi * radius**3
@@ -205,23 +201,8 @@ def read_depth(
     offset = np.array([math.hypot(p.x - centre[0], p.y - centre[1]) for p in near]) / scale
     logs = np.log([p.modulus for p in near]) - background  # type: ignore[arg-type]
     weight = 1.0 / (np.array([p.log_sigma() for p in near]) ** 2 + MODEL_SD**2)
-    shallow = [(k, p.shallow) for k, p in enumerate(near) if p.shallow is not None]
-    ratios = Ratios(
-        np.array([k for k, _ in shallow], dtype=np.int64),
-        np.array([r for _, (r, _) in shallow]),
-        1.0 / (np.array([sd for _, (_, sd) in shallow]) ** 2 + RATIO_SD**2),
-    )
-    chi = _chi2(offset, radii / scale, logs, weight, ratios, CONTRASTS[kind])  # (T, R, C)
-    return _reading(chi, CONTRASTS[kind], scale, len(near) + ratios.index.size)
-
-
-@dataclass(frozen=True)
-class Ratios:
-    """The probes' shallow-over-whole moduli: which probes (indices), log ratios, weights."""
-
-    index: NDArray[np.int64]
-    log_ratio: FloatArray
-    weight: FloatArray
+    chi = _chi2(offset, radii / scale, logs, weight, CONTRASTS[kind])  # (T, R, C)
+    return _reading(chi, CONTRASTS[kind], scale, len(near))
 
 
 def _chi2(
@@ -229,27 +210,17 @@ def _chi2(
     contact: FloatArray,
     logs: FloatArray,
     weight: FloatArray,
-    ratios: Ratios,
     contrasts: FloatArray,
 ) -> FloatArray:
-    """chi^2 over the grid of top depth, radius and contrast: each probe's modulus at its
-    contact's effective radius, the background's offset profiled (a Gaussian prior of
-    :data:`BACKGROUND_SD`), and each shallow ratio against the factor's at the half's radius
-    over the whole's (the background cancels)."""
+    """chi^2 over the grid of top depth, radius and contrast, the background's offset profiled
+    (a Gaussian prior of :data:`BACKGROUND_SD`)."""
     chi = np.empty((TOPS.size, RADII.size, contrasts.size))
     prior = 1.0 / BACKGROUND_SD**2
-    n = offset.size
-    at = np.concatenate([offset, offset[ratios.index]])
-    widths = np.concatenate([contact, contact[ratios.index] * math.sqrt(HALF)])
-    widths = widths * math.sqrt(EFFECTIVE_DEPTH)
     for j, radius in enumerate(RADII):
-        share = energy_share(at, widths, TOPS, float(radius))  # (T, N + M)
-        model = np.log(modulus_factor(share[None], contrasts[:, None, None]))  # (C, T, N + M)
-        residual = logs - model[..., :n]
+        share = energy_share(offset, contact, TOPS, float(radius))  # (T, N)
+        residual = logs - np.log(modulus_factor(share[None], contrasts[:, None, None]))
         shift = (residual * weight).sum(axis=2) / (weight.sum() + prior)  # (C, T)
         misfit = ((residual - shift[..., None]) ** 2 * weight).sum(axis=2) + shift**2 * prior
-        slope = ratios.log_ratio - (model[..., n:] - model[..., ratios.index])
-        misfit += (slope**2 * ratios.weight).sum(axis=2)
         chi[:, j, :] = misfit.T
     return chi
 
@@ -277,11 +248,8 @@ def _reading(chi: FloatArray, contrasts: FloatArray, scale: float, n: int) -> De
     depth_ci = (float(centres[held].min()), float(centres[held].max()))
     if "top" in opened or "radius" in opened:
         opened.insert(0, "depth")
-    weight = np.exp(-0.5 * (chi - least) / s2)
-    weight /= weight.sum()
-    by_top, by_radius = weight.sum(axis=(1, 2)), weight.sum(axis=(0, 2))
-    top, radius = float(by_top @ tops), float(by_radius @ radii)
-    contrast = math.exp(float(weight.sum(axis=(0, 1)) @ np.log(contrasts)))
+    i, j, k = (int(v) for v in np.unravel_index(int(np.argmin(chi)), chi.shape))
+    top, radius, contrast = float(tops[i]), float(radii[j]), float(contrasts[k])
     return DepthReading(
         depth=top + radius,
         depth_ci=depth_ci,

@@ -33,9 +33,6 @@ class Probe:
         lab_time: simulated or bench seconds it took, the stage's travel to it included.
         contact_radius: the tip's contact radius at its deepest (m; sqrt(R delta), Hertz's),
             None if unknown: how wide the probe reads the tissue (``extent``).
-        shallow: the log of the loading's first half's modulus over the whole's, and its sd
-            (the joint fit's ``shallow``), None if not read: how the modulus changes with
-            depth (``depth``).
     """
 
     x: float
@@ -46,7 +43,6 @@ class Probe:
     reasons: tuple[str, ...] = field(default=())
     lab_time: float = 0.0
     contact_radius: float | None = None
-    shallow: tuple[float, float] | None = None
 
     @property
     def usable(self) -> bool:
@@ -92,7 +88,6 @@ class Probe:
             tuple(d["reasons"]),
             float(d["lab_time_s"]),
             None if d["contact_radius_m"] is None else float(d["contact_radius_m"]),
-            _pair(d.get("shallow")),
         )
 
     @classmethod
@@ -107,7 +102,6 @@ class Probe:
             tuple(d["reasons"]),
             d["lab_time_s"],
             None if d.get("contact_radius_mm") is None else d["contact_radius_mm"] * MM,
-            _pair(d.get("shallow")),
         )
 
     def record(self) -> dict[str, object]:
@@ -122,7 +116,6 @@ class Probe:
             "reasons": list(self.reasons),
             "lab_time_s": self.lab_time,
             "contact_radius_m": self.contact_radius,
-            "shallow": None if self.shallow is None else list(self.shallow),
         }
 
     def as_dict(self) -> dict[str, object]:
@@ -137,10 +130,4 @@ class Probe:
             "reasons": list(self.reasons),
             "lab_time_s": self.lab_time,
             "contact_radius_mm": None if self.contact_radius is None else self.contact_radius / MM,
-            "shallow": None if self.shallow is None else list(self.shallow),
         }
-
-
-def _pair(value: Any) -> tuple[float, float] | None:
-    """A ``shallow`` pair read back (None in a file written before it)."""
-    return None if value is None else (float(value[0]), float(value[1]))

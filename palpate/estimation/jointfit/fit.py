@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from statistics import NormalDist
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -25,7 +24,6 @@ from .record import Record, check_options, checked_record
 from .refine import Refined, refine, require_contact
 from .result import FitFailed, JointFit
 from .scan import Start, scan
-from .shallow import shallow_ratio
 
 FloatArray = NDArray[np.float64]
 
@@ -158,18 +156,7 @@ def _profiled(
     if result.modulus is not None and result.modulus > 0.0:
         trimmed = {k: c.trimmed() for k, c in curves.items()}
         terms = Terms(result.modulus, result.model_form or 0.0, trimmed)
-    shallow = shallow_ratio(fit, record.force, base[1], noise.scale2, _contact_sd(result))
-    return dataclasses.replace(
-        result, warnings=result.warnings + found_against, terms=terms, shallow=shallow
-    )
-
-
-def _contact_sd(result: JointFit) -> float:
-    """x0's sd from its interval (m; 0 without one)."""
-    if result.contact_low is None or result.contact_high is None:
-        return 0.0
-    z = NormalDist().inv_cdf(0.5 + 0.5 * result.confidence)
-    return (result.contact_high - result.contact_low) / (2.0 * z)
+    return dataclasses.replace(result, warnings=result.warnings + found_against, terms=terms)
 
 
 @dataclass(frozen=True)

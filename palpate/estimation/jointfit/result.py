@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from .pooling import Terms
-    from .shallow import Shallow
 
 
 @dataclass(frozen=True)
@@ -39,8 +38,6 @@ class JointFit:
         nfev: residual evaluations of the refinement.
         law: the contact law's name.
         warnings: validity flags and fit diagnostics, one sentence each.
-        shallow: the loading's first half's modulus over the whole's, log and sd
-            (``jointfit.shallow``: how the modulus changes with depth), None if not read.
     """
 
     success: bool
@@ -66,7 +63,6 @@ class JointFit:
     nfev: int = 0
     law: str = ""
     warnings: tuple[str, ...] = field(default=())
-    shallow: Shallow | None = None
     # the trial's share of its sample's pooled fit (``jointfit.pooling``): in memory only
     terms: Terms | None = field(default=None, compare=False, repr=False)
 
@@ -104,7 +100,6 @@ class JointFit:
             "nfev": self.nfev,
             "law": self.law,
             "warnings": list(self.warnings),
-            "shallow": None if self.shallow is None else asdict(self.shallow),
         }
 
 

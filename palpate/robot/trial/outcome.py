@@ -113,9 +113,8 @@ def probe_of(
 ) -> Probe:
     """A finished trial as a map's probe at ``point`` (m): the joint fit's modulus and interval
     when it succeeded, the verdict's status and reasons (the trial's end when it has none), the
-    lab time it took (s, with the stage's travel to it), given the sensor's ``tip_radius`` (m)
-    the contact's radius at the fit's deepest point, sqrt(R delta), and how the modulus
-    changes with depth (the fit's ``shallow``)."""
+    lab time it took (s, with the stage's travel to it) and, given the sensor's ``tip_radius``
+    (m), the contact's radius at the fit's deepest point, sqrt(R delta)."""
     from ...maps.probes import Probe
 
     jf, v = o.joint, o.verdict
@@ -132,15 +131,7 @@ def probe_of(
         () if v is None else tuple(v.reasons) or (() if ok else (o.reason,)),
         lab_time,
         _contact_radius(jf, tip_radius) if ok else None,
-        _shallow(jf) if ok else None,
     )
-
-
-def _shallow(jf: JointFit | None) -> tuple[float, float] | None:
-    """The joint fit's shallow half over the whole (log ratio, sd), None if not read."""
-    if jf is None or jf.shallow is None:
-        return None
-    return (jf.shallow.log_ratio, jf.shallow.sd)
 
 
 def _contact_radius(jf: JointFit | None, tip_radius: float | None) -> float | None:
