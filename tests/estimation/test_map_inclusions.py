@@ -55,7 +55,7 @@ def test_two_stiff_bumps_and_a_soft_dip_are_each_found_of_their_kind() -> None:
         (x0, x1), (y0, y1) = near.centre_ci
         assert x0 <= truth[0] <= x1
         assert y0 <= truth[1] <= y1
-    assert found[0].as_dict()["depth_mm"] is None  # not read from one modulus a probe
+    assert found[0].as_dict()["depth_mm"] is None  # probes without a contact radius: not read
 
 
 def test_the_summary_reads_the_highest_of_two_bumps_not_between_them() -> None:
