@@ -131,6 +131,8 @@ class DepthReading:
         radius, radius_ci: the sphere's radius.
         contrast, contrast_ci: its modulus over the background's.
         probes: how many probes were read.
+        support: how much better a sphere explains them than the background alone (the drop
+            in chi^2 over s^2): under :data:`CHI2_95`, the probes about it do not need one.
         open: the names of the intervals that reach their grid's end (bounded on one side).
     """
 
@@ -143,7 +145,14 @@ class DepthReading:
     contrast: float
     contrast_ci: Interval
     probes: int
+    support: float
     open: tuple[str, ...] = ()
+
+    @property
+    def needed(self) -> bool:
+        """Whether the probes about it need a sphere at 95 % (one degree of freedom: its
+        strength; where there is none, its place and size are not defined)."""
+        return self.support >= CHI2_95
 
     def as_dict(self) -> dict[str, object]:
         mm = 1e3
@@ -158,6 +167,7 @@ class DepthReading:
             "contrast_ci": list(self.contrast_ci),
             "depth_probes": self.probes,
             "depth_open": list(self.open),
+            "depth_support": self.support,
         }
 
 
@@ -202,7 +212,10 @@ def read_depth(
     logs = np.log([p.modulus for p in near]) - background  # type: ignore[arg-type]
     weight = 1.0 / (np.array([p.log_sigma() for p in near]) ** 2 + MODEL_SD**2)
     chi = _chi2(offset, radii / scale, logs, weight, CONTRASTS[kind])  # (T, R, C)
-    return _reading(chi, CONTRASTS[kind], scale, len(near))
+    prior = 1.0 / BACKGROUND_SD**2
+    shift = float((logs * weight).sum() / (weight.sum() + prior))
+    alone = float(((logs - shift) ** 2 * weight).sum() + shift**2 * prior)  # no sphere
+    return _reading(chi, alone, CONTRASTS[kind], scale, len(near))
 
 
 def _chi2(
@@ -225,8 +238,11 @@ def _chi2(
     return chi
 
 
-def _reading(chi: FloatArray, contrasts: FloatArray, scale: float, n: int) -> DepthReading:
-    """The best grid point and the profile intervals of top, centre depth, radius, contrast."""
+def _reading(
+    chi: FloatArray, alone: float, contrasts: FloatArray, scale: float, n: int
+) -> DepthReading:
+    """The best grid point and the profile intervals of top, centre depth, radius, contrast;
+    ``alone``: chi^2 without a sphere."""
     least = float(chi.min())
     s2 = max(1.0, least / max(n - 4, 1))
     inside: NDArray[np.bool_] = np.asarray(chi <= least + CHI2_95 * s2)
@@ -260,5 +276,6 @@ def _reading(chi: FloatArray, contrasts: FloatArray, scale: float, n: int) -> De
         contrast=contrast,
         contrast_ci=contrast_ci,
         probes=n,
+        support=(alone - least) / s2,
         open=tuple(opened),
     )

@@ -13,7 +13,8 @@ radius and one length scale of the map). The first of the list is the summary's 
 with its extent (the disc through the tip's contact) where it has one; the rest by how far
 their extreme reads from the background. Each inclusion's depth, sphere and contrast are then
 read from the probes about it (:mod:`maps.depth`; ``depth`` None where too few probes are near
-it)::
+it), and a region whose probes a shift of the background explains as well as a sphere does is
+dropped (but the summary's own)::
 
     found = find_inclusions(StiffnessMap.fit(probes), patch, summary)
     [(f.kind, f.centre, f.radius, f.depth and f.depth.depth) for f in found]
@@ -109,17 +110,24 @@ def find_inclusions(
                 if best >= found_probability:
                     found.append(_read(kind, sign, m, patch, points, mean, mask, near, draws, best))
     found.sort(key=lambda f: -abs(math.log(f.extreme) - m.background))
-    return with_depths(_summary_first(found, summary), m)
+    return with_depths(_summary_first(found, summary), m, summary.found)
 
 
-def with_depths(found: list[Inclusion], m: StiffnessMap) -> list[Inclusion]:
-    """Each inclusion with its sphere read from the map's probes about it, the others'
-    probes left to them."""
+def with_depths(found: list[Inclusion], m: StiffnessMap, keep_first: bool) -> list[Inclusion]:
+    """Each inclusion with its sphere read from the map's probes about it, the others' probes
+    left to them. One the probes about it do not bear out is dropped, except the summary's own
+    (``keep_first``): fewer than :data:`maps.depth.MIN_PROBES` of them (where the probes carry
+    their contact radii: the map extrapolating into a corner it barely probed), or a shift of
+    the background explains them as well as a sphere (:attr:`DepthReading.needed`: the corners
+    of a patch whose background large inclusions lifted)."""
+    judged = any(p.contact_radius is not None for p in m.used)
     out = []
-    for f in found:
+    for k, f in enumerate(found):
         others = [g.centre for g in found if g is not f]
         reading = read_depth(m.used, f.centre, m.background, f.kind, others)
-        out.append(replace(f, depth=reading))
+        borne = reading.needed if reading is not None else not judged
+        if borne or (keep_first and k == 0):
+            out.append(replace(f, depth=reading))
     return out
 
 

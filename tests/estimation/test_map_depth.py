@@ -129,3 +129,20 @@ def test_probes_nearer_another_inclusion_are_left_to_it_and_too_few_give_none() 
     assert read_depth(probes[:4], (0.0, 0.0), math.log(E0), "stiff") is None
     with pytest.raises(ValueError, match="kind"):
         read_depth(probes, (0.0, 0.0), math.log(E0), "hard")
+
+
+def test_probes_a_shifted_background_explains_do_not_need_a_sphere() -> None:
+    rng = np.random.default_rng(5)
+    flat = []
+    for x in np.arange(-4, 5) * 1.25e-3:
+        for y in np.arange(-4, 5) * 1.25e-3:
+            e = 0.9 * E0 * math.exp(rng.normal(0.0, 0.02))  # 10 % under the map's background
+            ci = (e * math.exp(-Z95 * 0.02), e * math.exp(Z95 * 0.02))
+            flat.append(Probe(x, y, e, ci, "ok", contact_radius=A))
+    unneeded = read_depth(flat, (0.0, 0.0), math.log(E0), "soft")
+    assert unneeded is not None
+    assert not unneeded.needed
+    cyst = read_depth(_probes(1e-3, 3e-3, 0.3), (0.0, 0.0), math.log(E0), "soft")
+    assert cyst is not None
+    assert cyst.needed
+    assert cyst.support > 10 * unneeded.support + 10

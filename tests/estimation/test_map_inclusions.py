@@ -123,3 +123,31 @@ def test_two_nodules_whose_blurred_footprints_touch_are_two() -> None:
     scores = inclusion_scores(found, truths)
     assert scores["inclusions_found"] == 2
     assert scores["false_inclusions"] == 0
+
+
+def test_a_region_the_probes_about_it_do_not_bear_out_is_dropped_but_the_summary_s() -> None:
+    from palpate.maps.inclusions import Inclusion, with_depths
+
+    rng = np.random.default_rng(2)
+    probes = []
+    for x, y in raster_points(PATCH, 81):  # 2.5 mm apart, every contact 1.8 mm wide
+        e = E0 * math.exp(rng.normal(0.0, 0.02))
+        ci = (e * math.exp(-Z95 * 0.02), e * math.exp(Z95 * 0.02))
+        probes.append(Probe(x, y, e, ci, "ok", contact_radius=1.8e-3))
+    m = StiffnessMap.fit(probes)
+
+    def region(kind: str, centre: tuple[float, float]) -> Inclusion:
+        box = ((centre[0] - 1e-3, centre[0] + 1e-3), (centre[1] - 1e-3, centre[1] + 1e-3))
+        return Inclusion(kind, centre, box, 2e-3, (1e-3, 3e-3), 0.9 * E0, 0.99)
+
+    flat = [region("stiff", (0.0, 0.0)), region("soft", (5e-3, 5e-3))]
+    kept = with_depths(flat, m, keep_first=True)
+    assert [f.kind for f in kept] == ["stiff"]  # the summary's own stays, read as not needed
+    assert kept[0].depth is not None
+    assert not kept[0].depth.needed
+    assert with_depths(flat, m, keep_first=False) == []
+    # a corner 30 mm off the patch: no probe within 4.5 contact radii, so none bears it out
+    assert with_depths([region("soft", (30e-3, 30e-3))], m, keep_first=False) == []
+    # probes without their contact radii cannot judge: the region stays, unread
+    bare = StiffnessMap.fit([Probe(p.x, p.y, p.modulus, p.ci, p.status) for p in probes])
+    assert [f.depth for f in with_depths(flat, bare, keep_first=False)] == [None, None]
