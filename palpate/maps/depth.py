@@ -133,7 +133,9 @@ class DepthReading:
         probes: how many probes were read.
         support: how much better a sphere explains them than the background alone (the drop
             in chi^2 over s^2): under :data:`CHI2_95`, the probes about it do not need one.
-        open: the names of the intervals that reach their grid's end (bounded on one side).
+        open: the names of the intervals that reach an end of their grid the tissue does not
+            set (the top's deepest, either end of radius and contrast; the centre's depth with
+            either of the first two): the probes bound these on one side only.
     """
 
     depth: float
@@ -252,13 +254,14 @@ def _reading(
     held: NDArray[np.bool_] = np.any(inside, axis=2)  # (T, R)
     opened: list[str] = []
 
-    def span(name: str, values: FloatArray, kept: NDArray[np.bool_]) -> Interval:
+    def span(name: str, values: FloatArray, kept: NDArray[np.bool_], low: bool = True) -> Interval:
         lo, hi = float(values[kept].min()), float(values[kept].max())
-        if lo <= values.min() or hi >= values.max():
+        if (low and lo <= values.min()) or hi >= values.max():
             opened.append(name)
         return lo, hi
 
-    top_ci = span("top", tops, np.any(held, axis=1))
+    # a top at the grid's first value is at the surface, a bound the tissue sets
+    top_ci = span("top", tops, np.any(held, axis=1), low=False)
     radius_ci = span("radius", radii, np.any(held, axis=0))
     contrast_ci = span("contrast", contrasts, np.any(inside, axis=(0, 1)))
     depth_ci = (float(centres[held].min()), float(centres[held].max()))

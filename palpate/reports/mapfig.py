@@ -6,7 +6,8 @@ number as a grey cross, a ``suspect`` one in orange); the map's uncertainty (sd 
 and the probability of being above the threshold with its one-half contour (the apparent
 region), the inclusion's extent (the disc fitted through the tip's contact, solid black on every
 panel: the boundary the map reports), the estimated centre with its 95 % box, and in simulation
-every true inclusion's footprint (dashed) and centre (+). The map's other inclusions (a map of
+every true inclusion's footprint (dashed) and centre (+); each inclusion's depth as the map read
+it, on the left. The map's other inclusions (a map of
 several, ``maps.inclusions``): each disc on every panel, black if stiff, cyan if soft, its
 centre and its 95 % box on the right. A survey that found nothing says so in the title.
 """
@@ -63,6 +64,7 @@ def map_figure(result: SurveyResult, path: Path, title: str = "") -> Path:
         )
         axes[2].plot(s.centre[0] / MM, s.centre[1] / MM, "kx", ms=9, label="estimated centre")
     _others(axes, s.inclusions[1:])
+    _depths(axes[0], s.inclusions)
     _legend(fig, result)
     verdict = "inclusion found" if s.found else "no inclusion found"
     if len(s.inclusions) > 1:
@@ -140,6 +142,25 @@ def _others(axes: Any, others: Any) -> None:
         box.set_edgecolor(colour)
         axes[2].add_patch(box)
         axes[2].plot(*centre, "x", color=colour, ms=9)
+
+
+def _depths(ax: Any, inclusions: Any) -> None:
+    """Each inclusion's depth beside it on the left panel: its centre's depth and the 95 %
+    interval (mm), as the map read its sphere (``maps.depth``)."""
+    for inc in inclusions:
+        if inc.depth is None:
+            continue
+        d = inc.depth
+        ax.annotate(
+            f"{d.depth / MM:.1f} mm deep\n[{d.depth_ci[0] / MM:.1f}-{d.depth_ci[1] / MM:.1f}]",
+            (inc.centre[0] / MM, inc.centre[1] / MM),
+            xytext=(0, -(inc.radius / MM) * 9 - 10),
+            textcoords="offset points",
+            ha="center",
+            va="top",
+            fontsize=7,
+            color="w",
+        )
 
 
 def _save(fig: Any, path: Path) -> Path:

@@ -101,7 +101,7 @@ def inclusion_line(number: int, f: Inclusion) -> str:
     d = f.depth
     if d is None:
         return text + "; depth not read (too few probes about it)"
-    bounded = " (bounded on one side only)" if "depth" in d.open else ""
+    bounded = " (the probes bound it on one side only)" if "depth" in d.open else ""
     return (
         f"{text}; centre {d.depth * 1e3:.1f} mm deep [{d.depth_ci[0] * 1e3:.1f}.."
         f"{d.depth_ci[1] * 1e3:.1f}]{bounded}, top {d.top * 1e3:.1f} mm "
