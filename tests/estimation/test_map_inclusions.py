@@ -151,3 +151,31 @@ def test_a_region_the_probes_about_it_do_not_bear_out_is_dropped_but_the_summary
     # probes without their contact radii cannot judge: the region stays, unread
     bare = StiffnessMap.fit([Probe(p.x, p.y, p.modulus, p.ci, p.status) for p in probes])
     assert [f.depth for f in with_depths(flat, bare, keep_first=False)] == [None, None]
+
+
+def test_the_scores_carry_the_depth_where_the_map_read_it_and_a_study_sums_them() -> None:
+    from dataclasses import replace
+
+    from palpate.campaigns.mapstudy import whole_lines
+    from palpate.maps.depth import DepthReading
+
+    _, found = _read(_modulus)
+    truths = [Truth(STIFF_A, 2.5e-3, 3.5e-3, 5.0), Truth(SOFT, 3e-3, 4e-3, 0.3)]
+    stiff = min(
+        (f for f in found if f.kind == "stiff"),
+        key=lambda f: math.dist(f.centre, STIFF_A),
+    )
+    reading = DepthReading(
+        3.1e-3, (2.5e-3, 5e-3), 0.8e-3, (0.2e-3, 1.5e-3), 2.3e-3, (1e-3, 4e-3), 4.0, (2, 50), 20, 30
+    )
+    read = [replace(f, depth=reading) if f is stiff else f for f in found]
+    rows = inclusion_scores(read, truths)["per_inclusion"]
+    assert rows[0]["depth_error_mm"] == pytest.approx(0.4)
+    assert rows[0]["depth_in_ci"]
+    assert "depth_error_mm" not in rows[1]  # the soft one: no reading, no depth score
+    summary = whole_lines([inclusion_scores(read, truths)])
+    assert summary["depth_read"] == 1
+    assert summary["depth_in_ci"] == 1
+    assert summary["depth_error_mm_median"] == pytest.approx(0.4)
+    assert stiff.as_dict()["depth_mm"] is None
+    assert replace(stiff, depth=reading).as_dict()["depth_mm"] == pytest.approx(3.1)
