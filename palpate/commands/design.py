@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(found.as_dict(), indent=2))
     else:
-        print(found.verdict.headline())
+        print(found.headline())
         if found.lumen is not None:
             print(found.lumen.text())
         print_report(found.result, found.constraints, found.check)

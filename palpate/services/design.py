@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -341,12 +341,26 @@ class DesignOutcome:
     weight: WeightCheck | None
     verdict: DesignVerdict
     lumen: LumenReport | None = None
+    with_tip_grating: DesignOutcome | None = None
+
+    def headline(self) -> str:
+        """The report's first line: the verdict, and where the plain request is not usable
+        but a tip grating makes it so, the option that does."""
+        alt = self.with_tip_grating
+        if alt is None or not alt.verdict.usable:
+            return self.verdict.headline()
+        return (
+            "NOT USABLE without a tip grating; with --tip-grating: "
+            f"{alt.verdict.headline()} (without: {'; '.join(self.verdict.reasons)})"
+        )
 
     def as_dict(self) -> dict[str, Any]:
         w = self.weight
         extra = {**_tip_payload(self.tip), **({} if w is None else {"weight": w.as_dict()})}
         if self.lumen is not None:
             extra["lumen"] = self.lumen.as_dict()
+        if self.with_tip_grating is not None:
+            extra["with_tip_grating"] = self.with_tip_grating.as_dict()
         return {**self.verdict.as_dict(), **payload(self.result, self.constraints, self.check),
                 **extra}  # fmt: skip
 
@@ -354,7 +368,19 @@ class DesignOutcome:
 def evaluate(req: DesignRequest) -> DesignOutcome:
     """The search, the designed robot configuration (written with ``write``), the weight
     check and the simulated check of a request (``palpate design``'s options, or
-    ``palpate.design``'s keywords)."""
+    ``palpate.design``'s keywords). A plain request whose simulated check fails is checked
+    again with a tip grating (``with_tip_grating``), so the answer names the option that
+    serves it, where one does."""
+    found = _evaluated(req)
+    plain = not req.tip_grating and not req.no_sim
+    if plain and found.result.success and found.verdict.usable is False:
+        tipped = replace(req, tip_grating=True, write=None)  # written as asked, or not at all
+        return replace(found, with_tip_grating=_evaluated(tipped))
+    return found
+
+
+def _evaluated(req: DesignRequest) -> DesignOutcome:
+    """:func:`evaluate` for ``req`` as it is asked."""
     stack = load_stack(req.config)
     base = load(SceneConfig, req.scene if req.scene else resolve("scenes/bench.yaml"))
     modulus_range, constraints, space = inputs(req, stack, base)

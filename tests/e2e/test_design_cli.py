@@ -174,3 +174,20 @@ def test_a_sagging_sensor_with_a_tip_grating_is_pointed_to_the_load_plateau(
     )
     assert "beyond 1.5%" in weight
     assert "read its buckling from the tip load's plateau (campaign.detector: tip" in weight
+
+
+@pytest.mark.slow
+def test_a_plain_request_a_tip_grating_serves_names_the_option(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    argv = ["design", "--modulus-range", "1:10", "--unit", "kPa", "--executor", "serial"]
+    assert main(argv) == 1  # as asked, its simulated check fails (issue 60)
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("NOT USABLE without a tip grating; with --tip-grating: USABLE")
+    assert main([*argv, "--json"]) == 1
+    out = json.loads(capsys.readouterr().out)
+    assert out["usable"] is False
+    assert out["with_tip_grating"]["usable"] is True
+    assert "tip_grating" in out["with_tip_grating"]
+    assert main([*argv, "--tip-grating"]) == 0  # the option it names gives the answer
+    assert capsys.readouterr().out.startswith("USABLE design")
