@@ -21,6 +21,7 @@ LAYER_FRONTS = (
     "palpate.estimation.trial.finished",
     "palpate.reports.mapresults",
     "palpate.services.design",
+    "palpate.services.design_request",
 )
 
 

@@ -11,7 +11,7 @@ from typing import Any
 
 from palpate.campaigns.designcheck import UNITS
 from palpate.campaigns.executors import add_executor_arguments
-from palpate.services.design import FIELD_TYPES, POSES, DesignRequest, as_option
+from palpate.services.design_request import FIELD_TYPES, POSES, DesignRequest, as_option
 
 _FIELDS = {f.name: f for f in dataclasses.fields(DesignRequest)}
 
