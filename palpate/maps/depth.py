@@ -214,10 +214,18 @@ def read_depth(
     logs = np.log([p.modulus for p in near]) - background  # type: ignore[arg-type]
     weight = 1.0 / (np.array([p.log_sigma() for p in near]) ** 2 + MODEL_SD**2)
     chi = _chi2(offset, radii / scale, logs, weight, CONTRASTS[kind])  # (T, R, C)
-    prior = 1.0 / BACKGROUND_SD**2
-    shift = float((logs * weight).sum() / (weight.sum() + prior))
-    alone = float(((logs - shift) ** 2 * weight).sum() + shift**2 * prior)  # no sphere
+    alone = float(_shifted_misfit(logs, weight))  # no sphere: the background's shift alone
     return _reading(chi, alone, CONTRASTS[kind], scale, len(near))
+
+
+def _shifted_misfit(residual: FloatArray, weight: FloatArray) -> FloatArray:
+    """chi^2 of ``residual`` (probes on the last axis) less the background's offset that
+    minimises it under a Gaussian prior of :data:`BACKGROUND_SD` (closed form), the prior's
+    term included."""
+    prior = 1.0 / BACKGROUND_SD**2
+    shift = (residual * weight).sum(axis=-1) / (weight.sum() + prior)
+    misfit = ((residual - shift[..., None]) ** 2 * weight).sum(axis=-1) + shift**2 * prior
+    return np.asarray(misfit, dtype=np.float64)
 
 
 def _chi2(
@@ -230,13 +238,10 @@ def _chi2(
     """chi^2 over the grid of top depth, radius and contrast, the background's offset profiled
     (a Gaussian prior of :data:`BACKGROUND_SD`)."""
     chi = np.empty((TOPS.size, RADII.size, contrasts.size))
-    prior = 1.0 / BACKGROUND_SD**2
     for j, radius in enumerate(RADII):
         share = energy_share(offset, contact, TOPS, float(radius))  # (T, N)
         residual = logs - np.log(modulus_factor(share[None], contrasts[:, None, None]))
-        shift = (residual * weight).sum(axis=2) / (weight.sum() + prior)  # (C, T)
-        misfit = ((residual - shift[..., None]) ** 2 * weight).sum(axis=2) + shift**2 * prior
-        chi[:, j, :] = misfit.T
+        chi[:, j, :] = _shifted_misfit(residual, weight).T  # (C, T) -> (T, C)
     return chi
 
 

@@ -110,7 +110,9 @@ def find_inclusions(
                 if best >= found_probability:
                     found.append(_read(kind, sign, m, patch, points, mean, mask, near, draws, best))
     found.sort(key=lambda f: -abs(math.log(f.extreme) - m.background))
-    return with_depths(_summary_first(found, summary), m, summary.found)
+    ordered = _summary_first(found, summary)
+    own = bool(ordered) and summary.found and ordered[0].centre == summary.centre
+    return with_depths(ordered, m, keep_first=own)
 
 
 def with_depths(found: list[Inclusion], m: StiffnessMap, keep_first: bool) -> list[Inclusion]:

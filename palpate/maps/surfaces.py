@@ -110,6 +110,11 @@ class _AboutAnAxis:
         object.__setattr__(self, "_a", a)
         object.__setattr__(self, "_e", _frame(a, self.first))
 
+    def around(self, angle: float) -> Vector:
+        """The unit direction off the axis ``angle`` (rad) round from ``first``."""
+        e1, e2 = self._e
+        return np.asarray(math.cos(angle) * e1 + math.sin(angle) * e2)
+
 
 @dataclass(frozen=True)
 class Dome(_AboutAnAxis):
@@ -125,9 +130,7 @@ class Dome(_AboutAnAxis):
         polar = math.hypot(u, v) / self.radius
         if polar >= math.pi:
             raise ValueError(f"({u:.4g}, {v:.4g}) m is past the dome's far pole")
-        azimuth = math.atan2(v, u)
-        e1, e2 = self._e
-        side = math.cos(azimuth) * e1 + math.sin(azimuth) * e2
+        side = self.around(math.atan2(v, u))
         n = math.cos(polar) * self._a + math.sin(polar) * side
         return SurfacePoint(self.centre + self.radius * n, n)
 
@@ -144,9 +147,7 @@ class Lumen(_AboutAnAxis):
     origin: ArrayLike
 
     def at(self, u: float, v: float) -> SurfacePoint:
-        turn = v / self.radius
-        e1, e2 = self._e
-        radial = math.cos(turn) * e1 + math.sin(turn) * e2
+        radial = self.around(v / self.radius)
         point = np.asarray(self.origin, float) + u * self._a + self.radius * radial
         return SurfacePoint(point, -radial)
 
