@@ -32,6 +32,8 @@ ACCEPTS: dict[tuple[str, str], frozenset[str]] = {
     ("map", "--worlds"): frozenset(),
     ("map", "--plans"): frozenset(),
     ("map", "--workers"): frozenset(),
+    ("map", "--tilt-deg"): frozenset({"0"}),
+    ("map", "--through"): frozenset(),
     ("bench", "--seed"): frozenset({"0"}),
     ("emulate", "--seed"): frozenset({"0"}),
     ("emulate", "--seconds"): frozenset(),

@@ -19,7 +19,7 @@ import concurrent.futures
 import dataclasses
 import math
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -108,10 +108,16 @@ def survey_row(
     seed: int,
     plain: bool,
     whole: bool = False,
+    through: Literal["stage", "robot"] | None = None,
 ) -> dict[str, Any]:
-    """One survey of world ``index`` by ``plan``: its scores and costs (picklable)."""
+    """One survey of world ``index`` by ``plan`` (its probes reaching the patch ``through``
+    the stage or the robot; None: as the scene says): its scores and costs (picklable)."""
     strategy, budget = plan
     world = world_scene(scene, index, seed, plain, whole)
+    if through is not None:
+        world = dataclasses.replace(
+            world, campaign=dataclasses.replace(world.campaign, map_through=through)
+        )
     result = run_survey(
         world, stack, seed=seed * 1000 + index, strategy=strategy, max_probes=budget
     )
@@ -122,6 +128,7 @@ def survey_row(
         "world": index,
         "plain": plain,
         "whole": whole,
+        "through": world.campaign.map_through,
         "probes": len(result.probes),
         "lab_time_s": result.lab_time,
         "map_s_per_probe": result.map_seconds / max(len(result.probes), 1),
@@ -144,18 +151,22 @@ def run_map_study(
     workers: int = 1,
     progress: Callable[[dict[str, Any]], None] | None = None,
     whole: bool = False,
+    throughs: Sequence[Literal["stage", "robot"]] = (),
 ) -> list[dict[str, Any]]:
     """Every plan on every world, and the active plan on as many homogeneous worlds; with
     ``whole``, every plan on worlds drawn whole (:func:`drawn_inclusions`: some of them hold
-    none, so no homogeneous worlds beside them)."""
+    none, so no homogeneous worlds beside them); each of it once for each way of ``throughs``
+    (``stage``, ``robot``: the same worlds side by side; empty: the scene's way)."""
     jobs = [(plan, k, False) for plan in plans for k in range(worlds)]
     active = next((p for p in plans if p[0].startswith("active")), None)
     if active is not None and not whole:
         jobs += [(active, k, True) for k in range(worlds)]
+    ways: Sequence[Literal["stage", "robot"] | None] = tuple(throughs) or (None,)
     rows: list[dict[str, Any]] = []
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
         futures = [
-            pool.submit(survey_row, scene, stack, plan, k, seed, plain, whole)
+            pool.submit(survey_row, scene, stack, plan, k, seed, plain, whole, way)
+            for way in ways
             for plan, k, plain in jobs
         ]
         for future in concurrent.futures.as_completed(futures):
@@ -163,19 +174,25 @@ def run_map_study(
             rows.append(row)
             if progress is not None:
                 progress(row)
-    return sorted(rows, key=lambda r: (r["plain"], r["strategy"], r["budget"], r["world"]))
+    return sorted(
+        rows, key=lambda r: (r["through"], r["plain"], r["strategy"], r["budget"], r["world"])
+    )
 
 
 def summarise_study(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Per plan (and the homogeneous worlds apart): the medians and rates the study reports."""
-    groups: dict[tuple[str, int, bool], list[dict[str, Any]]] = {}
+    groups: dict[tuple[str, str, int, bool], list[dict[str, Any]]] = {}
     for r in rows:
-        groups.setdefault((r["strategy"], r["budget"], r["plain"]), []).append(r)
+        way = r.get("through", "stage")
+        groups.setdefault((way, r["strategy"], r["budget"], r["plain"]), []).append(r)
     out = []
-    for (strategy, budget, plain), rs in sorted(
-        groups.items(), key=lambda g: (g[0][2], g[0][0], g[0][1])
+    for (way, strategy, budget, plain), rs in sorted(
+        groups.items(), key=lambda g: (g[0][0] != "stage", g[0][3], g[0][1], g[0][2])
     ):
         line: dict[str, Any] = {"strategy": strategy, "budget": budget, "worlds": len(rs)}
+        if way != "stage":
+            line["through"] = way
+            line.update(normal_lines(rs))
         line["probes_median"] = _median([r["probes"] for r in rs])
         line["lab_time_s_median"] = _median([r["lab_time_s"] for r in rs])
         line["map_s_per_probe_max"] = max(r["map_s_per_probe"] for r in rs)
@@ -213,6 +230,18 @@ def whole_lines(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
         "depth_in_ci": sum(i["depth_in_ci"] for i in deep),
         "soft_true": len(soft),
         "soft_found_as_soft": sum(i["found"] for i in soft),
+    }
+
+
+def normal_lines(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """How square on a way's probes pressed, over its surveys (``maps.probes.normal_scores``)."""
+    known = [r for r in rows if "normal_error_max_deg" in r]
+    if not known:
+        return {}
+    return {
+        "normal_error_max_deg": max(r["normal_error_max_deg"] for r in known),
+        "probes_off_normal": sum(r["probes_off_normal"] for r in known),
+        "off_normal_unflagged": sum(r["off_normal_unflagged"] for r in known),
     }
 
 

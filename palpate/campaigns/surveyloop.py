@@ -33,6 +33,7 @@ from palpate.maps import (
 )
 from palpate.maps.gp import LENGTH_SCALE_MAX
 from palpate.maps.inclusions import Inclusion, find_inclusions
+from palpate.maps.probes import normal_scores
 from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
 from palpate.robot.records.ros2 import nanoseconds
 
@@ -144,12 +145,14 @@ class SurveyResult:
         grid (the truth's region: the inclusion's footprint, a disc of its radius about its
         centre); a homogeneous sample's "false alarm"."""
         s = self.summary
+        normal = normal_scores(self.probes)
         if self.truth is None:
             return {
                 "false_alarm": bool(s is not None and s.found),
                 "false_inclusions": 0 if s is None else len(s.inclusions),
+                **normal,
             }
-        out: dict[str, Any] = {"detected": bool(s is not None and s.found)}
+        out: dict[str, Any] = {"detected": bool(s is not None and s.found), **normal}
         if s is None:
             return out
         out.update(inclusion_scores(s.inclusions, (self.truth, *self.truth.others)))

@@ -17,9 +17,9 @@ import argparse
 import dataclasses
 import json
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from palpate.argtypes import non_negative_int, positive_int
+from palpate.argtypes import float_in, non_negative_int, positive_int
 from palpate.campaigns.runs import fingerprint, locked, new_run_dir, resumable, write_run_info
 from palpate.campaigns.survey import SurveyResult, run_survey
 from palpate.config import InputError, load, load_stack, resolve
@@ -45,6 +45,19 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--no-plots", action="store_true", help="skip map.png")
     add_live_argument(parser, "each probe's trial and the map after it")
+    parser.add_argument(
+        "--through",
+        type=parse_through,
+        help="how probes reach the patch, overriding campaign.map_through: stage (the x-y "
+        "stage moves the sample), robot (a positioner carries the robot); a study takes "
+        "stage,robot to survey every world both ways, side by side",
+    )
+    parser.add_argument(
+        "--tilt-deg",
+        type=float_in(0.0, 80.0),
+        help="override campaign.map_tilt_deg: the patch's plane tilted from facing the robot "
+        "(needs --through robot)",
+    )
     parser.add_argument(
         "--worlds",
         type=positive_int,
@@ -83,10 +96,50 @@ def map_scene(path: Path, sample: str | None) -> SceneConfig:
     return scene
 
 
+Way = Literal["stage", "robot"]
+WAYS: tuple[Way, ...] = ("stage", "robot")
+
+
+def parse_through(text: str) -> tuple[Way, ...]:
+    """``stage``, ``robot`` or ``stage,robot`` (``--through``' type)."""
+    names = [w.strip() for w in text.split(",")]
+    ways = tuple(w for w in WAYS if w in names)
+    if len(ways) != len(names):
+        raise argparse.ArgumentTypeError(f"{text!r} is not stage, robot or stage,robot")
+    return ways
+
+
+def reached(
+    scene: SceneConfig, path: Path, through: Way | None, tilt_deg: float | None
+) -> SceneConfig:
+    """The scene with ``--through`` and ``--tilt-deg`` in its campaign (InputError naming
+    the option when the result is not a valid map campaign)."""
+    changes: dict[str, Any] = {}
+    if through is not None:
+        changes["map_through"] = through
+    if tilt_deg is not None:
+        changes["map_tilt_deg"] = tilt_deg
+    if not changes:
+        return scene
+    try:
+        campaign = dataclasses.replace(scene.campaign, **changes)
+        moved = dataclasses.replace(scene, campaign=campaign)
+        moved.validate()
+    except ValueError as exc:
+        raise InputError(f"--through/--tilt-deg on {path}: {exc}") from exc
+    return moved
+
+
 def run(args: argparse.Namespace) -> int:
     """Exit 0 when the survey ran (found or not), 2 on bad input."""
     path = Path(args.scene) if args.scene else resolve(SHIPPED)
+    ways: tuple[Way, ...] = args.through or ()
+    if len(ways) > 1 and not args.worlds:
+        raise InputError("--through stage,robot: both ways side by side is a study (--worlds N)")
     scene = map_scene(path, args.sample)
+    for way in ways[1:]:
+        reached(scene, path, way, args.tilt_deg)  # each way checked before anything runs
+    scene = reached(scene, path, ways[0] if ways else None, args.tilt_deg)
     stack = load_stack(resolve(scene.robot))
     info = {
         "scene": scene.name,
@@ -166,7 +219,7 @@ def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
             f"{scene.fidelity.inclusion_offsets!r}; config/scenes/maps/several.yaml has it)"
         )
     extra = any(p[0] == "active" for p in plans) and not whole
-    total = args.worlds * (len(plans) + extra)
+    total = args.worlds * (len(plans) + extra) * len(args.through or (None,))
     bar = progress_bar(total, f"{scene.name} map study")
 
     def done(_: dict[str, Any]) -> None:
@@ -182,6 +235,7 @@ def _study(scene: SceneConfig, stack: Any, args: argparse.Namespace) -> int:
             workers=args.workers,
             progress=done,
             whole=whole,
+            throughs=args.through or (scene.campaign.map_through,),
         )
     finally:
         bar.close()

@@ -171,6 +171,15 @@ class CampaignConfig:
     max_probes: int = field(default=30, metadata=limits(ge=1, le=10000))
     map_threshold_kpa: float | None = field(default=None, metadata=limits(gt=0))
     stage_speed_mm_per_s: float = field(default=5.0, metadata=limits(gt=0, le=1000))
+    # How a map's probe reaches its point: "stage" (the x-y stage slides the sample under the
+    # bench column) or "robot" (the tissue stays and a positioner carries the robot: each probe a
+    # robot trial, its tube, roll and stage pose from robot.positioner.place, square on to the
+    # patch's plane; campaigns/throughrobot.py). The plane faces the robot's insertion axis,
+    # tilted map_tilt_deg toward +z (a tube of that tip angle at roll 0 meets it square on); the
+    # positioner travels +-positioner_travel_mm on each axis at stage_speed_mm_per_s.
+    map_through: Literal["stage", "robot"] = "stage"
+    map_tilt_deg: float = field(default=0.0, metadata=limits(ge=0, le=80))
+    positioner_travel_mm: float = field(default=30.0, metadata=limits(gt=0, le=500))
 
     def speeds_mm_per_s(self) -> tuple[float, ...]:
         """The indentation speeds the campaign runs each trial at (mm/s)."""
@@ -202,6 +211,8 @@ class CampaignConfig:
     probe_sagitta = SI("probe_sagitta_mm", MM)
     probe_touch = SI("probe_touch_ue", UE)
     stage_speed = SI("stage_speed_mm_per_s", MM)  # m/s
+    map_tilt = SI("map_tilt_deg", math.pi / 180)  # rad
+    positioner_travel = SI("positioner_travel_mm", MM)
 
     @property
     def map_threshold(self) -> float | None:
@@ -336,3 +347,8 @@ def _check_map(scene: SceneConfig) -> None:
     if len(scene.campaign_samples()) != 1:
         names = [s.name for s in scene.campaign_samples()]
         raise ValueError(f"campaign.samples: a map surveys one sample, got {names}")
+    if c.map_through == "stage" and c.map_tilt_deg != 0.0:
+        raise ValueError(
+            "campaign.map_tilt_deg: the x-y stage's column meets only a level patch; a tilted "
+            "one needs campaign.map_through: robot"
+        )

@@ -33,6 +33,9 @@ class Probe:
         lab_time: simulated or bench seconds it took, the stage's travel to it included.
         contact_radius: the tip's contact radius at its deepest (m; sqrt(R delta), Hertz's),
             None if unknown: how wide the probe reads the tissue (``extent``).
+        normal_error: the angle between the sensor's axis and the surface's normal where it
+            indented (rad; a map through the robot), None where nothing turned it (the bench
+            column over a level patch).
     """
 
     x: float
@@ -43,6 +46,7 @@ class Probe:
     reasons: tuple[str, ...] = field(default=())
     lab_time: float = 0.0
     contact_radius: float | None = None
+    normal_error: float | None = None
 
     @property
     def usable(self) -> bool:
@@ -88,6 +92,7 @@ class Probe:
             tuple(d["reasons"]),
             float(d["lab_time_s"]),
             None if d["contact_radius_m"] is None else float(d["contact_radius_m"]),
+            None if d.get("normal_error_rad") is None else float(d["normal_error_rad"]),
         )
 
     @classmethod
@@ -116,6 +121,7 @@ class Probe:
             "reasons": list(self.reasons),
             "lab_time_s": self.lab_time,
             "contact_radius_m": self.contact_radius,
+            **({} if self.normal_error is None else {"normal_error_rad": self.normal_error}),
         }
 
     def as_dict(self) -> dict[str, object]:
@@ -130,4 +136,34 @@ class Probe:
             "reasons": list(self.reasons),
             "lab_time_s": self.lab_time,
             "contact_radius_mm": None if self.contact_radius is None else self.contact_radius / MM,
+            **(
+                {}
+                if self.normal_error is None
+                else {"normal_error_deg": math.degrees(self.normal_error)}
+            ),
         }
+
+
+NORMAL_TOLERANCE = math.radians(2.0)  # square on: the issue's orthogonality tolerance
+OFF_NORMAL_WORDS = ("misalign", "oblique", "orientation unverified")  # a verdict that says so
+
+
+def normal_scores(probes: list[Probe], tolerance: float = NORMAL_TOLERANCE) -> dict[str, object]:
+    """How square on the probes pressed (those with a known normal error): the largest error
+    (deg), how many were off the normal by more than ``tolerance`` (rad), and how many of those
+    pressed without a verdict that says so (a reason naming misalignment, an oblique press or
+    an unverified orientation); empty when no probe knows its normal error."""
+    known = [p for p in probes if p.normal_error is not None]
+    if not known:
+        return {}
+    off = [p for p in known if p.normal_error is not None and p.normal_error > tolerance]
+    silent = [
+        p
+        for p in off
+        if p.modulus is not None and not any(w in r for r in p.reasons for w in OFF_NORMAL_WORDS)
+    ]
+    return {
+        "normal_error_max_deg": max(math.degrees(p.normal_error or 0.0) for p in known),
+        "probes_off_normal": len(off),
+        "off_normal_unflagged": len(silent),
+    }

@@ -15,6 +15,7 @@ from typing import Any
 from palpate.campaigns.surveyloop import SurveyResult
 from palpate.maps import MapSummary
 from palpate.maps.inclusions import Inclusion
+from palpate.maps.probes import normal_scores
 
 
 def write_map_results(
@@ -60,6 +61,13 @@ def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) ->
                 f"radius {s.radius * 1e3:.2f} mm{_radius_note(s)}"
             )
         lines += [inclusion_line(k + 1, f) for k, f in enumerate(s.inclusions)]
+    normal = normal_scores(result.probes)
+    if normal:
+        lines.append(
+            f"through the robot: every probe's axis within {normal['normal_error_max_deg']:.1f} "
+            f"deg of the true surface normal; {normal['probes_off_normal']} beyond 2 deg, "
+            f"{normal['off_normal_unflagged']} of them without a verdict that says so"
+        )
     if result.truth is not None:
         t = result.truth
         lines.append(

@@ -74,6 +74,11 @@ class Positioner:
             if not lo <= hi:
                 raise ValueError(f"positioner {axis} travel [{lo}, {hi}] m is not [min, max]")
 
+    @property
+    def home(self) -> Vector:
+        """The base at stage zero, where the robot's base frame is the world's."""
+        return np.zeros(3)
+
     def holds(self, base: Vector, slack: float = 1e-12) -> bool:
         """Whether ``base`` (3,) is within the travel."""
         return all(

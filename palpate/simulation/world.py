@@ -58,6 +58,10 @@ class TrialSpec:
     reference: float | None = None  # Pa, the reported reference modulus; None: the truth
     indent_speed: float | None = None  # m/s; None: the campaign's indent_speed_mm_per_s
     at: tuple[float, float] = (0.0, 0.0)  # m: the point of the sample's surface it presses
+    # The tissue's outward unit normal in the robot's frame where the planned tip meets it (a
+    # robot trial placed on a surface that faces a known way: a map through the robot), None:
+    # facing the tube, then tilted as the sample says. The controller is told none of it.
+    facing: tuple[float, float, float] | None = None
 
     @property
     def stage(self) -> Stage:
@@ -66,7 +70,10 @@ class TrialSpec:
 
     def record(self) -> dict[str, Any]:
         """The spec as a log's header writes it (its tube by name)."""
-        return {**dataclasses.asdict(self), "tube": self.tube.name}
+        record = {**dataclasses.asdict(self), "tube": self.tube.name}
+        if self.facing is None:
+            del record["facing"]  # the logs of trials that face their tube, as they were
+        return record
 
     @property
     def reported(self) -> float:
@@ -126,7 +133,10 @@ def _robot_geometry(
     )
     if not ik.reachable:
         raise InputError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
-    if sample is None:
+    if spec.facing is not None:
+        n = np.asarray(spec.facing, dtype=np.float64)  # the tip sphere touches it at -R n
+        surface = Surface(point=nominal.sensor_tip - r_tip * n, normal=n)
+    elif sample is None:
         surface = Surface(point=target, normal=normal)
     else:
         surface = place_sample(tube, spec.roll, (target, nominal.tangent), sample, spec.seed)

@@ -1,0 +1,150 @@
+"""A map through the robot (issue 58): the tissue stays where it is and a positioner carries
+the robot, as a lab's gantry on the bench or a guide sheath in the body does.
+
+The patch is a plane in the robot's base frame (:func:`map_plane`) that faces the insertion
+axis, tilted ``campaign.map_tilt_deg`` toward +z, so a tube of that tip angle at roll 0 meets it
+square on; its own coordinates ``(u, v)`` are the map's ``(x, y)`` (u along the base frame's y).
+For each point the plan picks, :meth:`ThroughRobot.place` solves the tube, roll and stage pose
+that put the sensor on the point along its normal (:func:`robot.positioner.place` over the
+robot file's tubes, the contact at the campaign's first exposed length), and the probe is a
+robot trial there (:meth:`ThroughRobot.spec`): the world's tissue faces the way the plane does
+in the robot's frame, whatever the tube's residual angle, and the controller is told none of it
+(with ``campaign.probe`` it touches to find the normal and re-plans its roll). The stage moves
+only between trials, with the sensor back at its retract pose (every trial ends there); its
+travel counts in the lab time at ``campaign.stage_speed_mm_per_s``.
+
+A point no tube meets within 2 degrees is probed obliquely and its verdict says so (at most
+``suspect``); a point the stage, the drive or the clearance refuses is a probe without a number
+that says why. Each probe carries its normal error: the angle between the sensor's axis where it
+indented and the surface's normal::
+
+    reach = ThroughRobot.of(scene, stack)
+    placed = reach.place((2e-3, -3e-3))
+    placed.tube, math.degrees(placed.residual), placed.base
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from palpate.config.scene import SceneConfig
+from palpate.config.schema import StackConfig, TubeConfig
+from palpate.maps import Probe
+from palpate.maps.surfaces import TiltedPlane
+from palpate.robot import kinematics
+from palpate.robot.positioner import Approach, Placement, Positioner, place
+from palpate.simulation.trial import TrialOutcome
+from palpate.simulation.world import TrialSpec
+
+Point = tuple[float, float]
+LATERAL = (0.0, 1.0, 0.0)  # the plane's u: the base frame's y
+
+
+def plane_normal(tilt: float) -> tuple[float, float, float]:
+    """The patch's outward normal: facing the insertion axis (-x), tilted ``tilt`` (rad) toward
+    +z, where a tube of tip angle ``tilt`` at roll 0 points (``robot.kinematics.tangent``)."""
+    return (-math.cos(tilt), 0.0, math.sin(tilt))
+
+
+def map_plane(scene: SceneConfig, stack: StackConfig) -> TiltedPlane:
+    """The patch's plane in the robot's base frame at stage zero: through the point the tube
+    whose tip angle is nearest the tilt touches at roll 0 with the campaign's first exposed
+    length out, facing :func:`plane_normal`."""
+    c = scene.campaign
+    tube = min(stack.tubes, key=lambda t: abs(t.tip_angle - c.map_tilt))
+    n = np.asarray(plane_normal(c.map_tilt))
+    contact = tube.flush_translation + c.exposed_lengths[0]
+    centre = kinematics.forward(tube, 0.0, contact).sensor_tip
+    return TiltedPlane(origin=centre - stack.sensor.tip_radius * n, normal=n, first=LATERAL)
+
+
+def true_normal(plane: TiltedPlane, tilt: float, azimuth: float) -> tuple[float, float, float]:
+    """The tissue's true outward normal: the plane's, tilted ``tilt`` (rad) toward ``azimuth``
+    (rad, about it from the plane's u toward its v): the sample's ``tilt_deg`` and
+    ``tilt_azimuth_deg``, a plane registered that far wrong. Each point keeps its place; the
+    tissue turns about it."""
+    n = plane.at(0.0, 0.0).normal
+    e1 = plane.at(1.0, 0.0).point - plane.at(0.0, 0.0).point
+    way = math.cos(azimuth) * e1 + math.sin(azimuth) * np.cross(n, e1)
+    t = math.cos(tilt) * n + math.sin(tilt) * way
+    return (float(t[0]), float(t[1]), float(t[2]))
+
+
+@dataclass(frozen=True)
+class ThroughRobot:
+    """How a map's probes reach the patch through the robot: the plane the plan believes in, the
+    positioner's travel, the approach, the tubes to choose from, and the tissue's true normal in
+    the robot's frame (:func:`true_normal`)."""
+
+    plane: TiltedPlane
+    stage: Positioner
+    approach: Approach
+    tubes: tuple[TubeConfig, ...]
+    truth: tuple[float, float, float]
+
+    @classmethod
+    def of(cls, scene: SceneConfig, stack: StackConfig) -> ThroughRobot:
+        c = scene.campaign
+        plane = map_plane(scene, stack)
+        sample = scene.campaign_samples()[0]
+        truth = true_normal(plane, sample.tilt, sample.tilt_azimuth or 0.0)
+        travel = (-c.positioner_travel, c.positioner_travel)
+        how = Approach(
+            tip_radius=stack.sensor.tip_radius,
+            exposed_length=c.exposed_lengths[0],
+            standoff=c.standoff,
+            translation_limits=stack.drive.translation_limits,
+            surface=plane,
+            roll_limits=stack.drive.roll_limits,
+        )
+        stage = Positioner(x=travel, y=travel, z=travel)
+        return cls(plane, stage, how, tuple(stack.tubes), truth)
+
+    def place(self, point: Point) -> Placement:
+        """The tube, roll and stage pose for the patch's ``point`` (m)."""
+        return place(self.tubes, self.plane.at(*point), self.stage, self.approach)
+
+    def spec(self, spec: TrialSpec, placed: Placement) -> TrialSpec:
+        """The probe's trial (a bench probe's ``spec``) as a robot trial at the placement."""
+        return dataclasses.replace(
+            spec,
+            kind="robot",
+            tube=next(t for t in self.tubes if t.name == placed.tube),
+            roll=placed.roll,
+            facing=self.truth,
+        )
+
+    def normal_error(self, placed: Placement, outcome: TrialOutcome) -> float:
+        """The angle (rad) between the sensor's axis at the roll the trial indented at (probing's
+        re-planned roll, else the placement's) and the surface's inward normal."""
+        probe = outcome.probe
+        roll = probe.roll if probe is not None and probe.reachable else placed.roll
+        tube = next(t for t in self.tubes if t.name == placed.tube)
+        cos = -float(kinematics.tangent(tube, roll) @ np.asarray(self.truth))
+        return math.acos(max(-1.0, min(1.0, cos)))
+
+
+def refused(point: Point, placed: Placement) -> Probe:
+    """The probe of a point the robot cannot reach: no number, and why."""
+    return Probe(point[0], point[1], None, None, "none", (f"not reached: {placed.reason}",))
+
+
+def oblique(probe: Probe, placed: Placement) -> Probe:
+    """A probe pressed off its normal (placement status 1): its verdict says so, at most
+    ``suspect``."""
+    if placed.status != 1:
+        return probe
+    why = f"oblique: {math.degrees(placed.residual):.1f} deg from the surface normal"
+    status = "suspect" if probe.status == "ok" else probe.status
+    return dataclasses.replace(probe, status=status, reasons=(*probe.reasons, why))
+
+
+def stage_travel(bases: tuple[np.ndarray, np.ndarray], speed: float) -> float:
+    """Seconds the positioner takes between two bases (m) at ``speed`` (m/s, along the line
+    between them, as the x-y stage's travel counts)."""
+    a, b = bases
+    return float(np.linalg.norm(b - a)) / speed
