@@ -13,11 +13,20 @@ for a stiffness map. Re-exported by :mod:`config.schema`; optional (a robot with
 A stage position ``(x, y)`` names the point of the sample under the tip, in the frame of the
 sample's single-trial point (where the tip presses at the stage's home, ``(0, 0)`` unless
 ``home_mm`` says otherwise): moving the stage to ``(x, y)`` slides the sample by ``-(x, y)``.
+
+``carries: robot`` (issue 58) is a gantry that carries the robot instead, as a lab's gantry on
+the bench or a guide sheath in the body does, the tissue staying where it is: the stage at
+``(x, y)`` moves the robot's base frame by ``x * x_direction + y * y_direction`` (unit vectors
+of the base frame, orthogonal). Set them in the tissue's plane (the defaults: across the
+straight tube's axis) and a position names the point of the tissue the tip presses, as for the
+sample.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from typing import Literal
 
 from .loader import limits
 from .optics import MM
@@ -40,10 +49,19 @@ class XYStageConfig:
     max_speed_mm_per_s: float = field(default=5.0, metadata=limits(gt=0, le=500))
     max_accel_mm_per_s2: float = field(default=50.0, metadata=limits(gt=0, le=10000))
     arrived_mm: float = field(default=0.02, metadata=limits(gt=0, le=5))
+    carries: Literal["sample", "robot"] = "sample"
+    x_direction: tuple[float, float, float] = (0.0, 1.0, 0.0)  # carries: robot
+    y_direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
 
     def validate(self) -> None:
         if self.x.id == self.y.id:
             raise ValueError(f"x.id and y.id must differ, got {self.x.id}")
+        dx, dy = self.x_direction, self.y_direction
+        for key, d in (("x_direction", dx), ("y_direction", dy)):
+            if not abs(math.hypot(*d) - 1.0) <= 1e-6:
+                raise ValueError(f"{key}: a unit vector of the base frame, got {list(d)}")
+        if not abs(sum(a * b for a, b in zip(dx, dy, strict=True))) <= 1e-6:
+            raise ValueError(f"y_direction: orthogonal to x_direction, got {list(dy)}")
         for axis, (lo, hi), home in (
             ("x", self.x_travel_mm, self.home_mm[0]),
             ("y", self.y_travel_mm, self.home_mm[1]),

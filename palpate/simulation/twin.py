@@ -33,6 +33,7 @@ from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import MM, StackConfig, TubeConfig, servo_roster
 from palpate.config.targets import load_targets
+from palpate.config.xystage import XYStageConfig
 from palpate.robot import kinematics
 from palpate.robot.drive import SERVOS, TRANSLATION, RollerGearDrive
 from palpate.robot.dynamixel.units import rad_from_ticks
@@ -60,6 +61,19 @@ def facing_surface(stack: StackConfig, exposed_length: float) -> Surface:
     the sensor touches it with ``exposed_length`` out; every tube and roll can reach it."""
     tube = next((t for t in stack.tubes if t.tip_angle_deg == 0), stack.tubes[0])
     return surface_at(tube, 0.0, tube.flush_translation + exposed_length, stack.sensor.tip_radius)
+
+
+def carried_touch(
+    base: Any, normal: Any, roll: float, tube: TubeConfig, cfg: XYStageConfig
+) -> tuple[float, float]:
+    """The point of a plane tissue (outward ``normal``) the tip presses with the robot's base
+    moved by ``base`` (m) from where it pressed the plane's origin: the sensor's line moved by
+    ``base`` meets the plane there, read along the stage's two directions. (x, y) itself when
+    the directions lie in the plane."""
+    t = kinematics.tangent(tube, roll)
+    n = np.asarray(normal)
+    moved = base - (float(base @ n) / float(t @ n)) * t
+    return float(moved @ np.asarray(cfg.x_direction)), float(moved @ np.asarray(cfg.y_direction))
 
 
 @dataclass(frozen=True)
@@ -153,7 +167,9 @@ class SimulatedBench:
         self._ids = {n: s.id for n, s in servo_roster(stack.servos, stack.stage).items()}
         self.bus = EmulatedBus.from_config(stack.servos, clock=clock, stage=stack.stage)
         self._stage = None if stack.stage is None else XYAxes(stack.stage)  # home at power-up
-        self.at = self._stage_at()  # the point of the sample under the tip (m)
+        self._placed = self._stage_at()  # where the stage stood when the world was made (m)
+        self._base = np.zeros(3)  # the robot's base frame, moved by a stage that carries it (m)
+        self.at = self._placed  # the point of the sample under the tip (m)
         self._world = self._new_world()
         self._touched = False
         layout = layout_from_config(stack.sensor, stack.board)
@@ -197,11 +213,22 @@ class SimulatedBench:
         if self._stage is None or any(self.servo(n).velocity_ticks_per_s for n in STAGE_SERVOS):
             return False
         at = self._stage_at()
-        return max(abs(at[0] - self.at[0]), abs(at[1] - self.at[1])) > 1e-6
+        return max(abs(at[0] - self._placed[0]), abs(at[1] - self._placed[1])) > 1e-6
+
+    def _place(self) -> None:
+        """Where the stage now stands: the point of the tissue under the tip (``at``) and, for a
+        stage that carries the robot, the base frame's offset."""
+        self._placed = x, y = self._stage_at()
+        cfg = self.stack.stage
+        if cfg is None or cfg.carries == "sample":
+            self.at = self._placed  # the stage slid the sample: the tissue under the tip
+            return
+        self._base = x * np.asarray(cfg.x_direction) + y * np.asarray(cfg.y_direction)
+        self.at = carried_touch(self._base, self.surface.normal, self._joints()[0], self.tube, cfg)
 
     def _pose(self, roll: float, translation: float) -> tuple[Any, Any, float]:
         p = kinematics.forward(self.tube, roll, translation)
-        return p.tube_tip, p.tangent, p.exposed_length
+        return p.tube_tip + self._base, p.tangent, p.exposed_length
 
     def _sample_config(self, name: str) -> SampleConfig:
         return next(s for s in self.scene.samples if s.name == name)
@@ -237,7 +264,7 @@ class SimulatedBench:
         if not self._touched and len(self.stations) > 1:
             self._face(self._nearest_station())
         if not self._touched and self._stage_settled():
-            self.at = self._stage_at()  # the stage slid the sample: the tissue under the tip
+            self._place()
             self._world = self._new_world()
         world = self._world
         sample = world.sample(t)
@@ -257,6 +284,8 @@ class SimulatedBench:
         self.sample = self._sample_config(st.sample)
         self.surface = st.surface
         self.tube = self.stack.tube(st.tube)
+        if self.stack.stage is not None and self.stack.stage.carries == "robot":
+            self._place()  # the same base, another surface
         self._world = self._new_world()
 
     def start(self) -> Self:

@@ -9,6 +9,7 @@ import math
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from palpate.config import ConfigError, load, resolve
@@ -16,6 +17,7 @@ from palpate.config.bench import LoadedBench, load_bench
 from palpate.config.scene import SceneConfig
 from palpate.lab.hardware import Hardware, open_hardware
 from palpate.lab.plan import plan_bench_map, plan_session
+from palpate.robot import kinematics
 from palpate.robot.xystage import STAGE_SERVOS, StageMoveError
 from palpate.services.lab import run_map_session
 from palpate.sim.clock import VirtualClock
@@ -32,13 +34,22 @@ ROBOT = (
 )
 
 
-def bench_map(tmp_path: Path, map_keys: str, robot: str = ROBOT) -> LoadedBench:
-    """The shipped bench-map.yaml with its robot, targets and logs under ``tmp_path`` and the
-    ``map:`` keys given."""
+# robot-gantry.yaml (the stage carries the robot) with the same quick drive and patient bus
+GANTRY = resolve("robot-gantry.yaml").read_text(encoding="utf-8") + (
+    "drive: {home_translation_mm: 43, max_speed_mm_per_s: 20}\nservos: {timeout_ms: 2000}\n"
+)
+
+
+def bench_map(
+    tmp_path: Path, map_keys: str, robot: str = ROBOT, bench: str = "bench-map.yaml"
+) -> LoadedBench:
+    """The shipped ``bench`` file (bench-map.yaml) with its robot, targets and logs under
+    ``tmp_path`` and the ``map:`` keys given."""
     (tmp_path / "robot.yaml").write_text(robot, encoding="utf-8")
-    text = resolve("bench-map.yaml").read_text(encoding="utf-8")
+    text = resolve(bench).read_text(encoding="utf-8")
     head = text[: text.index("map:\n")]
-    head = head.replace("robot: robot-stage.yaml", f"robot: {tmp_path}/robot.yaml")
+    for shipped in ("robot: robot-stage.yaml", "robot: robot-gantry.yaml"):
+        head = head.replace(shipped, f"robot: {tmp_path}/robot.yaml")
     head = head.replace("log_dir: out/trial", f"log_dir: {tmp_path}/logs")
     path = tmp_path / "bench.yaml"
     path.write_text(head + f"map: {{target: map-downward, {map_keys}}}\n", encoding="utf-8")
@@ -89,12 +100,18 @@ def test_a_bad_map_is_refused_with_its_key(
 
 
 @pytest.mark.slow
-def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("robot", "bench"), [(ROBOT, "bench-map.yaml"), (GANTRY, "bench-map-robot.yaml")]
+)
+def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(
+    tmp_path: Path, robot: str, bench: str
+) -> None:
     """Nine probes of a 3 x 3 raster over the map scene's inclusion (5x, 2.5 mm radius, 3.5 mm
-    deep at (3, -2) mm): the stage's servos take the sample to each point (the world sees the
-    inclusion from where the stage is), every probe a whole trial over the wire path, the map
-    names the stiff corner."""
-    loaded = bench_map(tmp_path, "patch_mm: [-6, -8, 6, 4], strategy: raster, max_probes: 9")
+    deep at (3, -2) mm): the stage's servos take the sample to each point, or carry the robot
+    there (the world sees the inclusion from where the tip presses), every probe a whole trial
+    over the wire path, the map names the stiff corner."""
+    keys = "patch_mm: [-6, -8, 6, 4], strategy: raster, max_probes: 9"
+    loaded = bench_map(tmp_path, keys, robot, bench)
     clock = VirtualClock()
     stations = stations_for(MAP_SCENE, loaded)
     with SimulatedBench(loaded.stack, MAP_SCENE, clock=clock, wire=False, stations=stations) as sim:
@@ -109,7 +126,12 @@ def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(tmp_path: Path) 
             sync_to_clock=True,
         )
         last = sim.at
+        base = sim.world.pose(0.0, 0.0)[0] - kinematics.forward(sim.tube, 0.0, 0.0).tube_tip
     assert outcomes == []
+    carried = loaded.stack.stage is not None and loaded.stack.stage.carries == "robot"
+    here = (result.probes[-1].x, result.probes[-1].y)
+    moved = (0.0, here[0], -here[1]) if carried else (0.0, 0.0, 0.0)
+    assert base == pytest.approx(moved, abs=0.05e-3)  # the robot moved, or the sample did
     assert result is not None
     assert len(result.probes) == 9
     assert all(p.usable for p in result.probes)
@@ -171,3 +193,38 @@ def test_teleop_jogs_the_stage_step_by_step_within_its_travel(tmp_path: Path) ->
             clock.sleep(0.01)
         assert sent[-1] == (2e-3, -1e-3)
         assert hw.stage.read() == pytest.approx((2e-3, -1e-3), abs=2e-6)
+
+
+@pytest.mark.parametrize(
+    ("line", "key"),
+    [
+        ("  x_direction: [0, 1, 0]", "  x_direction: [0, 2, 0]"),
+        ("  y_direction: [0, 0, -1]", "  y_direction: [0, 1, 1]"),
+    ],
+)
+def test_a_gantry_whose_directions_are_not_unit_and_orthogonal_is_refused(
+    tmp_path: Path, line: str, key: str
+) -> None:
+    assert line in GANTRY
+    with pytest.raises(ConfigError) as err:
+        bench_map(
+            tmp_path, "patch_mm: [-5, -5, 5, 5]", GANTRY.replace(line, key), "bench-map-robot.yaml"
+        )
+    assert key.split(":", maxsplit=1)[0].strip() in str(err.value)
+
+
+def test_a_carried_robot_presses_the_point_its_line_meets() -> None:
+    from palpate.config.xystage import XYStageConfig
+    from palpate.simulation.twin import carried_touch
+
+    straight = load_bench("bench-map.yaml").stack.tube("straight")
+    cfg = XYStageConfig(carries="robot")
+    base = 3e-3 * np.asarray(cfg.x_direction) - 2e-3 * np.asarray(cfg.y_direction)
+    facing = np.array([-1.0, 0.0, 0.0])  # square to the straight tube: the stage's own point
+    assert carried_touch(base, facing, 0.0, straight, cfg) == pytest.approx((3e-3, -2e-3))
+    tilted = np.array([-math.cos(0.3), 0.0, math.sin(0.3)])  # the face turned about y
+    x, y = carried_touch(base, tilted, 0.0, straight, cfg)
+    assert x == pytest.approx(3e-3)
+    assert y == pytest.approx(-2e-3)  # the line slides along x: the same point of the face's
+    off = 1e-3 * np.array([1.0, 0.0, 0.0])  # ...but a base moved along the tube is no move
+    assert carried_touch(base + off, tilted, 0.0, straight, cfg) == pytest.approx((x, y))
