@@ -1,6 +1,7 @@
 """Jog roll, advance and tube from the keyboard; live pose, strains and flags; store poses.
 
-A robot with an x-y stage under the sample (``stage:``) has its stage jogged too (x/X, y/Y).
+A robot with an x-y stage under the sample, or a gantry that carries it (``stage:``), has its
+stage jogged too (x/X, y/Y).
 
 ``palpate teleop`` runs on the simulator by default (both emulators in-process, real time, a
 world with a tissue sample of a scene, so strains and contact respond), on the real bench with
