@@ -150,9 +150,11 @@ def run_survey(
             return _robot_probe_at(scene, stack, reach, probes, point, seed, logs, live)
         return _probe_at(scene, stack, probes, point, seed, logs, live)
 
-    return run_plan(
+    result = run_plan(
         plan, probe_at, run_dir=run_dir, on_probe=on_probe, live=live, truth=truth_of(sample)
     )
+    result.reach = reach
+    return result
 
 
 def _probe_at(

@@ -38,6 +38,7 @@ from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_fra
 from palpate.robot.records.ros2 import nanoseconds
 
 if TYPE_CHECKING:
+    from palpate.campaigns.throughrobot import ThroughRobot
     from palpate.live import View
 
 MM = 1e-3
@@ -138,6 +139,7 @@ class SurveyResult:
     patch: Patch
     outcomes: list[Any] = field(default_factory=list)  # the probes' trials
     length_scale_max: float = LENGTH_SCALE_MAX  # the map's (m)
+    reach: ThroughRobot | None = None  # how the probes reached the patch through the robot
 
     def scores(self) -> dict[str, Any]:
         """Against the truth: the centre's error (mm), and the boundary's sensitivity,

@@ -38,6 +38,11 @@ def write_map_results(
         from palpate.reports.mapfig import map_figure
 
         payload["figure"] = str(map_figure(result, run_dir / "map.png", title))
+        if result.reach is not None:
+            from palpate.reports.map3d import map3d_figure
+
+            path = map3d_figure(result, result.reach, run_dir / "map3d.png", title)
+            payload["figure_3d"] = str(path)
     return payload
 
 

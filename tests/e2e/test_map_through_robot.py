@@ -144,13 +144,25 @@ def test_a_trial_facing_its_tube_logs_its_spec_as_before(scene: SceneConfig) -> 
     assert turned.record()["facing"] == (-1.0, 0.0, 0.0)
 
 
-def test_palpate_map_through_the_robot_prints_and_writes_each_probe_s_normal_error(
+def test_the_report_says_how_square_on_the_probes_pressed(scene: SceneConfig) -> None:
+    from palpate.reports.mapresults import map_lines
+
+    stack = load_stack(resolve(scene.robot))
+    wrong = registered_wrong(through(scene, 30.0), 3.0)
+    result = run_survey(wrong, stack, strategy="raster", max_probes=4)
+    text = "\n".join(map_lines(result, Path("run"), "t", "raster"))
+    assert "every probe's axis within 3.0 deg of the true surface normal" in text
+    assert "4 beyond 2 deg, 4 of them without a verdict that says so" in text
+
+
+def test_palpate_map_through_the_robot_writes_each_probe_s_normal_error_and_a_3d_figure(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     argv = ["map", "--through", "robot", "--tilt-deg", "15", "--max-probes", "4"]
-    assert main([*argv, "--strategy", "raster", "--out", str(tmp_path), "--no-plots"]) == 0
-    out = capsys.readouterr().out
-    assert "through the robot: every probe's axis within 0.0 deg" in out
+    assert main([*argv, "--strategy", "raster", "--out", str(tmp_path), "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["scores"]["normal_error_max_deg"] == pytest.approx(0.0, abs=1e-6)
+    assert Path(payload["figure_3d"]).stat().st_size > 10_000  # the robot and the patch drawn
     (run,) = tmp_path.iterdir()
     probes = json.loads((run / "map.json").read_text(encoding="utf-8"))["probes"]
     assert [p["normal_error_deg"] for p in probes] == pytest.approx([0.0] * 4, abs=1e-6)
