@@ -36,7 +36,7 @@ from palpate.campaigns.surveyloop import (
     read_probes,
     run_plan,
 )
-from palpate.campaigns.throughrobot import ThroughRobot, oblique, refused, stage_travel
+from palpate.campaigns.throughrobot import ThroughRobot, oblique, refused
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
@@ -146,9 +146,7 @@ def run_survey(
     reach = ThroughRobot.of(scene, stack) if c.map_through == "robot" else None
 
     def probe_at(probes: list[Probe], point: Point) -> tuple[Probe, TrialOutcome | None]:
-        if reach is not None:
-            return _robot_probe_at(scene, stack, reach, probes, point, seed, logs, live)
-        return _probe_at(scene, stack, probes, point, seed, logs, live)
+        return _probe_at(scene, stack, reach, probes, point, seed, logs, live)
 
     result = run_plan(
         plan, probe_at, run_dir=run_dir, on_probe=on_probe, live=live, truth=truth_of(sample)
@@ -160,15 +158,23 @@ def run_survey(
 def _probe_at(
     scene: SceneConfig,
     stack: StackConfig,
+    reach: ThroughRobot | None,
     probes: list[Probe],
     point: tuple[float, float],
     seed: int,
     logs: Path | None,
     live: View | None,
-) -> tuple[Probe, TrialOutcome]:
-    """The next probe's trial at ``point``, the stage's travel to it from the last probe."""
+) -> tuple[Probe, TrialOutcome | None]:
+    """The next probe's trial at ``point``: on the bench column, the stage's travel to it from
+    the last probe; or through the robot (``reach``: ``campaigns.throughrobot``), placed and
+    pressed as a robot trial, the positioner's travel from the last probe's pose."""
     sample = scene.campaign_samples()[0]
     spec = probe_spec(scene, sample, len(probes), point, seed)
+    placed = None if reach is None else reach.place(point)
+    if reach is not None and placed is not None:
+        if placed.status not in (0, 1):
+            return refused(point, placed), None
+        spec = reach.spec(spec, placed)
     o = run_sim_trial(
         spec,
         moved_scene(scene, sample, point),
@@ -178,37 +184,13 @@ def _probe_at(
         live=live,
     )
     last = (0.0, 0.0) if not probes else (probes[-1].x, probes[-1].y)
-    travel = math.hypot(point[0] - last[0], point[1] - last[1]) / scene.campaign.stage_speed
-    return probe_of(o, point, o.sim_time + travel, stack.sensor.tip_radius), o
-
-
-def _robot_probe_at(
-    scene: SceneConfig,
-    stack: StackConfig,
-    reach: ThroughRobot,
-    probes: list[Probe],
-    point: tuple[float, float],
-    seed: int,
-    logs: Path | None,
-    live: View | None,
-) -> tuple[Probe, TrialOutcome | None]:
-    """The next probe through the robot (``campaigns.throughrobot``): placed, pressed as a
-    robot trial, with the positioner's travel from the last probe's pose."""
-    placed = reach.place(point)
-    if placed.status not in (0, 1):
-        return refused(point, placed), None
-    sample = scene.campaign_samples()[0]
-    spec = reach.spec(probe_spec(scene, sample, len(probes), point, seed), placed)
-    o = run_sim_trial(
-        spec,
-        moved_scene(scene, sample, point),
-        stack,
-        transport=scene.transport,
-        log_dir=logs,
-        live=live,
-    )
-    last = reach.stage.home if not probes else reach.place((probes[-1].x, probes[-1].y)).base
-    travel = stage_travel((last, placed.base), scene.campaign.stage_speed)
-    probe = probe_of(o, point, o.sim_time + travel, stack.sensor.tip_radius)
+    if reach is None or placed is None:
+        travel = math.hypot(point[0] - last[0], point[1] - last[1])
+    else:
+        travel = reach.travel(last if probes else None, placed)
+    lab_time = o.sim_time + travel / scene.campaign.stage_speed
+    probe = probe_of(o, point, lab_time, stack.sensor.tip_radius)
+    if reach is None or placed is None:
+        return probe, o
     probe = dataclasses.replace(probe, normal_error=reach.normal_error(placed, o))
     return oblique(probe, placed), o

@@ -118,6 +118,12 @@ class ThroughRobot:
             facing=self.truth,
         )
 
+    def travel(self, last: Point | None, placed: Placement) -> float:
+        """How far (m) the positioner moves the base to ``placed`` from the last probe's point's
+        placement (from stage zero for the first, ``last`` None), along the line between."""
+        start = self.stage.home if last is None else self.place(last).base
+        return float(np.linalg.norm(placed.base - start))
+
     def normal_error(self, placed: Placement, outcome: TrialOutcome) -> float:
         """The angle (rad) between the sensor's axis at the roll the trial indented at (probing's
         re-planned roll, else the placement's) and the surface's inward normal."""
@@ -141,10 +147,3 @@ def oblique(probe: Probe, placed: Placement) -> Probe:
     why = f"oblique: {math.degrees(placed.residual):.1f} deg from the surface normal"
     status = "suspect" if probe.status == "ok" else probe.status
     return dataclasses.replace(probe, status=status, reasons=(*probe.reasons, why))
-
-
-def stage_travel(bases: tuple[np.ndarray, np.ndarray], speed: float) -> float:
-    """Seconds the positioner takes between two bases (m) at ``speed`` (m/s, along the line
-    between them, as the x-y stage's travel counts)."""
-    a, b = bases
-    return float(np.linalg.norm(b - a)) / speed
