@@ -192,5 +192,5 @@ def _probe_at(
     probe = probe_of(o, point, lab_time, stack.sensor.tip_radius)
     if reach is None or placed is None:
         return probe, o
-    probe = dataclasses.replace(probe, normal_error=reach.normal_error(placed, o))
+    probe = dataclasses.replace(probe, normal_error=o.true_misalignment)  # the world's truth
     return oblique(probe, placed), o

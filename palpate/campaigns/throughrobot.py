@@ -15,8 +15,8 @@ travel counts in the lab time at ``campaign.stage_speed_mm_per_s``.
 
 A point no tube meets within 2 degrees is probed obliquely and its verdict says so (at most
 ``suspect``); a point the stage, the drive or the clearance refuses is a probe without a number
-that says why. Each probe carries its normal error: the angle between the sensor's axis where it
-indented and the surface's normal::
+that says why. Each probe carries its normal error: the angle between the sensor's axis and the
+surface's normal where it indented, the world's truth (``TrialOutcome.true_misalignment``)::
 
     reach = ThroughRobot.of(scene, stack)
     placed = reach.place((2e-3, -3e-3))
@@ -37,7 +37,6 @@ from palpate.maps import Probe
 from palpate.maps.surfaces import TiltedPlane
 from palpate.robot import kinematics
 from palpate.robot.positioner import Approach, Placement, Positioner, place
-from palpate.simulation.trial import TrialOutcome
 from palpate.simulation.world import TrialSpec
 
 Point = tuple[float, float]
@@ -123,15 +122,6 @@ class ThroughRobot:
         placement (from stage zero for the first, ``last`` None), along the line between."""
         start = self.stage.home if last is None else self.place(last).base
         return float(np.linalg.norm(placed.base - start))
-
-    def normal_error(self, placed: Placement, outcome: TrialOutcome) -> float:
-        """The angle (rad) between the sensor's axis at the roll the trial indented at (probing's
-        re-planned roll, else the placement's) and the surface's inward normal."""
-        probe = outcome.probe
-        roll = probe.roll if probe is not None and probe.reachable else placed.roll
-        tube = next(t for t in self.tubes if t.name == placed.tube)
-        cos = -float(kinematics.tangent(tube, roll) @ np.asarray(self.truth))
-        return math.acos(max(-1.0, min(1.0, cos)))
 
 
 def refused(point: Point, placed: Placement) -> Probe:
