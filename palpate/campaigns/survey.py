@@ -36,7 +36,7 @@ from palpate.campaigns.surveyloop import (
     read_probes,
     run_plan,
 )
-from palpate.campaigns.throughrobot import ThroughRobot, oblique, refused
+from palpate.campaigns.throughrobot import ThroughRobot, measured_tilt, oblique, refused
 from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
@@ -192,5 +192,7 @@ def _probe_at(
     probe = probe_of(o, point, lab_time, stack.sensor.tip_radius)
     if reach is None or placed is None:
         return probe, o
-    probe = dataclasses.replace(probe, normal_error=o.true_misalignment)  # the world's truth
+    probe = dataclasses.replace(
+        probe, normal_error=o.true_misalignment, tilt=measured_tilt(o)
+    )  # the world's truth, and what the trial's touches say
     return oblique(probe, placed), o

@@ -33,10 +33,12 @@ import numpy as np
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig, TubeConfig
+from palpate.estimation.verdict import NORMAL_SIGMAS
 from palpate.maps import Probe
 from palpate.maps.surfaces import TiltedPlane
 from palpate.robot import kinematics
 from palpate.robot.positioner import Approach, Placement, Positioner, place
+from palpate.simulation.trial import TrialOutcome
 from palpate.simulation.world import TrialSpec
 
 Point = tuple[float, float]
@@ -122,6 +124,16 @@ class ThroughRobot:
         placement (from stage zero for the first, ``last`` None), along the line between."""
         start = self.stage.home if last is None else self.place(last).base
         return float(np.linalg.norm(placed.base - start))
+
+
+def measured_tilt(outcome: TrialOutcome) -> float | None:
+    """The largest tilt to the normal the trial's own touches allow (rad): the misalignment the
+    estimator was told and ``NORMAL_SIGMAS`` of the measured normal's sigma; None where no
+    normal was measured (no probing, or touches along one line)."""
+    probe = outcome.probe
+    if probe is None or probe.normal is None or not math.isfinite(probe.normal_sigma):
+        return None
+    return abs(outcome.misalignment) + NORMAL_SIGMAS * probe.normal_sigma
 
 
 def refused(point: Point, placed: Placement) -> Probe:

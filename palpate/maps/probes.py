@@ -3,7 +3,9 @@
 A probe carries the joint fit's modulus and interval and the verdict; the map (``gp``) turns the
 interval into the probe's own noise on log E (its half-width over the interval's z), inflates a
 ``suspect`` probe's variance (:data:`SUSPECT_INFLATION`) and leaves out a probe without a number,
-keeping its reason::
+keeping its reason. A probe suspect only because its measured tilt to the normal is not verified
+within the campaign's tolerance, and that tilt (with its doubt) is under :data:`SMALL_TILT`,
+keeps its interval: its number stands (a map through the robot, issue 58)::
 
     probe = Probe(x=2e-3, y=-1e-3, modulus=3.4e5, ci=(3.2e5, 3.6e5), status="ok")
     probe.log_sigma()   # ~0.03: the sd of log E the interval implies
@@ -19,6 +21,10 @@ Z95 = 1.959963984540054  # the joint fit's intervals are 95 %
 SUSPECT_INFLATION = 4.0  # a suspect probe's variance on log E, times its interval's
 MM = 1e-3
 SIGMA_FLOOR = 0.01  # sd of log E below which no probe is believed (1 %: the world's own scatter)
+# A measured tilt this small costs the joint fit little (docs/accuracy.md: 0.9 % square on, 16 %
+# at 25 deg; about 1.5 % at 5), so a probe suspect for that alone keeps its interval.
+SMALL_TILT = math.radians(5.0)
+TILT_REASON = "misalignment "  # how the verdict's reasons of a measured tilt begin (verdict.py)
 
 
 @dataclass(frozen=True)
@@ -36,6 +42,8 @@ class Probe:
         normal_error: the angle between the sensor's axis and the surface's normal where it
             indented (rad; a map through the robot), None where nothing turned it (the bench
             column over a level patch).
+        tilt: the largest tilt to the normal the trial's own touches allow (rad: the measured
+            misalignment and two of its sigmas), None where no normal was measured.
     """
 
     x: float
@@ -47,6 +55,7 @@ class Probe:
     lab_time: float = 0.0
     contact_radius: float | None = None
     normal_error: float | None = None
+    tilt: float | None = None
 
     @property
     def usable(self) -> bool:
@@ -63,9 +72,15 @@ class Probe:
             raise ValueError(f"probe at ({self.x:.4g}, {self.y:.4g}) m has no usable interval")
         lo, hi = self.ci
         sigma = max(math.log(hi / lo) / (2.0 * Z95), SIGMA_FLOOR)
-        if self.status == "suspect":
+        if self.status == "suspect" and not self.only_a_small_tilt:
             sigma *= math.sqrt(SUSPECT_INFLATION)
         return sigma
+
+    @property
+    def only_a_small_tilt(self) -> bool:
+        """Suspect for a measured tilt alone, and that tilt under :data:`SMALL_TILT`."""
+        small = self.tilt is not None and self.tilt <= SMALL_TILT
+        return small and bool(self.reasons) and all(r.startswith(TILT_REASON) for r in self.reasons)
 
     def why_left_out(self) -> str | None:
         """Why the map does not use it (None: it does)."""
@@ -93,6 +108,7 @@ class Probe:
             float(d["lab_time_s"]),
             None if d["contact_radius_m"] is None else float(d["contact_radius_m"]),
             None if d.get("normal_error_rad") is None else float(d["normal_error_rad"]),
+            None if d.get("tilt_rad") is None else float(d["tilt_rad"]),
         )
 
     @classmethod
@@ -122,6 +138,7 @@ class Probe:
             "lab_time_s": self.lab_time,
             "contact_radius_m": self.contact_radius,
             **({} if self.normal_error is None else {"normal_error_rad": self.normal_error}),
+            **({} if self.tilt is None else {"tilt_rad": self.tilt}),
         }
 
     def as_dict(self) -> dict[str, object]:
@@ -141,6 +158,7 @@ class Probe:
                 if self.normal_error is None
                 else {"normal_error_deg": math.degrees(self.normal_error)}
             ),
+            **({} if self.tilt is None else {"tilt_deg": math.degrees(self.tilt)}),
         }
 
 

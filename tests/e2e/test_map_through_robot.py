@@ -195,3 +195,40 @@ def test_a_study_surveys_the_same_worlds_both_ways_side_by_side(scene: SceneConf
     lines = summarise_study(rows)
     assert [line.get("through") for line in lines] == [None, "robot"]
     assert lines[1]["normal_error_max_deg"] == pytest.approx(0.0, abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("tilt_deg", "reasons", "kept"),
+    [
+        (3.0, ("misalignment 2.1 deg beyond the campaign's tolerance of 2 deg",), True),
+        (6.0, ("misalignment 4.1 deg beyond the campaign's tolerance of 2 deg",), False),
+        (None, ("misalignment 2.1 deg beyond the campaign's tolerance of 2 deg",), False),
+        (3.0, ("misalignment 2.1 deg beyond ...", "imprecise: the 95 % interval spans"), False),
+        (3.0, ("oblique: 10.0 deg from the surface normal",), False),
+    ],
+)
+def test_a_probe_suspect_for_a_small_measured_tilt_alone_keeps_its_interval(
+    tilt_deg: float | None, reasons: tuple[str, ...], kept: bool
+) -> None:
+    tilt = None if tilt_deg is None else math.radians(tilt_deg)
+    ok = Probe(0.0, 0.0, 3e5, (2.9e5, 3.1e5), "ok")
+    suspect = dataclasses.replace(ok, status="suspect", reasons=reasons, tilt=tilt)
+    ratio = suspect.log_sigma() / ok.log_sigma()
+    assert ratio == pytest.approx(1.0 if kept else 2.0)
+    assert Probe.from_record(json.loads(json.dumps(suspect.record()))) == suspect
+
+
+def test_a_probing_survey_says_how_far_each_trial_s_touches_allow_the_tilt(
+    scene: SceneConfig,
+) -> None:
+    stack = load_stack(resolve(scene.robot))
+    felt = run_survey(
+        through(registered_wrong(scene, 3.0), 30.0, probe=True),
+        stack,
+        strategy="raster",
+        max_probes=4,
+    )
+    for p in felt.probes:
+        assert p.tilt is not None
+        assert p.normal_error is not None
+        assert p.tilt >= p.normal_error - math.radians(0.5)  # the touches' bound holds the truth
