@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from transforms3d.quaternions import quat2mat
 
 from palpate.campaigns.mapstudy import run_map_study, summarise_study
 from palpate.campaigns.survey import moved_scene, probe_spec, run_survey
@@ -21,6 +22,7 @@ from palpate.config.scene import SceneConfig
 from palpate.maps import Probe
 from palpate.maps.probes import normal_scores
 from palpate.robot import kinematics
+from palpate.robot.records.recording import read_recording
 from palpate.simulation.trial import run_sim_trial
 
 SCENE = resolve("scenes/maps/inclusion.yaml")
@@ -167,6 +169,22 @@ def test_palpate_map_through_the_robot_writes_each_probe_s_normal_error_and_a_3d
     (run,) = tmp_path.iterdir()
     probes = json.loads((run / "map.json").read_text(encoding="utf-8"))["probes"]
     assert [p["normal_error_deg"] for p in probes] == pytest.approx([0.0] * 4, abs=1e-6)
+    rec = read_recording(run / "map.mcap")  # where the tissue and the robot stood, as /tf
+    assert rec.count("/tf") == 4
+    _, last = rec.messages["/tf"][-1]
+    frames = {(t.header.frame_id, t.child_frame_id): t.transform for t in last.transforms}
+    sample, base = frames[("world", "sample")], frames[("world", "base")]
+    q = sample.rotation
+    rotation = quat2mat((q.w, q.x, q.y, q.z))
+    origin = np.array([sample.translation.x, sample.translation.y, sample.translation.z])
+    at = origin + rotation @ np.array([probes[-1]["x_mm"], probes[-1]["y_mm"], 0.0]) * 1e-3
+    stack = load_stack(resolve("robot.yaml"))
+    reach = ThroughRobot.of(through(load(SceneConfig, SCENE), 15.0), stack)
+    assert at == pytest.approx(
+        reach.plane.at(probes[-1]["x_mm"] * 1e-3, probes[-1]["y_mm"] * 1e-3).point, abs=1e-9
+    )
+    moved = np.array([base.translation.x, base.translation.y, base.translation.z])
+    assert np.linalg.norm(moved) > 1e-3  # the positioner carried the robot off stage zero
 
 
 @pytest.mark.parametrize(
