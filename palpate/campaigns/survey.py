@@ -41,6 +41,7 @@ from palpate.config.sample import SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 from palpate.maps import Probe
+from palpate.robot.plan import State
 from palpate.robot.trial.outcome import probe_of
 from palpate.simulation.trial import TrialOutcome, run_sim_trial
 from palpate.simulation.world import BENCH_COLUMN, TrialSpec
@@ -192,7 +193,7 @@ def _probe_at(
     probe = probe_of(o, point, lab_time, stack.sensor.tip_radius)
     if reach is None or placed is None:
         return probe, o
-    probe = dataclasses.replace(
-        probe, normal_error=o.true_misalignment, tilt=measured_tilt(o)
-    )  # the world's truth, and what the trial's touches say
+    indented = o.state != State.UNREACHABLE  # else the world's last contact was a touch
+    error = o.true_misalignment if indented else None  # the world's truth
+    probe = dataclasses.replace(probe, normal_error=error, tilt=measured_tilt(o))
     return oblique(probe, placed), o

@@ -250,3 +250,20 @@ def test_a_probing_survey_says_how_far_each_trial_s_touches_allow_the_tilt(
         assert p.tilt is not None
         assert p.normal_error is not None
         assert p.tilt >= p.normal_error - math.radians(0.5)  # the touches' bound holds the truth
+
+
+def test_a_probe_the_trial_could_not_turn_square_on_says_why_and_claims_no_normal(
+    scene: SceneConfig,
+) -> None:
+    """Registered 4 deg wrong along the bent tube's bend, where no roll helps: the trial's
+    touches find the normal, no roll meets it within the tolerance, and it ends unreachable."""
+    stack = load_stack(resolve(scene.robot))
+    wrong = through(registered_wrong(scene, 4.0), 30.0, probe=True)
+    along = tuple(dataclasses.replace(s, tilt_azimuth_deg=90.0) for s in wrong.samples)
+    wrong = dataclasses.replace(wrong, samples=along)
+    result = run_survey(wrong, stack, strategy="raster", max_probes=1)
+    (p,) = result.probes
+    assert result.outcomes[0].state == "unreachable"
+    assert p.modulus is None
+    assert p.reasons[0].startswith("unreachable: no orthogonal pose of tube bent30")
+    assert p.normal_error is None  # it never indented

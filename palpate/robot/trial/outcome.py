@@ -122,13 +122,16 @@ def probe_of(
     ci = None
     if ok and jf is not None and jf.ci_low is not None and jf.ci_high is not None:
         ci = (jf.ci_low, jf.ci_high)
+    reasons = () if v is None else tuple(v.reasons) or (() if ok else (o.reason,))
+    if o.state == State.UNREACHABLE:  # why it never indented, before what the fit then said
+        reasons = (o.reason, *reasons)
     return Probe(
         point[0],
         point[1],
         jf.modulus if ok and jf is not None else None,
         ci,
         "none" if v is None else v.status,
-        () if v is None else tuple(v.reasons) or (() if ok else (o.reason,)),
+        reasons,
         lab_time,
         _contact_radius(jf, tip_radius) if ok else None,
     )
