@@ -18,7 +18,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -38,8 +38,8 @@ from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_fra
 from palpate.robot.records.ros2 import nanoseconds
 
 if TYPE_CHECKING:
-    from palpate.campaigns.throughrobot import ThroughRobot
     from palpate.live import View
+    from palpate.robot.records.cdr import Transform
 
 MM = 1e-3
 PROBES_FILE = "probes.jsonl"
@@ -125,6 +125,14 @@ class Truth:
         }
 
 
+class CarriedRobot(Protocol):
+    """Where a robot carried to each probe stood: ``frames(point)`` gives the ``/tf`` transforms
+    (``world`` -> ``base``, and ``world`` -> ``sample`` where the tissue's pose is known) of the
+    probe at ``point`` (``campaigns.throughrobot.ThroughRobot``, ``robot.xystage.Gantry``)."""
+
+    def frames(self, point: Point) -> list[Transform]: ...
+
+
 @dataclass
 class SurveyResult:
     """A survey's probes, its map's answer (None when too few probes gave a number), why it
@@ -139,7 +147,7 @@ class SurveyResult:
     patch: Patch
     outcomes: list[Any] = field(default_factory=list)  # the probes' trials
     length_scale_max: float = LENGTH_SCALE_MAX  # the map's (m)
-    reach: ThroughRobot | None = None  # how the probes reached the patch through the robot
+    reach: CarriedRobot | None = None  # how the probes reached the patch through the robot
 
     def scores(self) -> dict[str, Any]:
         """Against the truth: the centre's error (mm), and the boundary's sensitivity,

@@ -30,6 +30,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from transforms3d.quaternions import mat2quat
 
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig, TubeConfig
@@ -38,6 +39,7 @@ from palpate.maps import Probe
 from palpate.maps.surfaces import TiltedPlane
 from palpate.robot import kinematics
 from palpate.robot.positioner import Approach, Placement, Positioner, place
+from palpate.robot.records.cdr import Transform
 from palpate.simulation.trial import TrialOutcome
 from palpate.simulation.world import TrialSpec
 
@@ -118,6 +120,21 @@ class ThroughRobot:
             roll=placed.roll,
             facing=self.truth,
         )
+
+    def frames(self, point: Point) -> list[Transform]:
+        """``/tf`` of the probe at ``point``: ``world`` -> ``sample`` (the patch's plane, its u,
+        v and normal as x, y, z) and ``world`` -> ``base`` (the placement; stage zero where
+        none was found)."""
+        origin = self.plane.at(0.0, 0.0)
+        e1 = self.plane.at(1.0, 0.0).point - origin.point
+        e2 = self.plane.at(0.0, 1.0).point - origin.point
+        w, x, y, z = mat2quat(np.column_stack([e1, e2, origin.normal]))
+        placed = self.place(point)
+        base = placed.base if placed.status in (0, 1) else self.stage.home
+        return [
+            ("world", "sample", tuple(float(v) for v in origin.point), (x, y, z, w)),
+            ("world", "base", tuple(float(v) for v in base), (0.0, 0.0, 0.0, 1.0)),
+        ]
 
     def travel(self, last: Point | None, placed: Placement) -> float:
         """How far (m) the positioner moves the base to ``placed`` from the last probe's point's

@@ -9,10 +9,11 @@ Channels, each message stamped with the lab time (s) at which its probe finished
   ``sd`` (of log E) and ``p_above`` (of the threshold as the map had it then);
 - ``/map/probes`` (``sensor_msgs/msg/PointCloud2``): the probes so far, fields ``x``, ``y``,
   ``z``, ``modulus_kpa`` (NaN without a number) and ``order`` (1, 2, ...);
-- ``/tf`` (``tf2_msgs/msg/TFMessage``), a map through the robot only: ``world`` -> ``sample``
-  (the patch's plane in the robot's base frame at stage zero, so the clouds stand where the
-  tissue is) and ``world`` -> ``base`` (where the positioner put the robot for that probe), at
-  each probe; the trials' own recordings carry ``base`` -> ``tube_tip`` -> ``sensor_tip``.
+- ``/tf`` (``tf2_msgs/msg/TFMessage``), a map through the robot only, at each probe: ``world``
+  -> ``base`` (where the positioner or the bench's gantry put the robot for that probe) and, in
+  simulation, ``world`` -> ``sample`` (the patch's plane in the robot's base frame at stage
+  zero, so the clouds stand where the tissue is); the trials' own recordings carry ``base`` ->
+  ``tube_tip`` -> ``sensor_tip``.
 
 Why point clouds: a standard message every ROS 2 viewer colours by any of its fields (the
 modulus, its uncertainty or the probability, chosen in the viewer), on any cell spacing;
@@ -33,12 +34,10 @@ import numpy as np
 from mcap.well_known import MessageEncoding, SchemaEncoding  # type: ignore[import-untyped,unused-ignore]
 from mcap.writer import CompressionType, Writer  # type: ignore[import-untyped,unused-ignore]
 from mcap_ros2._dynamic import serialize_dynamic  # type: ignore[import-untyped,unused-ignore]
-from transforms3d.quaternions import mat2quat
 
 from palpate.campaigns.survey import SurveyResult
-from palpate.campaigns.throughrobot import ThroughRobot
 from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
-from palpate.robot.records.cdr import Transform, tf_message
+from palpate.robot.records.cdr import tf_message
 from palpate.robot.records.ros2 import HEADER, SCHEMAS, SEP, TIME, TOPICS, header, nanoseconds
 
 CLOUD = "sensor_msgs/msg/PointCloud2"
@@ -81,23 +80,6 @@ def cloud(stamp_ns: int, names: Sequence[str], columns: Sequence[np.ndarray]) ->
     }
 
 
-def robot_frames(reach: ThroughRobot, point: tuple[float, float]) -> list[Transform]:
-    """``world`` -> ``sample`` (the patch's plane: its u, v and normal as x, y, z) and ``world``
-    -> ``base`` (the positioner's placement for ``point``; stage zero where none was found)."""
-    plane = reach.plane
-    origin = plane.at(0.0, 0.0)
-    e1 = plane.at(1.0, 0.0).point - origin.point
-    e2 = plane.at(0.0, 1.0).point - origin.point
-    w, x, y, z = mat2quat(np.column_stack([e1, e2, origin.normal]))
-    placed = reach.place(point)
-    base = placed.base if placed.status in (0, 1) else reach.stage.home
-    identity = (0.0, 0.0, 0.0, 1.0)
-    return [
-        ("world", FRAME, tuple(float(v) for v in origin.point), (x, y, z, w)),
-        ("world", "base", tuple(float(v) for v in base), identity),
-    ]
-
-
 def write_map_recording(result: SurveyResult, path: Path, threshold: float | None = None) -> Path:
     """The survey's map after each probe (module docstring) as MCAP at ``path``."""
     encode = serialize_dynamic(CLOUD, CLOUD_SCHEMA)[CLOUD]
@@ -117,7 +99,7 @@ def write_map_recording(result: SurveyResult, path: Path, threshold: float | Non
             lab += probe.lab_time
             stamp = nanoseconds(lab)
             if tf is not None and result.reach is not None:
-                data = tf_message(stamp, robot_frames(result.reach, (probe.x, probe.y)))
+                data = tf_message(stamp, result.reach.frames((probe.x, probe.y)))
                 writer.add_message(tf, log_time=stamp, data=data, publish_time=stamp)
             so_far = result.probes[:k]
             data = encode(cloud(stamp, PROBE_FIELDS, probe_frame(so_far)))

@@ -38,7 +38,9 @@ def write_map_results(
         from palpate.reports.mapfig import map_figure
 
         payload["figure"] = str(map_figure(result, run_dir / "map.png", title))
-        if result.reach is not None:
+        from palpate.campaigns.throughrobot import ThroughRobot
+
+        if isinstance(result.reach, ThroughRobot):  # the tissue's pose known: the simulator's
             from palpate.reports.map3d import map3d_figure
 
             path = map3d_figure(result, result.reach, run_dir / "map3d.png", title)

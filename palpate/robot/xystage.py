@@ -20,6 +20,7 @@ from ..config.xystage import XYStageConfig
 from ..sensor.clock import Clock
 from .drive import JointLimitError
 from .motors import MotorBus, MotorState
+from .records.cdr import Transform
 
 STAGE_X = "stage_x"
 STAGE_Y = "stage_y"
@@ -81,6 +82,19 @@ class XYAxes:
     def homed(self, shafts_now: Mapping[str, float]) -> XYAxes:
         """Axes whose offsets make ``shafts_now`` the configured home pose."""
         return XYAxes(self.cfg, {n: shafts_now[n] for n in STAGE_SERVOS})
+
+
+class Gantry:
+    """Where a stage that carries the robot (``carries: robot``) put its base for a stage
+    position: ``frames(point)``, the ``/tf`` ``world`` -> ``base`` of a map's probe there."""
+
+    def __init__(self, cfg: XYStageConfig) -> None:
+        self.cfg = cfg
+
+    def frames(self, point: Point) -> list[Transform]:
+        (x, y), dx, dy = point, self.cfg.x_direction, self.cfg.y_direction
+        base = tuple(x * a + y * b for a, b in zip(dx, dy, strict=True))
+        return [("world", "base", base, (0.0, 0.0, 0.0, 1.0))]
 
 
 class StageController:

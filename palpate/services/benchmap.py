@@ -36,7 +36,7 @@ from palpate.lab.trial import PLANNED, BenchOutcome, run_bench_trial
 from palpate.live import View
 from palpate.maps import Probe
 from palpate.robot.trial.outcome import probe_of
-from palpate.robot.xystage import StageMoveError
+from palpate.robot.xystage import Gantry, StageMoveError
 
 CLEAR_MARGIN = 0.5 * MM  # the sensor counts as back within this of the retract pose
 
@@ -96,4 +96,7 @@ def run_bench_map(
             raise SurveyStopped(probe, outcome, f"{outcome.state}: {outcome.reason}")
         return probe, outcome
 
-    return run_plan(plan, probe_at, run_dir=log_dir, live=live)
+    result = run_plan(plan, probe_at, run_dir=log_dir, live=live)
+    if stage.axes.cfg.carries == "robot":
+        result.reach = Gantry(stage.axes.cfg)
+    return result

@@ -17,7 +17,9 @@ from palpate.config.bench import LoadedBench, load_bench
 from palpate.config.scene import SceneConfig
 from palpate.lab.hardware import Hardware, open_hardware
 from palpate.lab.plan import plan_bench_map, plan_session
+from palpate.reports.maprecording import write_map_recording
 from palpate.robot import kinematics
+from palpate.robot.records.recording import read_recording
 from palpate.robot.xystage import STAGE_SERVOS, StageMoveError
 from palpate.services.lab import run_map_session
 from palpate.sim.clock import VirtualClock
@@ -132,6 +134,14 @@ def test_a_raster_map_on_the_emulated_stage_finds_the_inclusion(
     here = (result.probes[-1].x, result.probes[-1].y)
     moved = (0.0, here[0], -here[1]) if carried else (0.0, 0.0, 0.0)
     assert base == pytest.approx(moved, abs=0.05e-3)  # the robot moved, or the sample did
+    rec = read_recording(write_map_recording(result, tmp_path / "map.mcap"))
+    if carried:  # where the gantry put the robot's base at each probe, as /tf
+        assert rec.count("/tf") == 9
+        (last_tf,) = rec.messages["/tf"][-1][1].transforms
+        t = last_tf.transform.translation
+        assert (t.x, t.y, t.z) == pytest.approx(moved, abs=1e-12)
+    else:
+        assert "/tf" not in rec.messages
     assert result is not None
     assert len(result.probes) == 9
     assert all(p.usable for p in result.probes)
