@@ -175,7 +175,7 @@ def _probe_at(
     if reach is not None and placed is not None:
         if placed.status not in (0, 1):
             return refused(point, placed), None
-        spec = reach.spec(spec, placed)
+        spec = reach.spec(spec, placed, point)
     o = run_sim_trial(
         spec,
         moved_scene(scene, sample, point),

@@ -32,7 +32,7 @@ def map3d_figure(result: SurveyResult, reach: ThroughRobot, path: Path, title: s
     fig = plt.figure(figsize=(13, 6), layout="constrained")
     whole: Any = fig.add_subplot(1, 2, 1, projection="3d")
     near: Any = fig.add_subplot(1, 2, 2, projection="3d")
-    pressed = np.array([reach.plane.at(p.x, p.y).point for p in result.probes]) / MM
+    pressed = np.array([reach.surface.at(p.x, p.y).point for p in result.probes]) / MM
     errors = [
         math.degrees(p.normal_error) if p.normal_error is not None else math.nan
         for p in result.probes
@@ -67,7 +67,7 @@ def _patch(ax: Any, result: SurveyResult, reach: ThroughRobot) -> None:
     if s is None:
         return
     xs, ys = s.x[::STRIDE], s.y[::STRIDE]
-    grid = np.array([[reach.plane.at(float(u), float(v)).point for u in xs] for v in ys]) / MM
+    grid = np.array([[reach.surface.at(float(u), float(v)).point for u in xs] for v in ys]) / MM
     field = s.mean[::STRIDE, ::STRIDE]
     colour = plt.get_cmap("viridis")((field - field.min()) / max(float(np.ptp(field)), 1e-9))
     ax.plot_surface(grid[..., 0], grid[..., 1], grid[..., 2], facecolors=colour, alpha=0.7)

@@ -135,7 +135,8 @@ def _robot_geometry(
         raise InputError(f"trial {spec.trial_id}: target not reachable: {ik.reason}")
     if spec.facing is not None:
         n = np.asarray(spec.facing, dtype=np.float64)  # the tip sphere touches it at -R n
-        surface = Surface(point=nominal.sensor_tip - r_tip * n, normal=n)
+        radius = None if sample is None else sample.curvature_radius  # a dome's
+        surface = Surface(point=nominal.sensor_tip - r_tip * n, normal=n, radius=radius)
     elif sample is None:
         surface = Surface(point=target, normal=normal)
     else:

@@ -15,7 +15,7 @@ from transforms3d.quaternions import quat2mat
 
 from palpate.campaigns.mapstudy import run_map_study, summarise_study
 from palpate.campaigns.survey import moved_scene, probe_spec, run_survey
-from palpate.campaigns.throughrobot import ThroughRobot, map_plane
+from palpate.campaigns.throughrobot import ThroughRobot, map_surface
 from palpate.cli import main
 from palpate.config import load, load_stack, resolve
 from palpate.config.scene import SceneConfig
@@ -55,7 +55,7 @@ def test_the_tube_of_the_plane_s_tilt_meets_each_point_square_on(scene: SceneCon
     tilted = through(scene, 30.0)
     stack = load_stack(resolve(scene.robot))
     reach = ThroughRobot.of(tilted, stack)
-    plane = map_plane(tilted, stack)
+    plane = map_surface(tilted, stack)
     centre = reach.place((0.0, 0.0))
     assert (centre.tube, centre.status) == ("bent30", 0)
     assert np.allclose(centre.base, 0.0, atol=1e-9)  # the plane's origin is at stage zero
@@ -78,7 +78,7 @@ def test_a_probe_through_the_robot_reads_what_the_stage_s_probe_reads(scene: Sce
     spec = probe_spec(scene, sample, 0, point, 0)
     bench = run_sim_trial(spec, moved_scene(scene, sample, point), stack)
     placed = reach.place(point)
-    spec = reach.spec(spec, placed)
+    spec = reach.spec(spec, placed, point)
     assert spec.kind == "robot"
     assert spec.tube.name == "bent30"
     robot = run_sim_trial(spec, moved_scene(tilted, sample, point), stack)
@@ -181,7 +181,7 @@ def test_palpate_map_through_the_robot_writes_each_probe_s_normal_error_and_a_3d
     stack = load_stack(resolve("robot.yaml"))
     reach = ThroughRobot.of(through(load(SceneConfig, SCENE), 15.0), stack)
     assert at == pytest.approx(
-        reach.plane.at(probes[-1]["x_mm"] * 1e-3, probes[-1]["y_mm"] * 1e-3).point, abs=1e-9
+        reach.surface.at(probes[-1]["x_mm"] * 1e-3, probes[-1]["y_mm"] * 1e-3).point, abs=1e-9
     )
     moved = np.array([base.translation.x, base.translation.y, base.translation.z])
     assert np.linalg.norm(moved) > 1e-3  # the positioner carried the robot off stage zero
@@ -267,3 +267,44 @@ def test_a_probe_the_trial_could_not_turn_square_on_says_why_and_claims_no_norma
     assert p.modulus is None
     assert p.reasons[0].startswith("unreachable: no orthogonal pose of tube bent30")
     assert p.normal_error is None  # it never indented
+
+
+def domed(scene: SceneConfig, radius_mm: float) -> SceneConfig:
+    """The scene's samples curved into a convex dome facing the robot, their tips sticking."""
+    curved = tuple(
+        dataclasses.replace(s, curvature_radius_mm=radius_mm, friction=1.0) for s in scene.samples
+    )
+    return dataclasses.replace(scene, samples=curved)
+
+
+def test_on_a_dome_the_normal_turns_and_the_tube_of_its_angle_meets_it_square_on(
+    scene: SceneConfig,
+) -> None:
+    stack = load_stack(resolve(scene.robot))
+    dome = through(domed(scene, 40.0), 0.0)
+    reach = ThroughRobot.of(dome, stack)
+    apex = reach.place((0.0, 0.0))
+    assert (apex.tube, apex.status) == ("straight", 0)
+    ring = 40e-3 * math.radians(15.0)  # where the normal has turned by the bent15's angle
+    aside = reach.place((0.0, ring))
+    assert (aside.tube, aside.status) == ("bent15", 0)
+    assert aside.residual < 1e-6
+    between = reach.place((0.0, 0.5 * ring))  # 7.5 deg: between the straight and the bent15
+    assert between.status == 1
+    assert math.degrees(between.residual) == pytest.approx(7.5, abs=0.01)
+    spec = reach.spec(probe_spec(dome, dome.samples[0], 0, (0.0, ring), 0), aside, (0.0, ring))
+    n = reach.surface.at(0.0, ring).normal
+    assert spec.facing == pytest.approx(tuple(n))
+
+
+def test_a_dome_survey_presses_where_placed_and_says_which_probes_were_off_the_normal(
+    scene: SceneConfig,
+) -> None:
+    stack = load_stack(resolve(scene.robot))
+    dome = through(domed(scene, 40.0), 0.0, probe="measure")
+    result = run_survey(dome, stack, strategy="raster", max_probes=4)
+    assert all(p.modulus is not None for p in result.probes)  # every one indented
+    errors = [p.normal_error for p in result.probes]
+    assert all(e is not None for e in errors)
+    assert max(e or 0.0 for e in errors) > math.radians(2.0)  # between the tubes' cones
+    assert normal_scores(result.probes)["off_normal_unflagged"] == 0
