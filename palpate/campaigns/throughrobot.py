@@ -136,6 +136,10 @@ class ThroughRobot:
         """The tube, roll and stage pose for the patch's ``point`` (m)."""
         return place(self.tubes, self.surface.at(*point), self.stage, self.approach)
 
+    def tube(self, placed: Placement) -> TubeConfig:
+        """The tube a placement chose."""
+        return next(t for t in self.tubes if t.name == placed.tube)
+
     def spec(self, spec: TrialSpec, placed: Placement, point: Point) -> TrialSpec:
         """The probe's trial (a bench probe's ``spec`` at ``point``) as a robot trial at the
         placement, the tissue facing its true normal there."""
@@ -143,7 +147,7 @@ class ThroughRobot:
         return dataclasses.replace(
             spec,
             kind="robot",
-            tube=next(t for t in self.tubes if t.name == placed.tube),
+            tube=self.tube(placed),
             roll=placed.roll,
             facing=(float(n[0]), float(n[1]), float(n[2])),
         )

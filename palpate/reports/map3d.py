@@ -78,7 +78,7 @@ def _robot(ax: Any, reach: ThroughRobot, point: tuple[float, float], label: str)
     placed = reach.place(point)
     if placed.status not in (0, 1):
         return
-    tube = next(t for t in reach.tubes if t.name == placed.tube)
+    tube = reach.tube(placed)
     body = (body_points(tube, placed.roll, placed.contact_translation) + placed.base) / MM
     line = ax.plot(
         *body.T, lw=1.5, label=f"{label}: {tube.name}, roll {math.degrees(placed.roll):.0f} deg"

@@ -7,9 +7,9 @@ and the probability of being above the threshold with its one-half contour (the 
 region), the inclusion's extent (the disc fitted through the tip's contact, solid black on every
 panel: the boundary the map reports), the estimated centre with its 95 % box, and in simulation
 every true inclusion's footprint (dashed) and centre (+); each inclusion's depth as the map read
-it, on the left. The map's other inclusions (a map of
-several, ``maps.inclusions``): each disc on every panel, black if stiff, cyan if soft, its
-centre and its 95 % box on the right. A survey that found nothing says so in the title.
+it, on the left. The map's other inclusions (a map of several, ``maps.inclusions``): each disc
+on every panel, black if stiff, cyan if soft, its centre and its 95 % box on the right. A
+survey that found nothing says so in the title.
 """
 
 from __future__ import annotations

@@ -9,13 +9,14 @@ map's answer, the truth in simulation), ``map.mcap`` (the map as point clouds) a
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
 from palpate.campaigns.surveyloop import SurveyResult
 from palpate.maps import MapSummary
 from palpate.maps.inclusions import Inclusion
-from palpate.maps.probes import normal_scores
+from palpate.maps.probes import NORMAL_TOLERANCE, normal_scores
 
 
 def write_map_results(
@@ -72,7 +73,8 @@ def map_lines(result: SurveyResult, run_dir: Path, title: str, strategy: str) ->
     if normal:
         lines.append(
             f"through the robot: every probe's axis within {normal['normal_error_max_deg']:.1f} "
-            f"deg of the true surface normal; {normal['probes_off_normal']} beyond 2 deg, "
+            f"deg of the true surface normal; {normal['probes_off_normal']} beyond "
+            f"{math.degrees(NORMAL_TOLERANCE):g} deg, "
             f"{normal['off_normal_unflagged']} of them without a verdict that says so"
         )
     if result.truth is not None:

@@ -85,16 +85,26 @@ class XYAxes:
 
 
 class Gantry:
-    """Where a stage that carries the robot (``carries: robot``) put its base for a stage
-    position: ``frames(point)``, the ``/tf`` ``world`` -> ``base`` of a map's probe there."""
+    """Where a stage that carries the robot (``carries: robot``) puts the robot's base for a
+    stage position: ``base(point)``, and ``frames(point)``, the ``/tf`` ``world`` -> ``base`` of
+    a map's probe there. :meth:`of` gives None for a stage that carries the sample."""
 
     def __init__(self, cfg: XYStageConfig) -> None:
         self.cfg = cfg
 
-    def frames(self, point: Point) -> list[Transform]:
+    @classmethod
+    def of(cls, cfg: XYStageConfig | None) -> Gantry | None:
+        return None if cfg is None or cfg.carries != "robot" else cls(cfg)
+
+    def base(self, point: Point) -> tuple[float, float, float]:
+        """The base frame's offset (m) with the stage at ``point``: ``x * x_direction + y *
+        y_direction``."""
         (x, y), dx, dy = point, self.cfg.x_direction, self.cfg.y_direction
-        base = tuple(x * a + y * b for a, b in zip(dx, dy, strict=True))
-        return [("world", "base", base, (0.0, 0.0, 0.0, 1.0))]
+        bx, by, bz = (x * a + y * b for a, b in zip(dx, dy, strict=True))
+        return bx, by, bz
+
+    def frames(self, point: Point) -> list[Transform]:
+        return [("world", "base", self.base(point), (0.0, 0.0, 0.0, 1.0))]
 
 
 class StageController:

@@ -97,6 +97,5 @@ def run_bench_map(
         return probe, outcome
 
     result = run_plan(plan, probe_at, run_dir=log_dir, live=live)
-    if stage.axes.cfg.carries == "robot":
-        result.reach = Gantry(stage.axes.cfg)
+    result.reach = Gantry.of(stage.axes.cfg)
     return result

@@ -38,7 +38,7 @@ from palpate.robot import kinematics
 from palpate.robot.drive import SERVOS, TRANSLATION, RollerGearDrive
 from palpate.robot.dynamixel.units import rad_from_ticks
 from palpate.robot.trial.setup import sensor_section
-from palpate.robot.xystage import STAGE_SERVOS, XYAxes
+from palpate.robot.xystage import STAGE_SERVOS, Gantry, XYAxes
 from palpate.sensor.parser import layout_from_config
 from palpate.sim.board import BoardEmulator, BoardSample
 from palpate.sim.clock import VirtualClock
@@ -167,6 +167,7 @@ class SimulatedBench:
         self._ids = {n: s.id for n, s in servo_roster(stack.servos, stack.stage).items()}
         self.bus = EmulatedBus.from_config(stack.servos, clock=clock, stage=stack.stage)
         self._stage = None if stack.stage is None else XYAxes(stack.stage)  # home at power-up
+        self._gantry = Gantry.of(stack.stage)  # a stage that carries the robot, not the sample
         self._placed = self._stage_at()  # where the stage stood when the world was made (m)
         self._base = np.zeros(3)  # the robot's base frame, moved by a stage that carries it (m)
         self.at = self._placed  # the point of the sample under the tip (m)
@@ -218,13 +219,13 @@ class SimulatedBench:
     def _place(self) -> None:
         """Where the stage now stands: the point of the tissue under the tip (``at``) and, for a
         stage that carries the robot, the base frame's offset."""
-        self._placed = x, y = self._stage_at()
-        cfg = self.stack.stage
-        if cfg is None or cfg.carries == "sample":
+        self._placed = self._stage_at()
+        if self._gantry is None:
             self.at = self._placed  # the stage slid the sample: the tissue under the tip
             return
-        self._base = x * np.asarray(cfg.x_direction) + y * np.asarray(cfg.y_direction)
-        self.at = carried_touch(self._base, self.surface.normal, self._joints()[0], self.tube, cfg)
+        self._base = np.asarray(self._gantry.base(self._placed))
+        roll = self._joints()[0]
+        self.at = carried_touch(self._base, self.surface.normal, roll, self.tube, self._gantry.cfg)
 
     def _pose(self, roll: float, translation: float) -> tuple[Any, Any, float]:
         p = kinematics.forward(self.tube, roll, translation)
@@ -284,7 +285,7 @@ class SimulatedBench:
         self.sample = self._sample_config(st.sample)
         self.surface = st.surface
         self.tube = self.stack.tube(st.tube)
-        if self.stack.stage is not None and self.stack.stage.carries == "robot":
+        if self._gantry is not None:
             self._place()  # the same base, another surface
         self._world = self._new_world()
 
