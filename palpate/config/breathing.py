@@ -30,7 +30,10 @@ class BreathingConfig:
         ventilator's breath hold this long at end-expiration after every ``breaths`` breaths (0:
         free breathing, no hold); ``residual_mm``: the drift through a hold (at an even rate, taken
     back by the breaths after it);
-        ``cardiac_mm`` and ``cardiac_period_s``: the heart's beat, always; ``phase``: where in its
+        ``cardiac_mm`` (peak to peak) and ``cardiac_period_s``: the heart's beat, always, shaped
+        as a heart's (``cardiac_shape: beat``: systole, filling, rest; ``sine``: its first harmonic
+        alone), its R-R interval swinging by ``cardiac_variability`` of the period (``sim.heart``);
+        ``phase``: where in its
         cycle each trial starts, drawn per trial (``random``) or at the cycle's start
         (``start``); ``gate``: the ventilator's breath-hold signal reaches the board (status bit 6
         of every frame) while a hold lasts; ``ecg``: an ECG monitor's sync pulse reaches the board
@@ -45,6 +48,8 @@ class BreathingConfig:
     residual_mm: float = field(default=1.0, metadata=limits(ge=-10, le=10))
     cardiac_mm: float = field(default=0.0, metadata=limits(ge=0, le=10))
     cardiac_period_s: float = field(default=0.85, metadata=limits(gt=0, le=5))
+    cardiac_shape: Literal["beat", "sine"] = "beat"
+    cardiac_variability: float = field(default=0.04, metadata=limits(ge=0, le=0.3))
     phase: Literal["random", "start"] = "random"
     gate: bool = True
     ecg: bool = True

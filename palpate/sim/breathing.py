@@ -5,9 +5,8 @@ a virtual time, and whether the ventilator holds the breath then.
 Each breath is Lujan's ``A sin^(2n)(pi t / T)`` (0 at end-expiration, ``A`` at inspiration);
 after every ``breaths`` breaths a hold at end-expiration that drifts by ``residual_mm`` at an
 even rate (``residual h / H``), an offset the next breaths take back at an even rate; the
-heart's beat on top, always, and an ECG monitor's sync pulse at each of its R waves (the
-mechanical beat lags the R wave: the surface starts toward the sensor ``ECG_LAG`` of a period
-after it).
+heart's beat on top, always, and an ECG monitor's sync pulse at each of its R waves
+(``sim.heart``).
 
 Usage::
 
@@ -23,10 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..config.breathing import BreathingConfig
+from .heart import Heart
 
 MM = 1e-3
-ECG_PULSE = 0.02  # s: a monitor's sync output is a 10-100 ms pulse at each R wave
-ECG_LAG = 0.15  # of a period: the ventricles contract 0.1-0.2 s after the R wave
 
 
 @dataclass(frozen=True)
@@ -35,6 +33,11 @@ class Breath:
 
     config: BreathingConfig
     phase: float = 0.0
+    heart: Heart | None = None  # the config's, at ``phase``, its rate steady, where not given
+
+    def __post_init__(self) -> None:
+        if self.heart is None:
+            object.__setattr__(self, "heart", Heart.of(self.config, self.phase, None))
 
     @classmethod
     def of(cls, config: BreathingConfig | None, rng: np.random.Generator) -> Breath | None:
@@ -42,7 +45,7 @@ class Breath:
         if config is None:
             return None
         phase = float(rng.uniform(0.0, config.cycle)) if config.phase == "random" else 0.0
-        return cls(config, phase)
+        return cls(config, phase, Heart.of(config, phase, rng))
 
     def _in_cycle(self, t: float) -> float:
         return (t + self.phase) % self.config.cycle
@@ -55,10 +58,7 @@ class Breath:
     def beat(self, t: float) -> bool:
         """The ECG monitor's sync pulse is on at ``t`` (s): the first ``ECG_PULSE`` after an R
         wave, while the heart beats and its monitor reaches the board."""
-        c = self.config
-        if not (c.ecg and c.cardiac_mm):
-            return False
-        return (t + self.phase + ECG_LAG * c.cardiac_period_s) % c.cardiac_period_s < ECG_PULSE
+        return self.heart is not None and self.heart.r_wave(t)
 
     def lift(self, t: float) -> float:
         """The surface's displacement (m) toward the sensor at ``t`` (s)."""
@@ -73,8 +73,4 @@ class Breath:
                 lift += c.residual_mm * (1.0 - tau / breathing)
         else:
             lift = c.residual_mm * (tau - breathing) / c.hold_s
-        if c.cardiac_mm:
-            lift += (
-                0.5 * c.cardiac_mm * math.sin(2 * math.pi * (t + self.phase) / c.cardiac_period_s)
-            )
-        return lift * MM
+        return lift * MM + (0.0 if self.heart is None else self.heart.lift(t))

@@ -96,6 +96,6 @@ def test_a_gated_trial_that_arrives_in_a_hold_takes_the_beat_out(
 ) -> None:
     assert beating.log_path is not None
     told = replay(arrived_in_a_hold(beating.log_path, tmp_path / "told.jsonl", gated=True))
-    assert told["joint"]["modulus"] == pytest.approx(2e3, rel=0.1)
+    assert told["joint"]["modulus"] == pytest.approx(2e3, rel=0.05)
     older = replay(arrived_in_a_hold(beating.log_path, tmp_path / "older.jsonl", gated=None))
-    assert older["joint"]["modulus"] < 0.8 * 2e3  # the beat left in: the estimate reads low
+    assert older["joint"]["modulus"] < 0.9 * 2e3  # the beat left in: the estimate reads low

@@ -47,12 +47,34 @@ def test_the_beat_is_measured_from_the_load(seed: int) -> None:
     t, x, load, pulses = record(6.0, 0.1e-3, 2e-5, seed)
     beat = heartbeat(x, load, t, r_waves(t.tolist(), pulses.tolist()), load > 1e-4)
     assert beat is not None
-    lag = -math.atan2(beat.cos, beat.sin) / (2 * math.pi)
+    lag = -math.atan2(beat.cos[0], beat.sin[0]) / (2 * math.pi)
     assert lag == pytest.approx(LAG, abs=0.02)
     assert beat.amplitude == pytest.approx(AMPLITUDE, rel=0.25)
     true = AMPLITUDE * np.sin(2 * np.pi * (t / PERIOD - LAG))
     fitted = beat.lift(t) * AMPLITUDE / beat.amplitude
     assert np.max(np.abs(fitted - true)) < 0.15 * AMPLITUDE
+
+
+def test_a_heart_shaped_beat_is_measured_beyond_its_first_harmonic() -> None:
+    """A heart's beat (sim.heart: a fast systole, a slow diastole; a quarter of its motion past
+    the first harmonic) is followed within a tenth of its peak to peak, where one harmonic
+    alone misses it by a fifth."""
+    from palpate.sim.heart import BEAT_MEAN, beat_shape
+
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 6.0, 0.004)
+    x = 0.1e-3 * t
+    true = 2 * AMPLITUDE * (np.array([beat_shape(s - LAG) for s in t / PERIOD]) - BEAT_MEAN)
+    load = 3.0e3 * np.clip(x - 0.1e-3 + true, 0.0, None) ** 1.5 + rng.normal(0.0, 2e-5, t.size)
+    pulses = t[(t % PERIOD) < 0.02]
+    beat = heartbeat(x, load, t, r_waves(t.tolist(), pulses.tolist()), load > 1e-4)
+    assert beat is not None
+    assert len(beat.cos) > 1
+    fitted = beat.lift(t) * AMPLITUDE / beat.amplitude
+    assert np.max(np.abs(fitted - true)) < 0.2 * AMPLITUDE
+    first = Heartbeat(beat.beats, beat.cos[:1], beat.sin[:1])
+    alone = first.lift(t) * AMPLITUDE / first.amplitude
+    assert np.max(np.abs(alone - true)) > 0.3 * AMPLITUDE
 
 
 def test_no_beat_without_two_r_waves_or_enough_contact() -> None:
@@ -73,3 +95,34 @@ def test_a_gated_trial_is_estimated_from_its_last_attempt() -> None:
     assert loads == [0.0, 0.0]
     once = rows[:4]
     assert last_attempt(once, None, None) == (once, None, None)
+
+
+def test_an_amplitude_at_the_searchs_edge_is_not_an_estimate() -> None:
+    """Where the joint fit's residual still falls at the search's edge, the record has not fixed
+    the beat's amplitude: the estimate fails and says so (a number there is the edge's)."""
+    from palpate.estimation.jointfit.result import JointFit
+    from palpate.estimation.trial.motion import HEART_SCALES, fitted_heart, unfixed
+
+    beat = Heartbeat((0.0, 0.9, 1.8), (0.1e-3,), (0.0,))
+
+    def falling(b: Heartbeat) -> JointFit:  # the residual falls all the way to the upper edge
+        return JointFit(True, "ok", modulus=2e3, rms=1.0 / b.amplitude, n_points=100)
+
+    def bowl(b: Heartbeat) -> JointFit:  # least at 1.2 times the first amplitude
+        rms = 1.0 + (b.amplitude / 0.1e-3 - 1.2) ** 2
+        return JointFit(True, "ok", modulus=2e3, rms=rms, n_points=100)
+
+    edge = fitted_heart(beat, falling)
+    assert not edge.fixed
+    assert edge.amplitude == pytest.approx(HEART_SCALES[1] * 0.1e-3, rel=0.02)
+    inside = fitted_heart(beat, bowl)
+    assert inside.fixed
+    assert inside.amplitude == pytest.approx(0.12e-3, rel=0.02)
+    joint = JointFit(True, "ok", modulus=2e3, n_points=100)
+    failed = unfixed(joint, edge)
+    assert failed is not None
+    assert not failed.success
+    assert failed.modulus is None
+    assert failed.message.startswith("heartbeat: the record does not fix")
+    assert unfixed(joint, inside) is joint
+    assert unfixed(joint, None) is joint

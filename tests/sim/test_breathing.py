@@ -36,7 +36,10 @@ def test_the_motion_is_continuous() -> None:
 
 
 def test_the_heart_beats_on_top_and_free_breathing_never_holds() -> None:
-    free = Breath(BreathingConfig(hold_s=0.0, cardiac_mm=1.0, cardiac_period_s=1.0, phase="start"))
+    sine = {"cardiac_shape": "sine", "cardiac_variability": 0.0}
+    free = Breath(
+        BreathingConfig(hold_s=0.0, cardiac_mm=1.0, cardiac_period_s=1.0, phase="start", **sine)  # type: ignore[arg-type]
+    )
     assert free.config.cycle == 4.0
     assert not any(free.holding(x) for x in np.arange(0.0, 20.0, 0.1))
     assert free.lift(0.25) == pytest.approx(3e-3 * np.sin(np.pi / 16) ** 4 + 0.5e-3)
@@ -52,10 +55,12 @@ def test_each_trial_starts_somewhere_in_the_cycle() -> None:
 
 def test_the_ecg_pulses_once_a_beat_ahead_of_the_motion() -> None:
     """A 20 ms sync pulse at each R wave, only while the heart beats and its monitor is on; the
-    surface starts toward the sensor ECG_LAG of a period after it."""
-    from palpate.sim.breathing import ECG_LAG, ECG_PULSE
+    surface starts toward the sensor ECG_LAG of a period after it (a sine's beat, the rate
+    steady)."""
+    from palpate.sim.heart import ECG_LAG, ECG_PULSE
 
-    beating = Breath(BreathingConfig(cardiac_mm=0.4, cardiac_period_s=0.8, phase="start"))
+    steady = {"cardiac_shape": "sine", "cardiac_variability": 0.0}
+    beating = Breath(BreathingConfig(cardiac_mm=0.4, cardiac_period_s=0.8, phase="start", **steady))  # type: ignore[arg-type]
     t = np.arange(0.0, 8.0, 0.004)
     on = np.array([beating.beat(x) for x in t])
     rises = t[1:][on[1:] & ~on[:-1]]

@@ -52,7 +52,7 @@ from ..verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from .finished import FinishedTrial, tip_load_at_buckling
 from .inputs import EstimatorInputs
 from .lean import lean_of_rows, loading_tip, rows_in
-from .motion import Row, motion_envelope, still_record
+from .motion import Row, motion_envelope, still_record, unfixed
 from .relaxed import relaxation_of
 from .states import (
     LOADING_STATES,
@@ -218,7 +218,7 @@ def fit_rows(
     raw, (rows, motion, heart) = rows, still_record(rows, times, tip_forces, beats, drift, joint)
     fitted = fit(rows)
     envelope = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)
-    fitted = dataclasses.replace(fitted, joint=envelope, motion=motion, heart=heart)
+    fitted = dataclasses.replace(fitted, joint=unfixed(envelope, heart), motion=motion, heart=heart)
     if inputs.rigid:
         return fitted
     lean = lean_of_rows(rows, stack.sensor, section, inputs)

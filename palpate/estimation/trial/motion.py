@@ -28,11 +28,15 @@ from ..pose.motion import LEVEL_SIGMAS, Motion, free_load, surface_motion
 Row = tuple[str, float, Sequence[float]]
 JointOf = Callable[[list[Row]], JointFit | None]
 DRIFT_SIGMAS = 3.0
-HEART_SCALES = (0.6, 2.0)  # of the least squares' amplitude (which reads 10-40 % small)
+HEART_SCALES = (0.4, 3.0)  # of the least squares' amplitude (which reads 10-40 % small where
+# the beat is a sine, up to 55 % where a heart's systole is the only contact a beat gives)
 HEART_STEP = 0.05  # of it: the residual's curvature is read this far either side
 HEART_FLOOR = 0.10  # the amplitude's standard error at least (of it): the residual's minimum
 # lies 0-10 % below the true amplitude on the scenes of docs/invivo.md (the law's form), up to
 # 25 % below where the hold's drift is as fast as the indentation (a soft sample's long contact)
+HEART_EDGE = 0.02  # of the least squares' amplitude: a best this near the search's edge is not
+# a minimum (the residual still falls past it: a stiff sample's record of two beats, the beam
+# buckled by the systole; its estimate read 0.1-0.3 of the truth where the edge was taken)
 HEART_ROWS = ("contact", "indenting")  # rows whose load is the tissue's (not the buckled beam's)
 
 
@@ -121,7 +125,7 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
     against a beat) is least, searched over ``HEART_SCALES`` of the least squares' amplitude; its
     standard error from the residual's curvature there (the residuals' correlation counted as
     the fit counts it, by its noise scale), ``HEART_FLOOR`` of it at least. Unchanged where every
-    fit fails."""
+    fit fails; not ``fixed`` where the least lies at the search's edge."""
 
     fits: dict[float, JointFit | None] = {}  # by scale: the search's, read again at its best
 
@@ -138,6 +142,9 @@ def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) 
     if not math.isfinite(found.fun):
         return heart
     best, step = float(found.x), HEART_STEP
+    if min(best - lo, hi - best) < HEART_EDGE:
+        edge = heart.scaled(best, HEART_FLOOR * heart.amplitude * best)
+        return dataclasses.replace(edge, fixed=False)
     joint = fits[best] if best in fits else fit(heart.scaled(best))
     around = [score(best - step), float(found.fun), score(best + step)]
     curve = (around[0] - 2.0 * around[1] + around[2]) / step**2
@@ -159,6 +166,20 @@ def heart_envelope(
     sigmas = (-DRIFT_SIGMAS, DRIFT_SIGMAS)
     factors = [max(0.0, 1.0 + k * heart.sigma / heart.amplitude) for k in sigmas]
     return spanning(joint, [fit(heart.scaled(f)) for f in factors])
+
+
+def unfixed(joint: JointFit | None, heart: Heartbeat | None) -> JointFit | None:
+    """``joint`` failed where the record did not fix the heart's amplitude (``fixed``: its
+    residual least at the search's edge): its modulus would be the edge's, not the tissue's."""
+    if joint is None or heart is None or heart.fixed:
+        return joint
+    return JointFit(
+        False,
+        f"heartbeat: the record does not fix the beat's amplitude (its fit is best at the "
+        f"search's edge, {2e3 * heart.amplitude:.2f} mm peak to peak; a record of a few beats, "
+        "the beam buckled by the systole)",
+        n_points=joint.n_points,
+    )
 
 
 def steady_rows(
