@@ -151,6 +151,7 @@ def envelope(
         n_contact=fit.n_contact,
         max_depth=max_depth,
         rms=float(np.sqrt(np.mean(r * r))),
+        rho=noise.rho,
         noise_scale=math.sqrt(noise.scale2),
         model_spread=spread,
         model_form=eps,

@@ -25,6 +25,8 @@ class JointFit:
         n_points: samples used; n_contact: those with delta > 0 at the solution.
         max_depth: the largest fitted indentation delta.
         rms: rms of the standardised residuals (about 1 when the noise model holds).
+        rho: their lag-1 autocorrelation past contact, capped at ``jointfit.noise.MAX_RHO``
+            (the model misses part of the curve where it is high).
         noise_scale: s, the factor the nominal noise was inflated by for the interval.
         model_spread: |E(other layer ratio) - E| (Pa), each form fitted with its own x0 and P0
             (0 for a half-space); the interval is the envelope of both forms' intervals.
@@ -54,6 +56,7 @@ class JointFit:
     n_contact: int = 0
     max_depth: float | None = None
     rms: float | None = None
+    rho: float = 0.0
     noise_scale: float | None = None
     model_spread: float | None = None
     model_form: float | None = None
