@@ -9,13 +9,15 @@ published N joint states (a trial under way), while the previous call is still r
 last trial's latched ``trial/result`` and answers with it;
 ``name=value`` sets the node's parameter (an integer when it reads as one); ``joy`` holds a
 gamepad's stick forward until the robot has advanced 1 mm, then goes quiet for 2 s of the
-node's clock while the joint states are recorded (``jogs``); ``servo`` does the same with CRTK
+node's clock, and until the robot has stood still for ``STILL_S`` of it, while the joint
+states are recorded (``jogs``); ``servo`` does the same with CRTK
 ``servo_jp`` goals (an empty one first: it opens the jog session, whose joint states then flow).
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import os
@@ -37,6 +39,7 @@ from std_srvs.srv import Trigger
 from palpate.ros.names import SERVICES, TOPICS
 
 JOY_HZ = 20.0  # the joy node's repeat rate while a stick is held
+STILL_S = 1.0  # s of the node's clock a quiet jog's robot must stand still for
 WAIT_S = float(
     os.environ.get("CLIENT_WAIT_S", "600")
 )  # wall time for a service to appear and answer (a busy machine)
@@ -128,7 +131,14 @@ def main() -> None:
                 if start is None and joints:
                     start = joints[-1][1]
             quiet_from, stopped_at = len(joints), joints[-1][0]
-            lock.wait_for(lambda: joints[-1][0] > stopped_at + 2.0, timeout=WAIT_S)
+
+            def still() -> bool:  # 2 s of the node's clock, the last STILL_S of it put
+                quiet = joints[quiet_from:]
+                moved = [t for (_, a), (t, b) in itertools.pairwise(quiet) if a != b]
+                last = max(moved, default=stopped_at)
+                return joints[-1][0] > max(stopped_at + 2.0, last + STILL_S)
+
+            lock.wait_for(still, timeout=WAIT_S)
             return {"start": start, "quiet": joints[quiet_from:]}
 
     def answered(future: Any) -> Any:
