@@ -69,6 +69,10 @@ __all__ = [
 
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 WAIT_CONFIRM = 3  # ticks a contact holds while WAITING before the rest check takes it
+STANDOFF_HINT = (  # a contact while waiting at the stand-off: the tissue came to the tip
+    ": the tissue's motion (the breath, the heart) reached the waiting tip; raise "
+    "campaign.standoff_mm past the breath's excursion"
+)
 AT_REST = frozenset({State.HOMING, State.POSITIONING, State.WAITING})  # no tissue: a RestCheck
 GATED = frozenset({State.APPROACH, State.CONTACT, State.INDENTING, State.BUCKLED, State.HOLDING})
 CONTACT_PHASE = GATED | {State.PROBING}  # the sensor may touch the tissue: the stream must live
@@ -179,7 +183,8 @@ class IndentationMachine:
             self._fault(obs, violation)
             return
         if self._waited_contact(obs) and self.state in AT_REST and not self._rest.seen():
-            self._fault(obs, f"unexpected contact during {self.state.value} ({self._rest})")
+            hint = STANDOFF_HINT if self.state is State.WAITING else ""
+            self._fault(obs, f"unexpected contact during {self.state.value} ({self._rest}){hint}")
 
     def _waited_contact(self, obs: Observation) -> bool:
         """A contact at rest; while WAITING (a breath cycle at most: thousands of frames, where

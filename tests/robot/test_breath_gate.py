@@ -90,3 +90,31 @@ def test_an_ungated_plan_goes_without_waiting() -> None:
     assert result.state is State.DONE, result.reason
     assert "waiting" not in states(result.transitions)
     assert TrialPlan.gated is False
+
+
+@dataclass
+class BreathingRig(GatedRig):
+    """The gated rig whose tissue comes to the waiting tip from ``reach_at`` (s) on: a breath
+    larger than the stand-off."""
+
+    reach_at: float = 5.0
+
+    def observe(self, t: float) -> Observation:
+        obs = super().observe(t)
+        return Observation(**{**obs.__dict__, "contact": obs.contact or t >= self.reach_at})
+
+
+def test_tissue_that_reaches_the_waiting_tip_faults_and_says_to_raise_the_stand_off() -> None:
+    rig = BreathingRig(VirtualClock(), holds=hold_from(30.0, 20.0))
+    result = gated(rig)
+    assert result.state is State.FAULT
+    assert result.reason.startswith("unexpected contact during waiting")
+    assert result.reason.endswith("raise campaign.standoff_mm past the breath's excursion")
+    assert rig.advance == pytest.approx(0.0, abs=1e-5)  # retracted home
+
+
+def test_a_contact_while_positioning_names_no_stand_off() -> None:
+    rig = GatedRig(VirtualClock(), x_contact=5e-3)
+    result = gated(rig)
+    assert result.state is State.FAULT
+    assert "standoff" not in result.reason
