@@ -18,6 +18,8 @@ LAYER_FRONTS = (
     "palpate.maps",
     "palpate.sensor_design",
     "palpate.estimation.reach",
+    "palpate.estimation.pose.heartbeat",
+    "palpate.sim.heart",
     "palpate.estimation.trial.finished",
     "palpate.reports.mapresults",
     "palpate.services.design",
