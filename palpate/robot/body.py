@@ -26,6 +26,11 @@ from dataclasses import dataclass
 from .guards import Observation
 from .plan import TrialPlan
 
+STANDOFF_HINT = (  # a contact while waiting at the stand-off: the tissue came to the tip
+    ": the tissue's motion (the breath, the heart) reached the waiting tip; raise "
+    "campaign.standoff_mm past the breath's excursion"
+)
+
 
 @dataclass
 class BodyWatch:

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 from ..estimation.detect.buckling import BucklingDetector
 from ..estimation.reach import NO_BUCKLING
 from ..estimation.verdict import HOLDS_RAN_OUT
-from .body import BodyWatch
+from .body import STANDOFF_HINT, BodyWatch
 from .guards import STATE_TIMEOUT, Guards, Observation, limit_violation
 from .plan import PLANNED_ENDS, TERMINAL, Command, Prober, State, Transition, TrialMarks, TrialPlan
 from .probe_result import ProbeResult
@@ -69,10 +69,6 @@ __all__ = [
 
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 WAIT_CONFIRM = 3  # ticks a contact holds while WAITING before the rest check takes it
-STANDOFF_HINT = (  # a contact while waiting at the stand-off: the tissue came to the tip
-    ": the tissue's motion (the breath, the heart) reached the waiting tip; raise "
-    "campaign.standoff_mm past the breath's excursion"
-)
 AT_REST = frozenset({State.HOMING, State.POSITIONING, State.WAITING})  # no tissue: a RestCheck
 GATED = frozenset({State.APPROACH, State.CONTACT, State.INDENTING, State.BUCKLED, State.HOLDING})
 CONTACT_PHASE = GATED | {State.PROBING}  # the sensor may touch the tissue: the stream must live
