@@ -33,7 +33,7 @@ class Breath:
 
     config: BreathingConfig
     phase: float = 0.0
-    heart: Heart | None = None  # the config's, at ``phase``, its rate steady, where not given
+    heart: Heart | None = None  # where not given: the config's at ``phase``, swings' phases 0
 
     def __post_init__(self) -> None:
         if self.heart is None:

@@ -12,7 +12,7 @@ systole starts ``ECG_LAG`` of a period after it.
 
 Usage::
 
-    heart = Heart.of(fidelity.breathing, rng)  # None: no heart
+    heart = Heart.of(fidelity.breathing, phase, rng)  # None: no heart
     heart.lift(2.5), heart.r_wave(2.5)         # m toward the sensor; the sync pulse is on
 """
 
