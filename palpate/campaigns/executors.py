@@ -10,7 +10,11 @@
   optional extra (``pip install 'palpate[dask]'``), imported only when asked for.
 
 Local pool workers die with the process that started them (:func:`process_pool`): a campaign
-killed with SIGKILL leaves no worker behind waiting forever on its pipe.
+killed with SIGKILL leaves no worker behind waiting forever on its pipe. Each runs its linear
+algebra on one thread: a pool already puts one worker on each core, and a BLAS that spreads
+each worker's small products over every core as well spends them waiting on each other (a map
+study's compute per probe: 0.05 s median and 0.24 worst with two workers of two threads each on
+two cores, 0.012 and 0.018 with one thread each; docs/speed.md).
 
 No scheduling of our own: every backend is an Executor, ``palpate.campaigns.campaign.run_campaign``
 submits one job per trial and each trial is seeded by its spec, so results do not depend on
@@ -31,12 +35,21 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
 from typing import Any, TypeVar
 
+from threadpoolctl import threadpool_limits
+
 from palpate.config.loader import InputError
 
 T = TypeVar("T")
 
 _PR_SET_PDEATHSIG = 1  # linux/prctl.h
 _WATCH_PERIOD_S = 0.5
+
+
+def pool_worker(parent: int) -> None:
+    """Pool worker initializer: die with process ``parent`` (:func:`die_with_parent`) and keep
+    BLAS to this worker's core (one thread)."""
+    threadpool_limits(1)
+    die_with_parent(parent)
 
 
 def die_with_parent(parent: int) -> None:
@@ -59,9 +72,10 @@ def _watch_parent(parent: int) -> None:
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A local process pool whose workers die with this process (:func:`die_with_parent`)."""
+    """A local process pool whose workers die with this process and run BLAS on one thread
+    each (:func:`pool_worker`)."""
     return ProcessPoolExecutor(
-        max_workers=workers, initializer=die_with_parent, initargs=(os.getpid(),)
+        max_workers=workers, initializer=pool_worker, initargs=(os.getpid(),)
     )
 
 

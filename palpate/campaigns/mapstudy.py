@@ -27,6 +27,7 @@ from palpate.config.sample import InclusionConfig, SampleConfig
 from palpate.config.scene import SceneConfig
 from palpate.config.schema import StackConfig
 
+from .executors import process_pool
 from .survey import run_survey
 
 Plan = tuple[str, int]  # (strategy, probe budget)
@@ -163,7 +164,7 @@ def run_map_study(
         jobs += [(active, k, True) for k in range(worlds)]
     ways: Sequence[Literal["stage", "robot"] | None] = tuple(throughs) or (None,)
     rows: list[dict[str, Any]] = []
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+    with process_pool(max(1, workers)) as pool:
         futures = [
             pool.submit(survey_row, scene, stack, plan, k, seed, plain, whole, way)
             for way in ways

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from palpate.maps import (
     MapError,
@@ -278,7 +279,8 @@ def run_plan(
     stopped = ""
     while True:
         t0 = time.process_time()
-        point = plan.next(probes)
+        with threadpool_limits(1):  # tens of probes: more BLAS threads only wait on each other
+            point = plan.next(probes)
         map_seconds += time.process_time() - t0
         if point is None:
             break
@@ -299,7 +301,8 @@ def run_plan(
             break
     stopped = stopped or getattr(plan, "stopped", "") or f"{len(probes)} of {survey.budget} probes"
     t0 = time.process_time()
-    summary, note = map_of(probes, patch, survey.threshold, survey.seed, scale)
+    with threadpool_limits(1):
+        summary, note = map_of(probes, patch, survey.threshold, survey.seed, scale)
     map_seconds += time.process_time() - t0
     lab = sum(p.lab_time for p in probes)
     return SurveyResult(

@@ -20,6 +20,7 @@ from palpate.robot.records.log import read_log
 
 
 @pytest.mark.slow
+@pytest.mark.alone  # its own load of two cores, not a third worker's tests beside it
 def test_the_rehearsal_completes_with_a_joint_fit_beside_a_cpu_load(tmp_path: Path) -> None:
     with cpu_load(busy=2):
         session = rehearse(tmp_path)

@@ -26,6 +26,8 @@ from palpate.api import load_scene, read_log, read_recording, simulate_trial
 from palpate.ros.jog import COMMAND_TIMEOUT_S
 from palpate.ros.names import PARAMETERS, SERVICES, SUBSCRIPTIONS, TOPICS
 
+# under pytest -n, one worker runs these in turn: two nodes at once could draw one DDS domain
+pytestmark = pytest.mark.xdist_group("ros")
 CLIENT = Path(__file__).with_name("client.py")
 STILL_S = 1.0  # s of the node's clock the client waits for the robot to stand still (client.py)
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "ros2.md"
