@@ -30,6 +30,9 @@ from palpate.simulation.trial import TrialOutcome, TrialSpec
 
 UNITS: dict[str, float] = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6}
 
+DEFAULT_TOLERANCE = 0.20
+"""The largest |relative error| of the joint fit on a phantom for the design to be usable."""
+
 METHODS = ("paper", "joint")
 """The estimates shown: the paper's single point (Eqs. 13-14) and the contact-point-free fit."""
 
@@ -48,13 +51,18 @@ class CheckSettings:
 
 
 def campaign_lengths(length: float, window: tuple[float, float], count: int) -> tuple[float, ...]:
-    """``count`` exposed lengths (m) around the proposed one, in the middle of the window where
-    the hardware passes every check (geometric means of each end with the proposal); one when
-    the window is the proposal alone (a design on its checks' edge)."""
+    """The exposed lengths (m) the check simulates: the proposed ``length``, the two ends of the
+    ``window`` where the hardware passes every check, and ``count - 3`` more between the ends
+    (geometric); the proposal alone when ``count`` is 1 or the window is the proposal alone
+    (a design on its checks' edge). A window is tested at its ends, not asserted.
+
+    >>> [round(v * 1e3, 1) for v in campaign_lengths(0.045, (0.031, 0.0925), 3)]
+    [31.0, 45.0, 92.5]
+    """
     if count <= 1 or window[0] == window[1]:
         return (length,)
-    lo, hi = math.sqrt(window[0] * length), math.sqrt(window[1] * length)
-    return tuple(float(v) for v in np.linspace(lo, hi, count))
+    between = np.geomspace(window[0], window[1], max(count - 1, 2))
+    return tuple(sorted({float(v) for v in (*between, length)}))
 
 
 def design_scene(
@@ -181,6 +189,118 @@ def run_check(
     return outcomes, time.perf_counter() - t0
 
 
+NARROWING_STEPS = 3
+"""Bisections (in log length) towards each end of the window whose trials fail: each runs the
+phantoms at one more length, and leaves the window's edge within (ratio)^(1/8) of the truth."""
+
+
+MIDDLE_TOLERANCE = 0.05
+"""A length tried within 5 % of the window's geometric middle stands for the middle."""
+
+
+@dataclass(frozen=True)
+class SimulatedWindow:
+    """The exposed lengths whose simulated trials all pass, about the proposal.
+
+    Attributes:
+        lengths: (min, max) in m, contiguous about the proposed length; None when the
+            proposal's own trials fail.
+        failed: each length tried whose trials did not all pass, with what failed there.
+    """
+
+    lengths: tuple[float, float] | None
+    failed: tuple[tuple[float, str], ...]
+
+    @property
+    def middle(self) -> float | None:
+        """The window's geometric middle (m): the length to use."""
+        return None if self.lengths is None else math.sqrt(self.lengths[0] * self.lengths[1])
+
+    def holds(self, length: float) -> bool:
+        lo, hi = self.lengths or (math.inf, -math.inf)
+        return lo - 1e-9 <= length <= hi + 1e-9
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "simulated_window_mm": None
+            if self.lengths is None
+            else [round(v * 1e3, 2) for v in self.lengths],
+            "failed_at": [{"length_mm": round(v * 1e3, 2), "why": why} for v, why in self.failed],
+        }
+
+
+def narrowed_window(
+    length: float,
+    outcomes: list[TrialOutcome],
+    run_at: Callable[[float], list[TrialOutcome]],
+    tolerance: float = DEFAULT_TOLERANCE,
+    steps: int = NARROWING_STEPS,
+) -> tuple[list[TrialOutcome], SimulatedWindow]:
+    """The window of lengths whose trials pass (:func:`length_failures`), found from the
+    check's ``outcomes`` at the proposal and the window's ends, narrowed towards each end that
+    fails by bisection: ``run_at(L)`` simulates the phantoms at L; then its middle, when no
+    length tried stands for it. Returns every outcome (the new ones appended) and the window
+    (none when the proposal's or the middle's trials fail)."""
+    outcomes = list(outcomes)
+    why = {v: length_failures(os, tolerance) for v, os in by_length(outcomes).items()}
+    proposal = min(why, key=lambda v: abs(v - length))
+    if why[proposal]:
+        return outcomes, SimulatedWindow(None, tuple((v, w) for v, w in sorted(why.items()) if w))
+    ends = []
+    for side in (-1.0, 1.0):
+        good, bad = proposal, None
+        for v in sorted((v for v in why if side * (v - proposal) > 0), key=lambda v: side * v):
+            if why[v]:  # outward from the proposal, the first length that fails
+                bad = v
+                break
+            good = v
+        for _ in range(steps):
+            if bad is None:
+                break
+            new = run_at(math.sqrt(good * bad))
+            tried = new[0].spec.exposed_length if new else good
+            if tried in why or not new:  # the lengths' rounding met a length already tried
+                break
+            outcomes += new
+            why[tried] = length_failures(new, tolerance)
+            good, bad = (good, tried) if why[tried] else (tried, bad)
+        ends.append(good)
+    middle = math.sqrt(ends[0] * ends[1])
+    if min(abs(math.log(v / middle)) for v in why) > MIDDLE_TOLERANCE:
+        new = run_at(middle)
+        if new:
+            middle = new[0].spec.exposed_length
+            outcomes += new
+            why[middle] = length_failures(new, tolerance)
+    failed = tuple((v, w) for v, w in sorted(why.items()) if w)
+    if why.get(middle):  # the window's middle fails where its ends pass: no window
+        return outcomes, SimulatedWindow(None, failed)
+    return outcomes, SimulatedWindow((ends[0], ends[1]), failed)
+
+
+def by_length(outcomes: list[TrialOutcome]) -> dict[float, list[TrialOutcome]]:
+    """The outcomes grouped by their exposed length (m)."""
+    groups: dict[float, list[TrialOutcome]] = {}
+    for o in outcomes:
+        groups.setdefault(o.spec.exposed_length, []).append(o)
+    return groups
+
+
+def length_failures(outcomes: list[TrialOutcome], tolerance: float = DEFAULT_TOLERANCE) -> str:
+    """What fails among one length's trials ("" when every phantom ends done with an estimate
+    within ``tolerance``): each failing phantom with its error, no estimate or ending."""
+    bad = []
+    for o in outcomes:
+        e = relative_error(o, "joint")
+        if o.state != "done":
+            bad.append(f"{o.spec.sample} {o.state}")
+        elif e is None:
+            bad.append(f"{o.spec.sample} no estimate")
+        elif abs(e) > tolerance:
+            bad.append(f"{o.spec.sample} {100 * e:+.0f} %")
+    return ", ".join(bad)
+
+
 def relative_error(o: TrialOutcome, method: str) -> float | None:
     """(estimate - truth) / truth of one trial; None when it has no estimate."""
     m = o.modulus(method)
@@ -194,10 +314,6 @@ def error_summary(outcomes: list[TrialOutcome], method: str) -> dict[str, float 
         "median_abs_relative_error": median_abs_relative_error(outcomes, method),
         "max_abs_relative_error": max(errors, default=None),
     }
-
-
-DEFAULT_TOLERANCE = 0.20
-"""The largest |relative error| of the joint fit on a phantom for the design to be usable."""
 
 
 @dataclass(frozen=True)
@@ -236,10 +352,14 @@ def design_verdict(
     sag_ok: bool | None,
     sag_text: str = "",
     tolerance: float = DEFAULT_TOLERANCE,
+    window: SimulatedWindow | None = None,
+    allowed: tuple[float, float] | None = None,
 ) -> DesignVerdict:
     """The verdict on a proposal (``found``: the search found one) from its simulated check's
     ``outcomes`` (None: skipped), its weight check (``sag_ok``, None without one; ``sag_text``
-    says by how much) and the ``tolerance`` on the joint fit's |relative error|."""
+    says by how much) and the ``tolerance`` on the joint fit's |relative error|. With the
+    ``window`` of lengths whose trials pass, narrower than the ``allowed`` one its checks
+    give, only the trials within it are judged and the design is usable only there."""
     if not found:
         return DesignVerdict(False, ("no design satisfies the constraints",))
     conditions: tuple[str, ...] = ()
@@ -249,6 +369,13 @@ def design_verdict(
         )
     if outcomes is None:
         return DesignVerdict(None, ("simulated check skipped",), conditions)
+    if window is not None and window.lengths is not None and window.failed:
+        lo, hi = window.lengths
+        checks = "" if allowed is None else f" (its checks allow {allowed[0] * 1e3:.1f}-"
+        checks += "" if allowed is None else f"{allowed[1] * 1e3:.1f} mm)"
+        middle = f", {math.sqrt(lo * hi) * 1e3:.1f} mm the middle"
+        conditions += (f"at exposed lengths {lo * 1e3:.1f}-{hi * 1e3:.1f} mm{middle}{checks}",)
+        outcomes = [o for o in outcomes if window.holds(o.spec.exposed_length)]
     faulted = [o.spec.sample for o in outcomes if o.state != "done"]
     missing = [o.spec.sample for o in outcomes if o.modulus("joint") is None]
     wrong = [

@@ -100,7 +100,9 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     _option(parser, "--scene", "scene YAML whose fidelity and campaign settings the check uses",
             type=Path)  # fmt: skip
     _option(parser, "--moduli", "phantoms across the range")
-    _option(parser, "--lengths", "exposed lengths per phantom")
+    _option(parser, "--lengths", "exposed lengths per phantom: the window's two ends and the "
+            "proposal, more between them; a window whose ends fail is narrowed by bisection and "
+            "its middle simulated (1: the proposal only)")  # fmt: skip
     _option(parser, "--contact-uncertainty-mm", "contact-detection error (1 sigma) in the check")
     _option(parser, "--seed", "makes the simulated check reproducible")
     _option(

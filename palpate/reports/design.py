@@ -7,7 +7,13 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from palpate.campaigns.designcheck import METHODS, UNITS, error_summary, relative_error
+from palpate.campaigns.designcheck import (
+    METHODS,
+    UNITS,
+    SimulatedWindow,
+    error_summary,
+    relative_error,
+)
 from palpate.sensor_design import DesignConstraints, DesignEvaluation, DesignResult
 from palpate.simulation.trial import TrialOutcome
 
@@ -15,12 +21,13 @@ from palpate.simulation.trial import TrialOutcome
 @dataclass(frozen=True)
 class CheckRun:
     """The simulated check as run: its trials (none when skipped), wall time, the unit the
-    moduli are shown in and the executor named."""
+    moduli are shown in, the executor named and the lengths whose trials pass."""
 
     outcomes: list[TrialOutcome]
     wall: float
     unit: str
     executor: str
+    window: SimulatedWindow | None = None
 
 
 def design_dict(result: DesignResult, unit_name: str) -> dict[str, Any] | None:
@@ -88,6 +95,7 @@ def payload(
                 for o in outcomes
             ],
             **{m: error_summary(outcomes, m) for m in METHODS},
+            **({} if run.window is None else run.window.as_dict()),
             "wall_s": run.wall,
         },
     }
@@ -174,3 +182,16 @@ def _print_campaign(run: CheckRun) -> None:
         if mare is not None and worst is not None:
             print(f"  {m}: median |relative error| {100 * mare:.1f} %, worst {100 * worst:.1f} %")
     print(f"  {len(outcomes)} trials in {run.wall:.1f} s wall; moduli in {run.unit}")
+    if run.window is not None:
+        print(f"  {window_text(run.window)}")
+
+
+def window_text(window: SimulatedWindow) -> str:
+    """The lengths whose simulated trials pass, and what failed at the others."""
+    failed = "; ".join(f"at {v * 1e3:.1f} mm {why}" for v, why in window.failed)
+    if window.lengths is None:
+        return f"no length passes: {failed}"
+    lo, hi = window.lengths
+    return f"every phantom within tolerance at {lo * 1e3:.1f}-{hi * 1e3:.1f} mm" + (
+        f" (beyond it: {failed})" if failed else ""
+    )

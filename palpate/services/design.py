@@ -18,9 +18,11 @@ from palpate.campaigns.designcheck import (
     UNITS,
     CheckSettings,
     DesignVerdict,
+    SimulatedWindow,
     design_scene,
     design_verdict,
     designed_stack,
+    narrowed_window,
     run_check,
 )
 from palpate.config import load, load_stack, resolve
@@ -173,6 +175,34 @@ def _run_sim(
     return outcomes, wall
 
 
+def _window_check(
+    scene: SceneConfig, stack: StackConfig, req: DesignRequest, length: float
+) -> tuple[list[TrialOutcome], float, SimulatedWindow]:
+    """The check at the proposed ``length`` and the window's ends, narrowed where an end fails
+    (:func:`palpate.campaigns.designcheck.narrowed_window`): every trial, the wall time, the
+    lengths whose trials pass."""
+    outcomes, wall = _run_sim(scene, stack, req)
+    walls = [wall]
+
+    def run_at(at: float) -> list[TrialOutcome]:
+        campaign = replace(scene.campaign, exposed_lengths_mm=(round(at * 1e3, 1),))
+        more, w = _run_sim(replace(scene, campaign=campaign), stack, req)
+        walls.append(w)
+        return more
+
+    outcomes, window = narrowed_window(length, outcomes, run_at, req.tolerance_pct / 100)
+    return outcomes, sum(walls), window
+
+
+def _to_write(stack: StackConfig, window: SimulatedWindow | None) -> StackConfig:
+    """The configuration to write: at the middle of the lengths whose simulated trials pass,
+    where they are narrower than its checks allow."""
+    if window is None or window.middle is None or not window.failed:
+        return stack
+    sensor = replace(stack.sensor, exposed_length_mm=round(window.middle * 1e3, 1))
+    return replace(stack, sensor=sensor)
+
+
 def _written_note(req: DesignRequest) -> str:
     tip = " --tip-grating" if req.tip_grating else ""
     if req.lumen_mm is not None:
@@ -271,6 +301,7 @@ def _evaluated(req: DesignRequest) -> DesignOutcome:
     result, lumen = search(req, modulus_range, constraints, space)
     outcomes: list[TrialOutcome] = []
     wall = 0.0
+    window: SimulatedWindow | None = None
     tip: TipGratingChoice | None = None
     weight: WeightCheck | None = None
     if result.success:
@@ -287,16 +318,19 @@ def _evaluated(req: DesignRequest) -> DesignOutcome:
             s.fiber_radius, s.fiber_modulus, s.wire_radius, s.wire_modulus, s.wire_count
         )
         weight = weight_check(s.tip_mass, s.linear_mass, section.EI, s.exposed_length)
-        if req.write is not None:
-            write_yaml(sim_stack, req.write, _written_note(req))
         if not req.no_sim:
-            outcomes, wall = _run_sim(scene, sim_stack, req)
+            length = result.evaluation.design.exposed_length
+            outcomes, wall, window = _window_check(scene, sim_stack, req, length)
+        if req.write is not None:
+            write_yaml(_to_write(sim_stack, window), req.write, _written_note(req))
     verdict = design_verdict(
         result.success,
         None if req.no_sim else outcomes,
         None if weight is None else weight.ok,
         "" if weight is None else sag_text(weight),
         req.tolerance_pct / 100,
+        window,
+        result.length_window,
     )
-    check = CheckRun(outcomes, wall, req.unit, req.executor)
+    check = CheckRun(outcomes, wall, req.unit, req.executor, window)
     return DesignOutcome(result, constraints, check, tip, weight, verdict, lumen)

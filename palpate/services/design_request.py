@@ -89,7 +89,7 @@ class DesignRequest:
     config: str = "robot.yaml"
     scene: Path | None = None
     moduli: int = 4
-    lengths: int = 2
+    lengths: int = 3
     contact_uncertainty_mm: float = 0.0
     seed: int = 0
     workers: int = field(default_factory=default_workers)

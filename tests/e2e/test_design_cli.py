@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -155,13 +156,63 @@ def test_a_channel_nothing_passes_is_bad_input(capsys: pytest.CaptureFixture[str
     assert "--clearance-mm" in capsys.readouterr().err
 
 
-def test_a_design_on_its_checks_edge_is_checked_at_its_one_length() -> None:
+def test_a_window_is_checked_at_its_ends_and_the_proposal() -> None:
     from palpate.campaigns.designcheck import campaign_lengths
 
-    assert campaign_lengths(0.1, (0.1, 0.1), 2) == (0.1,)  # no window: not the same trial twice
-    lengths = campaign_lengths(0.05, (0.04, 0.07), 2)
-    assert len(lengths) == 2
-    assert 0.04 < lengths[0] < 0.05 < lengths[1] < 0.07
+    assert campaign_lengths(0.1, (0.1, 0.1), 3) == (0.1,)  # no window: not the same trial twice
+    assert campaign_lengths(0.05, (0.04, 0.07), 3) == (0.04, 0.05, 0.07)
+    lengths = campaign_lengths(0.05, (0.04, 0.07), 4)
+    assert lengths[:2] == (0.04, 0.05)
+    assert 0.05 < lengths[2] < 0.07
+
+
+def _phantom_trials(length: float, error: Callable[[float], float]) -> list[object]:
+    """Two phantoms' outcomes at ``length``, each reading ``error(length)`` off."""
+    from types import SimpleNamespace
+
+    def trial(sample: str, truth: float) -> object:
+        spec = SimpleNamespace(sample=sample, modulus=truth, exposed_length=round(length, 4))
+        joint = truth * (1 + error(length))
+        return SimpleNamespace(spec=spec, state="done", modulus=lambda method: joint)
+
+    return [trial("E1", 1e3), trial("E10", 1e4)]
+
+
+def test_the_window_narrows_to_the_lengths_whose_trials_pass() -> None:
+    """Trials that fail past 55 mm: the window found by bisection ends between the last length
+    that passes and 55 mm, its middle simulated; a middle that fails leaves no window."""
+    from palpate.campaigns.designcheck import campaign_lengths, narrowed_window
+
+    def past_55(length: float) -> float:
+        return 0.4 if length > 0.055 else 0.05
+
+    tried: list[float] = []
+
+    def run_at(length: float) -> list[object]:
+        tried.append(length)
+        return _phantom_trials(length, past_55)
+
+    first = [t for v in campaign_lengths(0.045, (0.031, 0.0925), 3) for t in run_at(v)]
+    outcomes, window = narrowed_window(0.045, first, run_at)  # type: ignore[arg-type]
+    assert window.lengths is not None
+    lo, hi = window.lengths
+    assert lo == 0.031
+    assert 0.050 < hi <= 0.055
+    assert [v for v, _ in window.failed][-1] == 0.0925
+    assert len(tried) == 3 + 3 + 1  # the first three, three bisections, the middle
+    assert len(outcomes) == 2 * len(tried)
+    assert window.middle == pytest.approx((lo * hi) ** 0.5)
+
+    def only_ends(length: float) -> float:
+        return 0.05 if length in (0.031, 0.045) else 0.4
+
+    first = [t for v in (0.031, 0.045) for t in _phantom_trials(v, only_ends)]
+    _, window = narrowed_window(
+        0.045,
+        first,  # type: ignore[arg-type]
+        lambda v: _phantom_trials(v, only_ends),  # type: ignore[arg-type,return-value]
+    )
+    assert window.lengths is None  # the middle, 37.3 mm, fails
 
 
 def test_a_sagging_sensor_with_a_tip_grating_is_pointed_to_the_load_plateau(
