@@ -16,6 +16,7 @@ from palpate.campaigns.executors import (
     ExecutorUnavailableError,
     SerialExecutor,
     open_executor,
+    process_pool,
 )
 from palpate.cli import main
 from palpate.config import load, load_stack, resolve
@@ -145,3 +146,19 @@ def test_palpate_sim_takes_the_executor_flag(
     assert all(t["state"] == "done" for t in out["trials"])
     assert main([*argv, "--out", str(tmp_path), "--scheduler", "tcp://127.0.0.1:1"]) == 2
     assert "--scheduler is for --executor dask" in capsys.readouterr().err
+
+
+def _blas_threads() -> list[int]:
+    import scipy.linalg  # noqa: F401  (scipy's own OpenBLAS too, as the map's GP loads it)
+    from threadpoolctl import threadpool_info
+
+    return [int(lib["num_threads"]) for lib in threadpool_info() if lib["user_api"] == "blas"]
+
+
+def test_a_pool_worker_runs_blas_on_one_thread() -> None:
+    """Two workers on two cores, each spreading its products over both, wait on each other
+    (docs/speed.md, "One BLAS thread a worker"): a pool's worker keeps BLAS to its core."""
+    with process_pool(2) as pool:
+        threads = pool.submit(_blas_threads).result()
+    assert threads
+    assert set(threads) == {1}
