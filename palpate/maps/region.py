@@ -25,19 +25,17 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage  # type: ignore[import-untyped,unused-ignore]
 from scipy.special import ndtr  # type: ignore[import-untyped,unused-ignore]
 
+from .depth import DepthReading
 from .extent import Extent, ExtentError, fit_extent
 from .gp import LENGTH_SCALE_MAX, MIN_PROBES, MM, MapError, Patch, StiffnessMap
 from .probes import Z95, Probe
-
-if TYPE_CHECKING:
-    from .inclusions import Inclusion
 
 FloatArray = NDArray[np.float64]
 MIN_RISE = 0.10  # the smallest rise above the background a threshold from the data takes
@@ -45,6 +43,46 @@ FOUND_PROBABILITY = 0.95
 GRID = 41  # points a side of the summary's grid
 DRAW_GRID = 25  # points a side of the posterior draws' grid
 DRAWS = 200
+Interval = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Inclusion:
+    """One region the map reads as an inclusion (m, Pa).
+
+    Attributes:
+        kind: ``"stiff"`` or ``"soft"``.
+        centre, centre_ci: its centre and the 95 % intervals of x and y.
+        radius, radius_ci: its radius and 95 % interval.
+        extreme: the map's highest (stiff) or lowest (soft) modulus in it.
+        probability: how sure the map is that its most certain point is past the level.
+        depth: its sphere read from the probes about it (depth, radius, contrast), None if
+            too few probes are near it.
+    """
+
+    kind: str
+    centre: tuple[float, float]
+    centre_ci: tuple[Interval, Interval]
+    radius: float
+    radius_ci: Interval
+    extreme: float
+    probability: float
+    depth: DepthReading | None = None
+
+    def as_dict(self) -> dict[str, object]:
+        sphere = self.depth.as_dict() if self.depth is not None else {}
+        return {
+            "kind": self.kind,
+            "center_mm": [self.centre[0] / MM, self.centre[1] / MM],
+            "center_ci_mm": [[v / MM for v in axis] for axis in self.centre_ci],
+            "radius_mm": self.radius / MM,
+            "radius_ci_mm": [v / MM for v in self.radius_ci],
+            "depth_mm": None,
+            "depth_ci_mm": None,
+            "extreme_kpa": self.extreme / 1e3,
+            "probability": self.probability,
+            **sphere,
+        }
 
 
 @dataclass(frozen=True)

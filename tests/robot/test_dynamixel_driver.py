@@ -248,12 +248,12 @@ def test_an_adapter_unplugged_and_replugged_is_reopened(
     with DynamixelBus.from_config(CFG, port=str(link)) as bus:
         bus.recovery.backoff = Backoff(0.0, 0.0)  # every attempt may reopen: no wall-time back-off
         bus.set_torque(True)
-        emulator.close()  # unplugged
+        emulator.close()  # unplugged: the device goes, and its name with it (udev), so that
+        link.unlink()  # a pty another process opens meanwhile at the same number is not it
         for _ in range(2):  # lost, then reopening fails while the device is away
             with pytest.raises(ServoTransportError, match="lost"):
                 bus.read_state()
         assert (bus.port_errors, bus.reopens) == (1, 0)
-        link.unlink()
         link.symlink_to(emulator.open())  # plugged in again
         assert set(bus.read_state()) == set(NAMES)
         assert (bus.port_errors, bus.reopens) == (1, 1)

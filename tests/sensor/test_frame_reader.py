@@ -143,6 +143,7 @@ def test_a_pty_closed_under_the_reader_then_replugged(tmp_path: Path) -> None:
     _send(master, range(3, 6))  # sent, never read: lost with the hang-up
     os.close(master)
     os.close(slave)
+    link.unlink()  # the device's name goes with it: a pty opened meanwhile at its number is not it
     for _ in range(20):  # EIO / EOF, then failed reopenings while unplugged: never raises
         assert reader.poll() == []
         clock.advance(0.01)
