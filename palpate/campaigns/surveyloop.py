@@ -33,9 +33,9 @@ from palpate.maps import (
     summarise,
 )
 from palpate.maps.gp import LENGTH_SCALE_MAX
-from palpate.maps.inclusions import Inclusion, find_inclusions
+from palpate.maps.inclusions import find_inclusions
 from palpate.maps.probes import normal_scores
-from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, grid_frame, probe_frame
+from palpate.maps.region import GRID_FIELDS, PROBE_FIELDS, Inclusion, grid_frame, probe_frame
 from palpate.robot.records.ros2 import nanoseconds
 
 if TYPE_CHECKING:

@@ -15,8 +15,8 @@ from typing import Any
 
 from palpate.campaigns.surveyloop import SurveyResult
 from palpate.maps import MapSummary
-from palpate.maps.inclusions import Inclusion
 from palpate.maps.probes import NORMAL_TOLERANCE, normal_scores
+from palpate.maps.region import Inclusion
 
 
 def write_map_results(
