@@ -94,6 +94,7 @@ class RemoteJog:
         self.robot, self.view, self.busy = robot, view, busy
         self.pad = JoyMapping()
         self.lock = threading.Lock()
+        self.starting = threading.Lock()  # one caller at a time decides to open a session
         self.commands = _Commands()
         self.closing = threading.Event()
         self.thread: threading.Thread | None = None
@@ -146,14 +147,17 @@ class RemoteJog:
         with self.lock:
             self.commands.keys.extend(keys)
             self.commands.last = time.monotonic()
-        if self.active or self.closing.is_set():
-            return True
-        if not self.busy.acquire(blocking=False):
-            log.warning("palpate ros: a trial or survey holds the robot; the jog is ignored")
-            self._take()
-            return False
-        self.thread = threading.Thread(target=self._session, name="palpate-ros-jog")
-        self.thread.start()
+        # callbacks run on several threads: two that both saw no session would both try to
+        # open one, and the loser would drop the winner's commands as "busy"
+        with self.starting:
+            if self.active or self.closing.is_set():
+                return True
+            if not self.busy.acquire(blocking=False):
+                log.warning("palpate ros: a trial or survey holds the robot; the jog is ignored")
+                self._take()
+                return False
+            self.thread = threading.Thread(target=self._session, name="palpate-ros-jog")
+            self.thread.start()
         return True
 
     def _take(self) -> _Commands:
