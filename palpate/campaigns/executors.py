@@ -10,9 +10,10 @@
   optional extra (``pip install 'palpate[dask]'``), imported only when asked for.
 
 Local pool workers die with the process that started them (:func:`process_pool`): a campaign
-killed with SIGKILL leaves no worker behind waiting forever on its pipe. Each runs its linear
-algebra on one thread: a pool already puts one worker on each core, and a BLAS that spreads
-each worker's small products over every core as well spends them waiting on each other (a map
+killed with SIGKILL leaves no worker behind waiting forever on its pipe. The workers share the
+cores' BLAS threads out (one each when there are as many workers as cores): a pool already puts
+one worker on each core, and a BLAS that spreads each worker's small products over every core as
+well spends them waiting on each other (a map
 study's compute per probe: 0.05 s median and 0.24 worst with two workers of two threads each on
 two cores, 0.012 and 0.018 with one thread each; docs/speed.md).
 
@@ -45,11 +46,18 @@ _PR_SET_PDEATHSIG = 1  # linux/prctl.h
 _WATCH_PERIOD_S = 0.5
 
 
-def pool_worker(parent: int) -> None:
+def pool_worker(parent: int, blas_threads: int = 1) -> None:
     """Pool worker initializer: die with process ``parent`` (:func:`die_with_parent`) and keep
-    BLAS to this worker's core (one thread)."""
-    threadpool_limits(1)
+    BLAS to this worker's share of the cores (``blas_threads``)."""
+    threadpool_limits(blas_threads)
     die_with_parent(parent)
+
+
+def blas_share(workers: int) -> int:
+    """BLAS threads for each of ``workers`` pool workers: the cores shared out, at least one
+    (two workers on two cores: one each; one worker alone, a new 3-D geometry's factorisation
+    for instance, keeps every core)."""
+    return max(1, (os.cpu_count() or 1) // max(1, workers))
 
 
 def die_with_parent(parent: int) -> None:
@@ -72,10 +80,10 @@ def _watch_parent(parent: int) -> None:
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A local process pool whose workers die with this process and run BLAS on one thread
-    each (:func:`pool_worker`)."""
+    """A local process pool whose workers die with this process and share the cores' BLAS
+    threads out among them (:func:`pool_worker`, :func:`blas_share`)."""
     return ProcessPoolExecutor(
-        max_workers=workers, initializer=pool_worker, initargs=(os.getpid(),)
+        max_workers=workers, initializer=pool_worker, initargs=(os.getpid(), blas_share(workers))
     )
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import sys
 from concurrent.futures import Executor
 from pathlib import Path
@@ -15,6 +16,7 @@ from palpate.campaigns.executors import (
     EXECUTORS,
     ExecutorUnavailableError,
     SerialExecutor,
+    blas_share,
     open_executor,
     process_pool,
 )
@@ -155,10 +157,13 @@ def _blas_threads() -> list[int]:
     return [int(lib["num_threads"]) for lib in threadpool_info() if lib["user_api"] == "blas"]
 
 
-def test_a_pool_worker_runs_blas_on_one_thread() -> None:
+def test_a_pool_worker_runs_blas_on_its_share_of_the_cores() -> None:
     """Two workers on two cores, each spreading its products over both, wait on each other
-    (docs/speed.md, "One BLAS thread a worker"): a pool's worker keeps BLAS to its core."""
-    with process_pool(2) as pool:
+    (docs/speed.md, "One BLAS thread a worker"): a pool's worker keeps BLAS to its share."""
+    cores = os.cpu_count() or 1
+    with process_pool(cores) as pool:
         threads = pool.submit(_blas_threads).result()
     assert threads
     assert set(threads) == {1}
+    assert blas_share(2) == max(1, cores // 2)
+    assert blas_share(1) == cores
