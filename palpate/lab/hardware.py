@@ -115,6 +115,25 @@ def _name(port: str | Any) -> str:
     return str(getter() if callable(getter) else getattr(port, "name", port))
 
 
+START_ATTEMPTS = 3
+"""Times the servos' start (ping, profiles, present pose, torque) is tried before the bus is
+called silent: each write already has ``servos.retries``, but a host busy beside the bus can
+leave a USB adapter's (or the emulator's) answers unread for longer than those take (80 ms at
+the default 20 ms timeout); the rehearsal beside two spinning cores once failed so at open."""
+
+
+def _start(drive: DriveController) -> None:
+    """``drive.start()``, tried :data:`START_ATTEMPTS` times (it is repeatable: it homes at the
+    present pose) before its last transport error is raised."""
+    for attempt in range(START_ATTEMPTS):
+        try:
+            drive.start()
+            return
+        except ServoTransportError:
+            if attempt == START_ATTEMPTS - 1:
+                raise
+
+
 @contextlib.contextmanager
 def open_hardware(
     stack: StackConfig,
@@ -147,7 +166,7 @@ def open_hardware(
         drive = DriveController(bus, stack.drive)
         stage = None if stack.stage is None else StageController(bus, stack.stage)
         try:
-            drive.start()
+            _start(drive)
             if stage is not None:
                 stage.start()
         except ServoTransportError as exc:
