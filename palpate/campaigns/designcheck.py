@@ -258,9 +258,9 @@ def narrowed_window(
             if bad is None:
                 break
             new = run_at(math.sqrt(good * bad))
-            tried = new[0].spec.exposed_length if new else good
-            if tried in why or not new:  # the lengths' rounding met a length already tried
+            if not new or new[0].spec.exposed_length in why:  # rounding met a length tried
                 break
+            tried = new[0].spec.exposed_length
             outcomes += new
             why[tried] = length_failures(new, tolerance)
             good, bad = (good, tried) if why[tried] else (tried, bad)
@@ -287,18 +287,9 @@ def by_length(outcomes: list[TrialOutcome]) -> dict[float, list[TrialOutcome]]:
 
 
 def length_failures(outcomes: list[TrialOutcome], tolerance: float = DEFAULT_TOLERANCE) -> str:
-    """What fails among one length's trials ("" when every phantom ends done with an estimate
-    within ``tolerance``): each failing phantom with its error, no estimate or ending."""
-    bad = []
-    for o in outcomes:
-        e = relative_error(o, "joint")
-        if o.state != "done":
-            bad.append(f"{o.spec.sample} {o.state}")
-        elif e is None:
-            bad.append(f"{o.spec.sample} no estimate")
-        elif abs(e) > tolerance:
-            bad.append(f"{o.spec.sample} {100 * e:+.0f} %")
-    return ", ".join(bad)
+    """What fails among one length's trials, as the verdict names it ("" when they pass: every
+    phantom done, with an estimate within ``tolerance``; :func:`design_verdict`)."""
+    return "; ".join(design_verdict(True, outcomes, None, tolerance=tolerance).reasons)
 
 
 def relative_error(o: TrialOutcome, method: str) -> float | None:
@@ -370,11 +361,16 @@ def design_verdict(
     if outcomes is None:
         return DesignVerdict(None, ("simulated check skipped",), conditions)
     if window is not None and window.lengths is not None and window.failed:
-        lo, hi = window.lengths
-        checks = "" if allowed is None else f" (its checks allow {allowed[0] * 1e3:.1f}-"
-        checks += "" if allowed is None else f"{allowed[1] * 1e3:.1f} mm)"
-        middle = f", {math.sqrt(lo * hi) * 1e3:.1f} mm the middle"
-        conditions += (f"at exposed lengths {lo * 1e3:.1f}-{hi * 1e3:.1f} mm{middle}{checks}",)
+        (lo, hi), middle = window.lengths, window.middle or 0.0
+        checks = (
+            ""
+            if allowed is None
+            else f" (its checks allow {allowed[0] * 1e3:.1f}-{allowed[1] * 1e3:.1f} mm)"
+        )
+        conditions += (
+            f"at exposed lengths {lo * 1e3:.1f}-{hi * 1e3:.1f} mm, {middle * 1e3:.1f} mm the "
+            f"middle{checks}",
+        )
         outcomes = [o for o in outcomes if window.holds(o.spec.exposed_length)]
     faulted = [o.spec.sample for o in outcomes if o.state != "done"]
     missing = [o.spec.sample for o in outcomes if o.modulus("joint") is None]
