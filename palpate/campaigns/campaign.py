@@ -16,6 +16,8 @@ import numpy as np
 
 from palpate.calibration import calibrated, is_reference
 from palpate.campaigns.executors import SerialExecutor, process_pool
+from palpate.campaigns.resume import logged_outcome
+from palpate.campaigns.shorter import buckled_unread, retries
 from palpate.config.loader import InputError
 from palpate.config.optics import MM
 from palpate.config.scene import ORIENTATION_ROLL_DEG, SceneConfig
@@ -107,15 +109,27 @@ class _Job:
 
 
 def _run_job(job: _Job) -> TrialOutcome:
-    return run_sim_trial(
-        job.spec,
-        job.scene,
-        job.stack,
-        transport=job.transport,
-        log_dir=job.log_dir,
-        keep_series=job.keep_series,
-        live=job.live,
-    )
+    """The job's trial; where it buckled unread, again at each shorter length (``shorter``)."""
+
+    def run(spec: TrialSpec) -> TrialOutcome:
+        if job.log_dir is not None and (logged := logged_outcome(job.log_dir, spec, job.stack)):
+            return logged  # an attempt that finished before a resumed run
+        return run_sim_trial(
+            spec,
+            job.scene,
+            job.stack,
+            transport=job.transport,
+            log_dir=job.log_dir,
+            keep_series=job.keep_series,
+            live=job.live,
+        )
+
+    outcome = run(job.spec)
+    for spec in retries(job.spec, job.scene.campaign):
+        if not buckled_unread(outcome):
+            break
+        outcome = dataclasses.replace(run(spec), tried=(*outcome.tried, outcome.spec.trial_id))
+    return outcome
 
 
 def run_campaign(

@@ -17,6 +17,8 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from palpate.campaigns.runs import set_aside
+from palpate.campaigns.shorter import buckled_unread, retries
+from palpate.config.scene import CampaignConfig
 from palpate.config.schema import StackConfig
 from palpate.estimation.fits.compliance import ComplianceFit
 from palpate.estimation.fits.southwell import SouthwellFit
@@ -37,21 +39,41 @@ T = TypeVar("T")
 
 
 def resume_outcomes(
-    log_dir: Path, specs: list[TrialSpec], stack: StackConfig
+    log_dir: Path,
+    specs: list[TrialSpec],
+    stack: StackConfig,
+    campaign: CampaignConfig | None = None,
 ) -> dict[str, TrialOutcome]:
     """The outcomes of ``specs`` whose logs in ``log_dir`` are complete, by trial id; a log
-    that cannot stand for its trial (killed mid-trial, damaged) is moved aside (``runs``)."""
+    that cannot stand for its trial (killed mid-trial, damaged) is moved aside (``runs``).
+    With ``campaign``, a trial that buckled unread is done only where its retries at shorter
+    lengths (``campaigns.shorter``) are, as far as they went: the last one stands for it."""
     done: dict[str, TrialOutcome] = {}
     for spec in specs:
-        path = log_dir / f"{spec.trial_id}.jsonl"
-        if not path.exists():
-            continue
-        outcome = outcome_from_log(path, spec, stack)
-        if outcome is None:
-            set_aside(path)
-        else:
+        outcome = logged_outcome(log_dir, spec, stack)
+        for retry in [] if campaign is None else retries(spec, campaign):
+            if outcome is None or not buckled_unread(outcome):
+                break
+            tried = (*outcome.tried, outcome.spec.trial_id)
+            outcome = logged_outcome(log_dir, retry, stack)
+            if outcome is not None:
+                outcome.tried = tried
+        if outcome is not None:
             done[spec.trial_id] = outcome
     return done
+
+
+def logged_outcome(log_dir: Path, spec: TrialSpec, stack: StackConfig) -> TrialOutcome | None:
+    """``spec``'s outcome from its log in ``log_dir``; None without one that can stand for it
+    (a damaged one moved aside). A resumed chain of retries reads its attempts that finished
+    with this, and runs the rest."""
+    path = log_dir / f"{spec.trial_id}.jsonl"
+    if not path.exists():
+        return None
+    outcome = outcome_from_log(path, spec, stack)
+    if outcome is None:
+        set_aside(path)
+    return outcome
 
 
 def outcome_from_log(path: Path, spec: TrialSpec, stack: StackConfig) -> TrialOutcome | None:
@@ -102,6 +124,8 @@ def _outcome(
         lean=Lean.from_record(estimate["lean"]) if isinstance(estimate.get("lean"), dict) else None,
         relaxation=_relaxation(estimate.get("relaxation")),
         relaxed_verdict=recorded_verdict(estimate, "relaxed_verdict"),
+        motion=None if estimate.get("motion") is None else float(estimate["motion"]),
+        heart=None if estimate.get("heart") is None else float(estimate["heart"]),
     )
 
 

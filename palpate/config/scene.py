@@ -103,6 +103,10 @@ class CampaignConfig:
         default=(42.0, 44.0, 46.0, 48.0, 50.0), metadata=limits(gt=0, le=500)
     )
     exposed_length_mm: float = field(default=42.0, metadata=limits(gt=0, le=500))  # robot
+    # A trial that buckles and gives no estimate (beside the heart, whose systole buckles a long
+    # beam on a stiff sample within its own excursion) runs again at each of these shorter
+    # exposed lengths in turn, until one gives an estimate (campaigns/shorter.py); empty: never.
+    retry_lengths_mm: tuple[float, ...] = field(default=(), metadata=limits(gt=0, le=500))
     tubes: tuple[str, ...] = ("straight", "bent15", "bent30", "bent50")
     orientations: tuple[Orientation, ...] = ("downward", "sideways", "upward")
     repeats: int = field(default=1, metadata=limits(ge=1, le=1000))
@@ -185,6 +189,10 @@ class CampaignConfig:
         """The indentation speeds the campaign runs each trial at (mm/s)."""
         return self.indent_speeds_mm_per_s or (self.indent_speed_mm_per_s,)
 
+    def lengths_pressed(self) -> tuple[float, ...]:
+        """The exposed lengths (m, at contact) the campaign's trials press at first."""
+        return (self.exposed_length,) if self.on_tubes else self.exposed_lengths
+
     @property
     def on_tubes(self) -> bool:
         """A robot campaign (the trials advance on the robot's tubes), not the bench column."""
@@ -197,6 +205,7 @@ class CampaignConfig:
     # the SI views of the unit-suffixed fields (palpate.config.units)
     exposed_lengths = SITuple("exposed_lengths_mm", MM)
     exposed_length = SI("exposed_length_mm", MM)
+    retry_lengths = SITuple("retry_lengths_mm", MM)
     standoff = SI("standoff_mm", MM)
     approach_speed = SI("approach_speed_mm_per_s", MM)  # m/s
     indent_speed = SI("indent_speed_mm_per_s", MM)
@@ -264,6 +273,13 @@ class SceneConfig:
             _check_world_patch(self)
         if self.campaign.kind == "map":
             _check_map(self)
+        longest = max(self.campaign.lengths_pressed(), default=0.0)
+        for i, length in enumerate(self.campaign.retry_lengths):
+            if length >= longest:
+                raise ValueError(
+                    f"campaign.retry_lengths_mm[{i}]: {length / MM:g} mm is no shorter than the "
+                    f"trials' {longest / MM:g} mm: a retry runs at a shorter exposed length"
+                )
 
     def campaign_samples(self) -> tuple[SampleConfig, ...]:
         wanted = self.campaign.samples
@@ -309,12 +325,16 @@ def require_exposed_gratings(
 
 def campaign_lengths(campaign: CampaignConfig) -> list[tuple[str, float]]:
     """(key, m) of the exposed lengths a simulated ``campaign`` presses at (at contact)."""
+    retry = [
+        (f"campaign.retry_lengths_mm[{i}]", length)
+        for i, length in enumerate(campaign.retry_lengths)
+    ]
     if campaign.on_tubes:
-        return [("campaign.exposed_length_mm", campaign.exposed_length)]
+        return [("campaign.exposed_length_mm", campaign.exposed_length), *retry]
     return [
         (f"campaign.exposed_lengths_mm[{i}]", length)
         for i, length in enumerate(campaign.exposed_lengths)
-    ]
+    ] + retry
 
 
 def check_patch(patch_mm: tuple[float, ...], key: str) -> None:

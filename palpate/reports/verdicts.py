@@ -287,4 +287,17 @@ def summary_lines(outcomes: Sequence[TrialOutcome]) -> list[str]:
             f"worst {100 * t.worst_ok:.1f} %"
         )
     lines += reason_lines(outcomes)
-    return lines + relaxed_lines(outcomes)
+    return lines + retried_lines(outcomes) + relaxed_lines(outcomes)
+
+
+def retried_lines(outcomes: Sequence[TrialOutcome]) -> list[str]:
+    """How many trials buckled unread and ran again at a shorter exposed length
+    (``campaign.retry_lengths_mm``), and how many of those then read (none without one)."""
+    again = [o for o in outcomes if o.tried]
+    if not again:
+        return []
+    read = sum(1 for o in again if o.modulus("joint") is not None)
+    return [
+        f"{len(again)} trials buckled without an estimate and ran again at a shorter exposed "
+        f"length (campaign.retry_lengths_mm): {read} of them read there"
+    ]

@@ -174,7 +174,7 @@ def _open_run(c: Campaign, request: CampaignRequest, locks: contextlib.ExitStack
     base = request.out / c.scene.name
     if request.resume:
         c.run_dir = locks.enter_context(locked(resumable(base, info)))
-        c.done = resume_outcomes(c.log_dir, c.specs, c.stack)
+        c.done = resume_outcomes(c.log_dir, c.specs, c.stack, c.scene.campaign)
         c.results = CampaignResults(c.run_dir)
         c.results.start(o.as_dict() for s in c.specs if (o := c.done.get(s.trial_id)))
         log.info(
@@ -222,7 +222,8 @@ def run(
     for c, r in zip(campaigns, results, strict=True):
         # the pool overlaps campaigns: each is charged the wall time since the previous finished
         c.wall, before = max(r.finished_s - before, 1e-9), r.finished_s
-        ran = {o.spec.trial_id: o for o in r.outcomes}
+        # by the spec each ran for (a retry's outcome names its own length: campaigns.shorter)
+        ran = {s.trial_id: o for s, o in zip(c.to_run(), r.outcomes, strict=True)}
         c.outcomes = [ran.get(s.trial_id) or c.done[s.trial_id] for s in c.specs]
     return time.perf_counter() - t_all
 

@@ -42,6 +42,9 @@ class TrialOutcome(Outcome):
     true_motion: float | None = None  # m, the surface's breathing range in contact (sim truth)
     probe: ProbeResult | None = None
     probing_time: float = 0.0  # simulated s in the probing step
+    # the ids of the attempts before this one, at longer exposed lengths, that buckled unread
+    # (campaign.retry_lengths_mm: campaigns/shorter.py)
+    tried: tuple[str, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         jf = self.joint
@@ -74,6 +77,7 @@ class TrialOutcome(Outcome):
             "probing_s": self.probing_time,
             "sim_time_s": self.sim_time,
             "log": self.log_path,
+            **({"tried": list(self.tried)} if self.tried else {}),
         }
 
 

@@ -126,3 +126,38 @@ def test_an_amplitude_at_the_searchs_edge_is_not_an_estimate() -> None:
     assert failed.message.startswith("heartbeat: the record does not fix")
     assert unfixed(joint, inside) is joint
     assert unfixed(joint, None) is joint
+
+
+def test_a_beat_far_deeper_than_the_indentation_is_not_an_estimate() -> None:
+    """A beat read over twice the record's deepest indentation is the fit trading the beat's
+    amplitude for the modulus (fresh scenes read 10-170 mm there, 50-95 % low): no estimate;
+    a beat within it stands."""
+    from palpate.estimation.jointfit.result import JointFit
+    from palpate.estimation.trial.motion import MAX_BEAT_OVER_DEPTH, unfixed
+
+    beat = Heartbeat((0.0, 0.9, 1.8), (0.2e-3,), (0.0,), fixed=True)  # 0.4 mm peak to peak
+    deep = JointFit(True, "ok", modulus=9e3, n_points=100, max_depth=0.6e-3)
+    assert unfixed(deep, beat) is deep
+    shallow = JointFit(True, "ok", modulus=3e3, n_points=100, max_depth=0.15e-3)
+    assert 0.4e-3 > MAX_BEAT_OVER_DEPTH * 0.15e-3
+    failed = unfixed(shallow, beat)
+    assert failed is not None
+    assert failed.modulus is None
+    assert "the fit traded the beat's amplitude for the modulus" in failed.message
+    assert failed.message.startswith("heartbeat: the beat read 0.40 mm peak to peak")
+
+
+def test_r_waves_with_too_short_a_contact_for_the_beat_are_not_an_estimate() -> None:
+    """An ECG on the record and no beat measured (too few rows in contact: the beam buckled
+    within a beat) leaves the beat in the record: no estimate; without R waves nothing changes."""
+    from palpate.estimation.jointfit.result import JointFit
+    from palpate.estimation.trial.motion import unfixed
+
+    joint = JointFit(True, "ok", modulus=4e3, n_points=100, max_depth=0.6e-3)
+    failed = unfixed(joint, None, beating=True)
+    assert failed is not None
+    assert failed.modulus is None
+    assert "contact is too short to measure the beat" in failed.message
+    assert unfixed(joint, None, beating=False) is joint
+    broken = JointFit(False, "no contact: too few points", n_points=100)
+    assert unfixed(broken, None, beating=True) is broken  # its own reason stands

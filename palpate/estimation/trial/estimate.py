@@ -218,7 +218,8 @@ def fit_rows(
     raw, (rows, motion, heart) = rows, still_record(rows, times, tip_forces, beats, drift, joint)
     fitted = fit(rows)
     envelope = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)
-    fitted = dataclasses.replace(fitted, joint=unfixed(envelope, heart), motion=motion, heart=heart)
+    read = unfixed(envelope, heart, beating=bool(beats))
+    fitted = dataclasses.replace(fitted, joint=read, motion=motion, heart=heart)
     if inputs.rigid:
         return fitted
     lean = lean_of_rows(rows, stack.sensor, section, inputs)

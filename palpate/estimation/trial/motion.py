@@ -29,6 +29,12 @@ from ..pose.motion import LEVEL_SIGMAS, Motion, free_load, surface_motion
 Row = tuple[str, float, Sequence[float]]
 JointOf = Callable[[list[Row]], JointFit | None]
 DRIFT_SIGMAS = 3.0
+# A beat read larger than this many times the record's deepest indentation is not the heart's:
+# the fit has traded the beat's amplitude for the modulus (a low modulus under a beat of tens of
+# mm moves the load as a true modulus under the true beat does). On fresh scenes of
+# docs/invivo.md the estimates with a beat in contact read 0.5-0.9 times the depth; those past 5
+# times read 50-95 % low.
+MAX_BEAT_OVER_DEPTH = 2.0
 HEART_SCALES = (0.4, 3.0)  # of the least squares' amplitude (which reads 10-40 % small where
 # the beat is a sine, up to 55 % where a heart's systole is the only contact a beat gives)
 HEART_STEP = 0.05  # of it: the residual's curvature is read this far either side
@@ -169,15 +175,26 @@ def heart_envelope(
     return spanning(joint, [fit(heart.scaled(f)) for f in factors])
 
 
-def unfixed(joint: JointFit | None, heart: Heartbeat | None) -> JointFit | None:
+def unfixed(
+    joint: JointFit | None, heart: Heartbeat | None, beating: bool = False
+) -> JointFit | None:
     """``joint`` failed where the record did not fix the heart's amplitude (``fixed``: its
-    residual least at the search's edge), or where the record taken against the beat still
+    residual least at the search's edge), where the record taken against the beat still
     leaves residuals correlated to the cap (``MAX_RHO``: the beat's model does not describe
-    it): its modulus would be the model's, not the tissue's (on fresh scenes of docs/invivo.md,
-    two in three such estimates missed the truth by 30 % or their interval missed it)."""
-    if joint is None or heart is None:
+    it), or where the beat read far deeper than the indentation (``MAX_BEAT_OVER_DEPTH``): its
+    modulus would be the model's, not the tissue's (on fresh scenes of docs/invivo.md, two in
+    three such estimates missed the truth by 30 % or their interval missed it). With
+    ``beating`` (the record holds an ECG's R waves) and no beat measured (``heart`` None: too
+    few rows in contact), the beat is in the record and not taken out: it fails too."""
+    if joint is None:
         return joint
-    if not heart.fixed:
+    if heart is None:
+        if not (beating and joint.success):
+            return joint
+        why = (
+            "the ECG's R waves are on the record, but its contact is too short to measure the beat"
+        )
+    elif not heart.fixed:
         why = (
             f"the record does not fix the beat's amplitude (its fit is best at the search's "
             f"edge, {2e3 * heart.amplitude:.2f} mm peak to peak)"
@@ -186,6 +203,14 @@ def unfixed(joint: JointFit | None, heart: Heartbeat | None) -> JointFit | None:
         why = (
             f"the record taken against the beat ({2e3 * heart.amplitude:.2f} mm peak to peak) "
             f"still misses it (residuals correlated, lag-1 {joint.rho:.2f})"
+        )
+    elif (depth := joint.max_depth) is not None and 2.0 * heart.amplitude > (
+        MAX_BEAT_OVER_DEPTH * depth
+    ):
+        why = (
+            f"the beat read {2e3 * heart.amplitude:.2f} mm peak to peak, over "
+            f"{MAX_BEAT_OVER_DEPTH:g} times the record's {1e3 * depth:.2f} mm of indentation: "
+            "the fit traded the beat's amplitude for the modulus"
         )
     else:
         return joint

@@ -100,6 +100,11 @@ def estimate_record(estimate: TrialEstimate) -> dict[str, Any]:
             estimate.relaxed_verdict,
         )
     )
+    # the surface's motion and the heart's beat (m), where the record held them: a resumed
+    # campaign's row reads them back
+    record.update(
+        {k: v for k, v in (("motion", estimate.motion), ("heart", estimate.heart)) if v is not None}
+    )
     return record
 
 
