@@ -17,10 +17,12 @@ states are recorded (``jogs``); ``servo`` does the same with CRTK
 from __future__ import annotations
 
 import argparse
+import atexit
 import itertools
 import json
 import math
 import os
+import signal
 import threading
 import time
 from collections import Counter, defaultdict
@@ -33,6 +35,7 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState, Joy
 from std_srvs.srv import Trigger
 
@@ -56,7 +59,11 @@ def main() -> None:
     parser.add_argument("--namespace", default="palpate")
     parser.add_argument("calls", nargs="*")
     args = parser.parse_args()
-    rclpy.init()
+    # SIGTERM (a caller terminated mid-trial) leaves the DDS graph in order: rclpy's own handler
+    # passes the signal on at once, and the process could end before its participant's
+    # removal was sent; the node would then see it gone only at the lease's end (20 s)
+    rclpy.init(signal_handler_options=SignalHandlerOptions.SIGINT)
+    signal.signal(signal.SIGTERM, _leave)
     node = rclpy.create_node("palpate_test_client")
     ns = "/" + args.namespace
     counts: Counter[str] = Counter()
@@ -100,6 +107,15 @@ def main() -> None:
     executor.add_node(node)
     spinning = threading.Thread(target=executor.spin)
     spinning.start()
+
+    def teardown() -> None:  # once: at the end, or on the way out of a SIGTERM
+        atexit.unregister(teardown)
+        executor.shutdown()
+        spinning.join()  # DDS's threads end before the interpreter's exit, not during it
+        node.destroy_node()
+        rclpy.shutdown()
+
+    atexit.register(teardown)
     answers: list[dict[str, Any]] = []
     pending: list[Any] = []
     parameters = AsyncParameterClient(node, f"{ns}/palpate")
@@ -216,10 +232,12 @@ def main() -> None:
             "strongest_push_n": min(pushes, default=None),  # +z into the tissue: most negative
         }
     print(json.dumps(out))
-    executor.shutdown()
-    spinning.join()  # DDS's threads end before the interpreter's exit, not during it
-    node.destroy_node()
-    rclpy.shutdown()
+    teardown()
+
+
+def _leave(signum: int, frame: Any) -> None:
+    """SIGTERM: out through ``SystemExit``, whose way out tears the node down."""
+    raise SystemExit(128 + signum)
 
 
 if __name__ == "__main__":
