@@ -139,7 +139,7 @@ def test_a_beat_far_deeper_than_the_indentation_is_not_an_estimate() -> None:
     deep = JointFit(True, "ok", modulus=9e3, n_points=100, max_depth=0.6e-3)
     assert unfixed(deep, beat) is deep
     shallow = JointFit(True, "ok", modulus=3e3, n_points=100, max_depth=0.15e-3)
-    assert 0.4e-3 > MAX_BEAT_OVER_DEPTH * 0.15e-3
+    assert MAX_BEAT_OVER_DEPTH * 0.15e-3 < 0.4e-3
     failed = unfixed(shallow, beat)
     assert failed is not None
     assert failed.modulus is None
