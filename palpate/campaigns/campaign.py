@@ -17,7 +17,7 @@ import numpy as np
 from palpate.calibration import calibrated, is_reference
 from palpate.campaigns.executors import SerialExecutor, process_pool
 from palpate.campaigns.resume import logged_outcome
-from palpate.campaigns.shorter import buckled_unread, retries
+from palpate.campaigns.shorter import chained
 from palpate.config.loader import InputError
 from palpate.config.optics import MM
 from palpate.config.scene import ORIENTATION_ROLL_DEG, SceneConfig
@@ -124,11 +124,8 @@ def _run_job(job: _Job) -> TrialOutcome:
             live=job.live,
         )
 
-    outcome = run(job.spec)
-    for spec in retries(job.spec, job.scene.campaign):
-        if not buckled_unread(outcome):
-            break
-        outcome = dataclasses.replace(run(spec), tried=(*outcome.tried, outcome.spec.trial_id))
+    outcome = chained(job.spec, job.scene.campaign, run)
+    assert outcome is not None  # every attempt runs
     return outcome
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from palpate.campaigns.runs import set_aside
-from palpate.campaigns.shorter import buckled_unread, retries
+from palpate.campaigns.shorter import chained
 from palpate.config.scene import CampaignConfig
 from palpate.config.schema import StackConfig
 from palpate.estimation.fits.compliance import ComplianceFit
@@ -50,14 +50,11 @@ def resume_outcomes(
     lengths (``campaigns.shorter``) are, as far as they went: the last one stands for it."""
     done: dict[str, TrialOutcome] = {}
     for spec in specs:
-        outcome = logged_outcome(log_dir, spec, stack)
-        for retry in [] if campaign is None else retries(spec, campaign):
-            if outcome is None or not buckled_unread(outcome):
-                break
-            tried = (*outcome.tried, outcome.spec.trial_id)
-            outcome = logged_outcome(log_dir, retry, stack)
-            if outcome is not None:
-                outcome.tried = tried
+
+        def logged(attempt: TrialSpec) -> TrialOutcome | None:
+            return logged_outcome(log_dir, attempt, stack)
+
+        outcome = logged(spec) if campaign is None else chained(spec, campaign, logged)
         if outcome is not None:
             done[spec.trial_id] = outcome
     return done
@@ -124,8 +121,8 @@ def _outcome(
         lean=Lean.from_record(estimate["lean"]) if isinstance(estimate.get("lean"), dict) else None,
         relaxation=_relaxation(estimate.get("relaxation")),
         relaxed_verdict=recorded_verdict(estimate, "relaxed_verdict"),
-        motion=None if estimate.get("motion") is None else float(estimate["motion"]),
-        heart=None if estimate.get("heart") is None else float(estimate["heart"]),
+        motion=_floats(estimate.get("motion"), optional=True),
+        heart=_floats(estimate.get("heart"), optional=True),
     )
 
 

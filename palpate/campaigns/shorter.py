@@ -10,23 +10,22 @@ over 1.7 times the indentation. Which length a sample needs is not known before 
 so a trial that buckled and gave no estimate runs again at each of the campaign's shorter lengths
 in turn, until one gives an estimate::
 
-    for spec in retries(first.spec, scene.campaign):
-        if not buckled_unread(outcome):
-            break
-        outcome = run_sim_trial(spec, ...)
+    outcome = chained(spec, scene.campaign, lambda s: run_sim_trial(s, scene, stack))
 
 Each attempt writes its own log (the trial's id names its length), so nothing is lost, and
-``--resume`` follows the same chain through the logs.
+``--resume`` follows the same chain through the logs (an attempt that reads None: not run yet).
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 from palpate.config.optics import MM
 from palpate.config.scene import CampaignConfig
 from palpate.robot.plan import State
 from palpate.robot.trial.outcome import Outcome
+from palpate.simulation.result import TrialOutcome
 from palpate.simulation.world import TrialSpec
 
 
@@ -53,3 +52,21 @@ def at_length(spec: TrialSpec, length: float) -> TrialSpec:
     if new not in parts:
         parts.append(new)
     return dataclasses.replace(spec, trial_id="-".join(parts), exposed_length=length)
+
+
+def chained(
+    spec: TrialSpec,
+    campaign: CampaignConfig,
+    attempt: Callable[[TrialSpec], TrialOutcome | None],
+) -> TrialOutcome | None:
+    """``attempt(spec)``, then while it buckled unread ``attempt`` of each of its
+    :func:`retries` in turn: the last attempt's outcome, its ``tried`` naming those before it.
+    None where an attempt gives None (a resumed chain whose next attempt has no log yet)."""
+    outcome = attempt(spec)
+    for retry in retries(spec, campaign):
+        if outcome is None or not buckled_unread(outcome):
+            break
+        tried = (*outcome.tried, outcome.spec.trial_id)
+        again = attempt(retry)
+        outcome = None if again is None else dataclasses.replace(again, tried=tried)
+    return outcome
