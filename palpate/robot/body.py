@@ -11,17 +11,28 @@ ventilator's breath-hold gate (frame status bit 6) and an ECG monitor's R waves 
   through the stand-off at full speed to ``TrialPlan.heart_margin`` before the expected
   surface. Only in a breath hold (``TrialPlan.gated``): free breathing moves the tissue more
   than the beat, and no faster. Without an ECG nothing changes.
+- Buckling is judged in the heart's quiet phase (:meth:`BodyWatch.quiet`): the buckling
+  detector reads only the ticks from ``TrialPlan.heart_quiet`` of the R-R interval after an R
+  wave (0.65-0.85: mid-diastole, cardiac CT's quiet window). Beside a strong beat the systole
+  alone buckles the beam within a beat or two of the first touch, before the stage has pressed
+  the still tissue at all; the beam springs back in diastole, so the machine goes on until it
+  buckles with the heart at rest, and the record spans the beats the estimate needs. It then
+  holds the buckled beam still (no post-buckling travel) through ``TrialPlan.heart_windows``
+  more quiet windows before it retracts (:meth:`BodyWatch.settled`): a buckled beam carries a
+  nearly constant load, so its shortening follows the surface: the breath hold's drift.
 
 Usage::
 
     body = BodyWatch()
     body.see(obs)                       # every tick
     body.hold_began(obs, plan.gate_fresh), body.approach(plan, advance), body.indent_speed(plan)
+    body.quiet(obs.t, plan)             # feed the buckling detector only then
+    body.mark(); body.settled(obs.t, plan)  # at buckling; every tick after: may it retract?
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from .guards import Observation
 from .plan import TrialPlan
@@ -32,6 +43,10 @@ STANDOFF_HINT = (  # a contact while waiting at the stand-off: the tissue came t
 )
 
 
+R_WAVES_KEPT = 5  # the R-R interval is the median of the last four
+R_WAVES_LOST = 2.5  # R-R intervals without an R wave: the ECG is lost, every tick is quiet
+
+
 @dataclass
 class BodyWatch:
     """The gate and the heart as the ticks have shown them so far."""
@@ -40,6 +55,10 @@ class BodyWatch:
     beating: bool = False  # an R wave was seen this trial
     _open: bool = True  # the gate last seen
     _rose: float | None = None  # when it last rose (s)
+    _pulse: bool = False  # the ECG's pulse on the last tick
+    _r_waves: list[float] = field(default_factory=list)  # the last R waves' times (s)
+    _windows: int = 0  # quiet windows ended since the mark
+    _was_quiet: bool = False
 
     def see(self, obs: Observation) -> None:
         """Take one tick's gate and ECG pulse."""
@@ -47,11 +66,49 @@ class BodyWatch:
             if obs.gate and not self._open:
                 self._rose = obs.t
             self._open = obs.gate
+        if obs.beat and not self._pulse:
+            self._r_waves = [*self._r_waves[-(R_WAVES_KEPT - 1) :], obs.t]
+        self._pulse = obs.beat
         self.beating = self.beating or obs.beat
+
+    def period(self) -> float | None:
+        """The R-R interval (s): the median of the last ones seen; None before two R waves."""
+        gaps = sorted(b - a for a, b in zip(self._r_waves, self._r_waves[1:], strict=False))
+        return gaps[len(gaps) // 2] if gaps else None
+
+    def quiet(self, t: float, plan: TrialPlan) -> bool:
+        """The heart is in its quiet phase at ``t``, or does not matter: no ECG, not gated, or R
+        waves that stopped (none for ``R_WAVES_LOST`` intervals). False while beating and the
+        R-R interval is not yet known."""
+        if not (plan.gated and self.beating):
+            return True
+        period = self.period()
+        if period is None:
+            return False
+        phase = (t - self._r_waves[-1]) / period
+        start, end = plan.heart_quiet
+        return phase > R_WAVES_LOST or start <= phase <= end
 
     def hold_began(self, obs: Observation, fresh: float) -> bool:
         """A breath hold is on at ``obs`` and began at most ``fresh`` s before."""
         return bool(obs.gate) and self._rose is not None and obs.t - self._rose <= fresh
+
+    def mark(self) -> None:
+        """Count the quiet windows from now (:meth:`settled`)."""
+        self._windows, self._was_quiet = 0, False
+
+    def settled(self, t: float, plan: TrialPlan) -> bool:
+        """``TrialPlan.heart_windows`` quiet windows have ended since the mark (call every tick
+        from it), or the heart does not matter (as :meth:`quiet`)."""
+        now = self.quiet(t, plan)
+        self._windows += int(self._was_quiet and not now)
+        self._was_quiet = now
+        return not (plan.gated and self.beating) or self._windows >= plan.heart_windows
+
+    def post_travel(self, plan: TrialPlan) -> float:
+        """The travel past buckling (m): none beside a beating heart, where the beam is held
+        still through the quiet windows instead (a moving stage's reading lags the strains')."""
+        return 0.0 if plan.gated and self.beating else plan.post_buckling_travel
 
     def approach(self, plan: TrialPlan, advance: float) -> tuple[float, float] | None:
         """The approach's goal and speed (m, m/s) while the heart is seen and the tip is short of

@@ -14,7 +14,7 @@ With ``TrialPlan.gated`` the machine waits at the stand-off (WAITING) for a brea
 has just begun (``robot.body``), then approaches and indents within it; a hold that ends first
 retracts and waits for the next (the tissue moves again), and after ``hold_retries`` such holds
 the trial ends DONE with no estimate (``estimation.verdict.HOLDS_RAN_OUT``). With an ECG's R
-waves the first beats in contact are indented slowly (``robot.body``).
+waves the tip indents slowly and buckling is judged in the heart's quiet phase (``robot.body``).
 
 With ``TrialPlan.hold_time`` > 0 the stage then stands still that long: the buckled beam is
 nearly a constant-force spring, so the hold is a creep test the gratings record
@@ -65,7 +65,6 @@ __all__ = [
     "TrialPlan",
     "limit_violation",
 ]
-
 
 REZERO_SETTLE_TICKS = 10  # ticks at rest before the strain zero is taken again
 WAIT_CONFIRM = 3  # ticks a contact holds while WAITING before the rest check takes it
@@ -330,10 +329,11 @@ class IndentationMachine:
         return Command(self.marks.x_contact + window, self.plan.roll, speed)
 
     def _indenting(self, obs: Observation) -> Command:
-        if self.detector.update(obs.strains, obs.advance, obs.tip_force):
-            self.marks.x_buckling = obs.advance
-            self.marks.t_buckling = obs.t
-            self.marks.strains_at_buckling = obs.strains
+        if self._body.quiet(obs.t, self.plan) and self.detector.update(
+            obs.strains, obs.advance, obs.tip_force
+        ):
+            self.marks.buckled(obs.t, obs.advance, obs.strains)
+            self._body.mark()
             self._go(State.BUCKLED, obs.t, "buckling detected", obs.advance, obs.strains)
             return self._indent_goal(obs)
         cmd = self._indent_goal(obs)
@@ -350,12 +350,12 @@ class IndentationMachine:
     def _post_goal(self, obs: Observation) -> float:
         """The post-buckling record's end, never past the travel window (nor its guard)."""
         assert self.marks.x_buckling is not None
-        goal = self.marks.x_buckling + self.plan.post_buckling_travel
+        goal = self.marks.x_buckling + self._body.post_travel(self.plan)
         return min(goal, self._indent_goal(obs).advance)
 
     def _buckled(self, obs: Observation) -> Command:
-        goal = self._post_goal(obs)
-        if obs.advance >= goal - self.plan.position_tolerance:
+        goal, settled = self._post_goal(obs), self._body.settled(obs.t, self.plan)
+        if obs.advance >= goal - self.plan.position_tolerance and settled:
             if self.plan.hold_time <= 0:
                 return self._complete(obs, "post-buckling record complete")
             why = "post-buckling record complete: holding"

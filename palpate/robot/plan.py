@@ -8,6 +8,7 @@ import enum
 from dataclasses import dataclass
 from typing import Protocol
 
+from ..estimation.pose.heartbeat import QUIET
 from .guards import Observation
 from .probe_result import ProbeResult
 
@@ -64,6 +65,10 @@ class TrialPlan:
     # speed to ``heart_margin`` before the expected surface (robot.body)
     heart_speed: float = 0.1e-3
     heart_margin: float = 1e-3
+    # the share of the R-R interval after an R wave in which the buckling detector reads ticks
+    # while the heart beats (robot.body: mid-diastole)
+    heart_quiet: tuple[float, float] = QUIET
+    heart_windows: int = 2  # quiet windows the buckled beam is held through before retracting
 
     def retract_goal(self, first_touch: float | None) -> float:
         """Home, or further back if the tissue was touched (at ``first_touch``, m) where the plan
@@ -109,3 +114,7 @@ class TrialMarks:
     t_buckling: float | None = None
     strains_at_buckling: tuple[float, ...] = ()
     reason: str = ""
+
+    def buckled(self, t: float, advance: float, strains: tuple[float, ...]) -> None:
+        """Mark buckling detected at ``t`` (s), ``advance`` (m), with these strains."""
+        self.x_buckling, self.t_buckling, self.strains_at_buckling = advance, t, strains

@@ -14,12 +14,10 @@ and ``estimation.jointfit`` fits the modulus and the contact position together. 
 the contact event: a late or early event cannot bias it.
 
 The strain noise is measured on the record itself (each row's 3-grating fit has one degree of
-freedom left; the median of its squared residual gives sigma), so nothing about the simulator's
-noise setting leaks in. The strains' zero, taken on a few frames at rest, leaves a load offset
-common to the whole record; the joint fit fits it beside E and the contact
-(``JointFit.load_offset``). What the estimator is told about the sample (thickness, bonding, Poisson
-ratio) is written to the log header under ``"estimator"`` so ``palpate replay`` re-runs it with
-the same inputs and reproduces the fit bit for bit.
+freedom left; the median of its squared residual gives sigma). The strains' zero leaves a load
+offset common to the record, fitted beside E and the contact (``JointFit.load_offset``). What
+the estimator is told about the sample is written to the log header under ``"estimator"`` so
+``palpate replay`` re-runs it with the same inputs and reproduces the fit bit for bit.
 """
 
 from __future__ import annotations
@@ -52,7 +50,7 @@ from ..verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from .finished import FinishedTrial, tip_load_at_buckling
 from .inputs import EstimatorInputs
 from .lean import lean_of_rows, loading_tip, rows_in
-from .motion import Row, motion_envelope, still_record, unfixed
+from .motion import Row, motion_envelope, record_heart, still_record, unfixed
 from .relaxed import relaxation_of
 from .states import (
     LOADING_STATES,
@@ -64,6 +62,7 @@ from .states import (
     row_loads,
     states_at,
 )
+from .strobe import strobe_fit, strobed_rows
 
 __all__ = [
     "EstimatorInputs",
@@ -215,10 +214,15 @@ def fit_rows(
         return fit(rows).joint
 
     drift = inputs.motion_tolerance is not None  # taken out where the campaign expects it
-    raw, (rows, motion, heart) = rows, still_record(rows, times, tip_forces, beats, drift, joint)
-    fitted = fit(rows)
-    envelope = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)
-    read = unfixed(envelope, heart, beating=bool(beats))
+    quiet = strobed_rows(rows, times, tip_forces, beats)  # estimation.trial.strobe
+    if quiet is not None and times is not None:  # the record read in the heart's quiet phase
+        fitted, (read, motion) = fit(rows), strobe_fit(quiet, times, drift, joint)
+        heart = record_heart(rows, tip_forces, times, beats)
+    else:  # the beat taken out of the whole record (estimation.trial.motion)
+        rows, motion, heart = still_record(raw := rows, times, tip_forces, beats, drift, joint)
+        fitted = fit(rows)
+        env = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)
+        read = unfixed(env, heart, beating=bool(beats))
     fitted = dataclasses.replace(fitted, joint=read, motion=motion, heart=heart)
     if inputs.rigid:
         return fitted
