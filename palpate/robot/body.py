@@ -16,10 +16,11 @@ ventilator's breath-hold gate (frame status bit 6) and an ECG monitor's R waves 
   wave (0.65-0.85: mid-diastole, cardiac CT's quiet window). Beside a strong beat the systole
   alone buckles the beam within a beat or two of the first touch, before the stage has pressed
   the still tissue at all; the beam springs back in diastole, so the machine goes on until it
-  buckles with the heart at rest, and the record spans the beats the estimate needs. It then
-  holds the buckled beam still (no post-buckling travel) through ``TrialPlan.heart_windows``
-  more quiet windows before it retracts (:meth:`BodyWatch.settled`): a buckled beam carries a
-  nearly constant load, so its shortening follows the surface: the breath hold's drift.
+  buckles with the heart at rest, and the record spans the beats the estimate needs. There the
+  stage stands (no post-buckling travel, :meth:`BodyWatch.post_travel`) through
+  ``TrialPlan.heart_windows`` more quiet windows before it retracts (:meth:`BodyWatch.settled`):
+  the beam at its buckling load, the stage still, only the breath hold's drift moves the load
+  in those windows, and the estimate reads the drift there (``estimation.trial.strobe``).
 
 Usage::
 
@@ -106,8 +107,8 @@ class BodyWatch:
         return not (plan.gated and self.beating) or self._windows >= plan.heart_windows
 
     def post_travel(self, plan: TrialPlan) -> float:
-        """The travel past buckling (m): none beside a beating heart, where the beam is held
-        still through the quiet windows instead (a moving stage's reading lags the strains')."""
+        """The travel past buckling (m): none beside a beating heart, where the stage stands
+        still through the quiet windows instead (:meth:`settled`)."""
         return 0.0 if plan.gated and self.beating else plan.post_buckling_travel
 
     def approach(self, plan: TrialPlan, advance: float) -> tuple[float, float] | None:

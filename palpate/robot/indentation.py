@@ -340,10 +340,8 @@ class IndentationMachine:
         if obs.advance >= cmd.advance - self.plan.position_tolerance:
             # The whole travel window used up without buckling (tissue below the sensor's range,
             # a compliant tube tip): an answer, not a fault (the verdict bounds the modulus).
-            travel = self.guards.max_travel_past_contact * 1e3
-            self.marks.reason = (
-                f"{NO_BUCKLING}: travel past contact reached the {travel:.2f} mm limit"
-            )
+            travel = f"{self.guards.max_travel_past_contact * 1e3:.2f} mm"
+            self.marks.reason = f"{NO_BUCKLING}: travel past contact reached the {travel} limit"
             return self._complete(obs, self.marks.reason)
         return cmd
 

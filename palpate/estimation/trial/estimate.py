@@ -50,7 +50,7 @@ from ..verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from .finished import FinishedTrial, tip_load_at_buckling
 from .inputs import EstimatorInputs
 from .lean import lean_of_rows, loading_tip, rows_in
-from .motion import Row, motion_envelope, record_heart, still_record, unfixed
+from .motion import Row, motion_envelope, still_record, unfixed
 from .relaxed import relaxation_of
 from .states import (
     LOADING_STATES,
@@ -196,9 +196,9 @@ def fit_rows(
     beside them the load's lean from the rows before buckling (``estimation.trial.lean``) and, with
     each row's time (s) and a hold in the rows, the relaxation (``estimation.trial.relaxed``). With
     each row's tip-grating load (N), the joint fit reads the load from it; with the ticks (s)
-    of an ECG's R-wave pulses, in a gated trial (``inputs.gated``; for a log that predates it,
-    rows that wait for a breath hold), the heart's beat is taken out
-    (``estimation.trial.motion``)."""
+    of an ECG's R-wave pulses, in a gated trial (``inputs.gated``; for an older log, rows that
+    wait for a breath hold), the record is read in the heart's quiet phase
+    (``estimation.trial.strobe``) or the beat taken out (``estimation.trial.motion``)."""
     rows = list(rows)
     held = inputs.gated if inputs.gated is not None else any(r[0] == WAITING for r in rows)
     beats = beats if held else None  # in a breath hold only (a trial may arrive in one)
@@ -214,11 +214,11 @@ def fit_rows(
         return fit(rows).joint
 
     drift = inputs.motion_tolerance is not None  # taken out where the campaign expects it
-    quiet = strobed_rows(rows, times, tip_forces, beats)  # estimation.trial.strobe
-    if quiet is not None and times is not None:  # the record read in the heart's quiet phase
+    quiet = strobed_rows(rows, times, tip_forces, beats)
+    if quiet is not None and times is not None:
         fitted, (read, motion) = fit(rows), strobe_fit(quiet, times, drift, joint)
-        heart = record_heart(rows, tip_forces, times, beats)
-    else:  # the beat taken out of the whole record (estimation.trial.motion)
+        heart = still_record(rows, times, tip_forces, beats, drift, joint)[2]  # as it beat
+    else:
         rows, motion, heart = still_record(raw := rows, times, tip_forces, beats, drift, joint)
         fitted = fit(rows)
         env = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)

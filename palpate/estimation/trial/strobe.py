@@ -43,6 +43,7 @@ OFF_BEAT = "off-beat"  # a row outside the quiet phase: no loading row (estimati
 MIN_WINDOWS = 2  # quiet windows with the tip in contact before buckling: a law, not a point
 MIN_BUCKLED = 2  # quiet windows with the beam buckled: the drift
 TOUCHING = ("contact", "indenting")
+HELD = 10e-6  # m: the stage stands within this of its last advance while buckled
 BUCKLED = ("buckled", "holding")
 DRIFT_SPAN = 0.5e-3  # m/s either way the drift's velocity is searched over (a hold: < 0.1 mm/s)
 DRIFT_STEP = 0.01e-3  # m/s: the residual's curvature is read this far either side
@@ -50,12 +51,13 @@ DRIFT_STEP = 0.01e-3  # m/s: the residual's curvature is read this far either si
 
 @dataclass(frozen=True)
 class Strobe:
-    """The rows with those outside the quiet phase set aside, and the first quiet row in
-    contact and the last buckled one (s): the span the drift is read over."""
+    """The rows with those outside the quiet phase set aside, the first quiet row in contact
+    and the last buckled one (s): the span the drift is read over, and the R waves."""
 
     rows: list[Row]
     touch: float
     release: float
+    beats: tuple[float, ...]  # the R waves (s)
 
 
 def strobed_rows(
@@ -67,7 +69,8 @@ def strobed_rows(
     """The rows with those outside the heart's quiet phase set aside (state ``OFF_BEAT``), the
     phase from the ticks (s) whose frames carried an ECG's R-wave pulse; None where fewer than
     ``MIN_WINDOWS`` quiet windows hold the tip in contact before buckling or fewer than
-    ``MIN_BUCKLED`` after it, or without times, tip loads or two R waves."""
+    ``MIN_BUCKLED`` hold the buckled beam still after it (:func:`held_rows`), or without times,
+    tip loads or two R waves."""
     if times is None or not pulses or not tip_forces or len(tip_forces) != len(rows):
         return None
     beats = r_waves(times, pulses)
@@ -81,14 +84,25 @@ def strobed_rows(
     zero, sigma = free
     quiet = in_quiet_phase(times, beats)
     touching = quiet & np.isin(states, TOUCHING) & (load - zero > LEVEL_SIGMAS[1] * sigma)
-    buckled = quiet & np.isin(states, BUCKLED)
+    buckled = quiet & held_rows(rows)
     if _windows(times, beats, touching) < MIN_WINDOWS or _windows(times, beats, buckled) < (
         MIN_BUCKLED
     ):
         return None
     kept = [(s if q else OFF_BEAT, u, e) for (s, u, e), q in zip(rows, quiet, strict=True)]
     span = (times[int(np.argmax(touching))], times[int(np.flatnonzero(buckled)[-1])])
-    return Strobe(kept, *span)
+    return Strobe(kept, *span, beats)
+
+
+def held_rows(rows: list[Row]) -> np.ndarray:
+    """Which rows hold the buckled beam still: buckled, at the stage's last advance while
+    buckled (the post-buckling travel's end, within ``HELD``)."""
+    states = np.asarray([r[0] for r in rows])
+    advance = np.asarray([r[1] for r in rows], dtype=np.float64)
+    buckled = np.isin(states, BUCKLED) & np.isfinite(advance)
+    if not buckled.any():
+        return buckled
+    return np.asarray(buckled & (np.abs(advance - advance[buckled][-1]) <= HELD))
 
 
 def _windows(times: Sequence[float], beats: Sequence[float], rows: np.ndarray) -> int:
