@@ -1,15 +1,18 @@
 """The machine with an ECG (issue 62): once the heart is seen to beat (frame status bit 7), a
 trial in a breath hold indents at the plan's heart speed and makes the time in the approach, at
 full speed to the heart margin before the expected surface; without an ECG, or without a breath
-hold (free breathing moves the tissue more than the beat), the plan's speeds are kept."""
+hold (free breathing moves the tissue more than the beat), the plan's speeds are kept. Beside
+a beating heart buckling is judged in mid-diastole and the stage then stands through two quiet
+windows."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import pytest
 
-from palpate.robot.body import BodyWatch
+from palpate.robot.body import R_WAVES_LOST, BodyWatch
 from palpate.robot.indentation import Guards, Observation, State
 from palpate.robot.trial.run import run_trial
 from palpate.sim.clock import VirtualClock
@@ -67,3 +70,54 @@ def test_the_watch_counts_a_hold_only_as_it_begins() -> None:
     assert not body.beating
     body.see(Observation(4.0, 0.0, 0.0, (), False, beat=True))
     assert body.beating
+
+
+def test_beside_a_heart_buckling_counts_in_the_quiet_phase_and_the_stage_then_stands() -> None:
+    """The rig's strains cross the detector's threshold at whatever phase the stage reaches its
+    buckling advance; the machine takes it only in mid-diastole, then holds the stage there (no
+    post-buckling travel) until two more quiet windows have ended."""
+    rig = BeatingRig(VirtualClock(), holds=hold_from(3.0, 60.0))
+    p = plan(gated=True)
+    result = run_trial(rig, rig.clock, p, Guards(), ThresholdDetector())
+    assert result.state is State.DONE, result.reason
+    t_buckled, x_buckled = result.marks.t_buckling, result.marks.x_buckling
+    assert t_buckled is not None
+    assert x_buckled is not None
+    start, end = p.heart_quiet
+    assert start <= (t_buckled % PERIOD) / PERIOD <= end
+    over = [u for s, u, e in result.record if s == "indenting" and math.hypot(*e) > 50e-6]
+    assert over
+    assert over[0] < x_buckled - 5 * rig.tick * p.heart_speed
+    held = [u for s, u, _ in result.record if s == State.BUCKLED.value]
+    assert max(held) - x_buckled < 2 * p.position_tolerance + rig.tick * p.heart_speed
+    retract = next(tr for tr in result.transitions if tr.target is State.RETRACTING)
+    ends = [k * PERIOD + end * PERIOD for k in range(int(retract.t / PERIOD) + 1)]
+    assert sum(t_buckled < e < retract.t for e in ends) >= p.heart_windows
+
+
+def test_without_a_heart_the_post_buckling_travel_is_kept() -> None:
+    rig = BeatingRig(VirtualClock(), holds=hold_from(3.0, 60.0), beats=False)
+    p = plan(gated=True)
+    result = run_trial(rig, rig.clock, p, Guards(), ThresholdDetector())
+    assert result.state is State.DONE, result.reason
+    assert result.marks.x_buckling is not None
+    held = [u for s, u, _ in result.record if s == State.BUCKLED.value]
+    assert max(held) == pytest.approx(result.marks.x_buckling + p.post_buckling_travel, abs=1e-5)
+
+
+def test_the_watch_knows_the_quiet_phase_from_the_r_waves() -> None:
+    body, p = BodyWatch(), plan(gated=True)
+    assert body.quiet(0.5, p)  # no heart seen: every tick is quiet
+    for t in (0.0, 1.0):
+        body.see(Observation(t, 0.0, 0.0, (), False, beat=True))
+        body.see(Observation(t + 0.02, 0.0, 0.0, (), False))
+    assert body.period() == pytest.approx(1.0)
+    assert body.quiet(1.8, p)
+    assert not body.quiet(1.3, p)  # systole
+    assert not body.quiet(1.95, p)  # the atria's kick
+    assert body.quiet(1.0 + (R_WAVES_LOST + 0.1), p)  # the ECG lost: no phase to wait for
+    late = BodyWatch()
+    late.see(Observation(0.0, 0.0, 0.0, (), False, beat=True))
+    assert not late.quiet(0.8, p)  # one R wave: the interval not yet known
+    assert body.post_travel(p) == 0.0
+    assert late.post_travel(plan()) == p.post_buckling_travel  # not gated: the plan's
