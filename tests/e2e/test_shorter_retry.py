@@ -2,8 +2,9 @@
 ``campaign.retry_lengths_mm``): beside a 0.5 mm beat, in a breath hold that drifts 1.5 mm (0.1
 mm/s, as fast as the stage), a 20 kPa sample buckles the 45 mm beam within one quiet window of
 the heart and gives no estimate; at 30 mm the beam's critical load is 2.25 times higher, the
-quiet windows in contact are more and the record reads it. Both attempts keep their logs, the row names the
-attempt that stands and the one before it, and ``--resume`` follows the same chain."""
+quiet windows in contact are more and the record reads it. Both attempts keep their logs, the
+row names the attempt that stands and the one before it, and ``--resume`` follows the same
+chain."""
 
 from __future__ import annotations
 
