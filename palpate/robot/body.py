@@ -11,13 +11,15 @@ ventilator's breath-hold gate (frame status bit 6) and an ECG monitor's R waves 
   through the stand-off at full speed to ``TrialPlan.heart_margin`` before the expected
   surface. Only in a breath hold (``TrialPlan.gated``): free breathing moves the tissue more
   than the beat, and no faster. Without an ECG nothing changes.
-- Buckling is judged in the heart's quiet phase (:meth:`BodyWatch.quiet`): the buckling
-  detector reads only the ticks from ``TrialPlan.heart_quiet`` of the R-R interval after an R
-  wave (0.65-0.85: mid-diastole, cardiac CT's quiet window). Beside a strong beat the systole
-  alone buckles the beam within a beat or two of the first touch, before the stage has pressed
-  the still tissue at all; the beam springs back in diastole, so the machine goes on until it
-  buckles with the heart at rest, and the record spans the beats the estimate needs. There the
-  stage stands (no post-buckling travel, :meth:`BodyWatch.post_travel`) through
+- Until the tip has touched the tissue in ``TrialPlan.heart_touches`` of the heart's quiet
+  phases (``TrialPlan.heart_quiet`` of the R-R interval after an R wave: mid-diastole, cardiac
+  CT's quiet window), the buckling detector reads only the quiet phase's ticks
+  (:meth:`BodyWatch.reads`). Beside a strong beat and a stiff sample the systole alone buckles
+  the beam within a beat or two of the first touch, before the stage has pressed the still
+  tissue at all; the beam springs back in diastole, so the machine goes on until it buckles
+  with the heart at rest, and the record holds the quiet windows the estimate needs. A soft
+  sample's record has them long before the systole buckles the beam: it ends there, as before.
+  At buckling the stage stands (no post-buckling travel, :meth:`BodyWatch.post_travel`) through
   ``TrialPlan.heart_windows`` more quiet windows before it retracts (:meth:`BodyWatch.settled`):
   the beam at its buckling load, the stage still, only the breath hold's drift moves the load
   in those windows, and the estimate reads the drift there (``estimation.trial.strobe``).
@@ -27,8 +29,8 @@ Usage::
     body = BodyWatch()
     body.see(obs)                       # every tick
     body.hold_began(obs, plan.gate_fresh), body.approach(plan, advance), body.indent_speed(plan)
-    body.quiet(obs.t, plan)             # feed the buckling detector only then
-    body.mark(); body.settled(obs.t, plan)  # at buckling; every tick after: may it retract?
+    body.reads(obs, plan)               # feed the buckling detector only then
+    body.mark(); body.settled(obs.t, plan)  # at contact and buckling; after: may it retract?
 """
 
 from __future__ import annotations
@@ -59,6 +61,8 @@ class BodyWatch:
     _pulse: bool = False  # the ECG's pulse on the last tick
     _r_waves: list[float] = field(default_factory=list)  # the last R waves' times (s)
     _windows: int = 0  # quiet windows ended since the mark
+    _touched: set[int] = field(default_factory=set)  # R waves whose quiet window had a contact
+    _count: int = 0  # R waves seen
     _was_quiet: bool = False
 
     def see(self, obs: Observation) -> None:
@@ -69,6 +73,7 @@ class BodyWatch:
             self._open = obs.gate
         if obs.beat and not self._pulse:
             self._r_waves = [*self._r_waves[-(R_WAVES_KEPT - 1) :], obs.t]
+            self._count += 1
         self._pulse = obs.beat
         self.beating = self.beating or obs.beat
 
@@ -94,9 +99,20 @@ class BodyWatch:
         """A breath hold is on at ``obs`` and began at most ``fresh`` s before."""
         return bool(obs.gate) and self._rose is not None and obs.t - self._rose <= fresh
 
+    def reads(self, obs: Observation, plan: TrialPlan) -> bool:
+        """Whether the buckling detector reads this indenting tick: in the heart's quiet phase,
+        or every tick once ``TrialPlan.heart_touches`` quiet windows have had the tip in contact
+        (a soft sample: the beam's record spans the beats before the systole buckles it), or
+        where the heart does not matter (as :meth:`quiet`)."""
+        quiet = self.quiet(obs.t, plan)
+        if quiet and obs.contact and plan.gated and self.beating:
+            self._touched.add(self._count)
+        return quiet or len(self._touched) >= plan.heart_touches
+
     def mark(self) -> None:
-        """Count the quiet windows from now (:meth:`settled`)."""
+        """Count the quiet windows from now (:meth:`reads`, :meth:`settled`)."""
         self._windows, self._was_quiet = 0, False
+        self._touched.clear()
 
     def settled(self, t: float, plan: TrialPlan) -> bool:
         """``TrialPlan.heart_windows`` quiet windows have ended since the mark (call every tick

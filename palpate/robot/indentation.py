@@ -319,6 +319,7 @@ class IndentationMachine:
 
     def _contact(self, obs: Observation) -> Command:
         self.detector.reset()
+        self._body.mark()
         self._go(State.INDENTING, obs.t, "indenting", obs.advance, obs.strains)
         return self._indent_goal(obs)
 
@@ -329,7 +330,7 @@ class IndentationMachine:
         return Command(self.marks.x_contact + window, self.plan.roll, speed)
 
     def _indenting(self, obs: Observation) -> Command:
-        if self._body.quiet(obs.t, self.plan) and self.detector.update(
+        if self._body.reads(obs, self.plan) and self.detector.update(
             obs.strains, obs.advance, obs.tip_force
         ):
             self.marks.buckled(obs.t, obs.advance, obs.strains)

@@ -68,7 +68,9 @@ class TrialPlan:
     # the share of the R-R interval after an R wave in which the buckling detector reads ticks
     # while the heart beats (robot.body: mid-diastole)
     heart_quiet: tuple[float, float] = QUIET
-    heart_windows: int = 2  # quiet windows the buckled beam is held through before retracting
+    # quiet windows in contact before a buckle outside them counts; held still after buckling
+    heart_touches: int = 4
+    heart_windows: int = 2
 
     def retract_goal(self, first_touch: float | None) -> float:
         """Home, or further back if the tissue was touched (at ``first_touch``, m) where the plan

@@ -72,11 +72,12 @@ def test_the_watch_counts_a_hold_only_as_it_begins() -> None:
     assert body.beating
 
 
-def test_beside_a_heart_buckling_counts_in_the_quiet_phase_and_the_stage_then_stands() -> None:
-    """The rig's strains cross the detector's threshold at whatever phase the stage reaches its
-    buckling advance; the machine takes it only in mid-diastole, then holds the stage there (no
+def test_beside_a_heart_a_stiff_sample_buckles_in_the_quiet_phase_and_the_stage_stands() -> None:
+    """The tip touches just before the rig's strains cross the detector's threshold (a stiff
+    sample: the systole buckles the beam before diastole has pressed the tissue): the machine
+    passes the crossing by outside mid-diastole, takes it there, then holds the stage (no
     post-buckling travel) until two more quiet windows have ended."""
-    rig = BeatingRig(VirtualClock(), holds=hold_from(3.0, 60.0))
+    rig = BeatingRig(VirtualClock(), holds=hold_from(3.0, 60.0), x_contact=11.9e-3)
     p = plan(gated=True)
     result = run_trial(rig, rig.clock, p, Guards(), ThresholdDetector())
     assert result.state is State.DONE, result.reason
@@ -87,12 +88,22 @@ def test_beside_a_heart_buckling_counts_in_the_quiet_phase_and_the_stage_then_st
     assert start <= (t_buckled % PERIOD) / PERIOD <= end
     over = [u for s, u, e in result.record if s == "indenting" and math.hypot(*e) > 50e-6]
     assert over
-    assert over[0] < x_buckled - 5 * rig.tick * p.heart_speed
+    assert over[0] < x_buckled - 5 * rig.tick * p.heart_speed  # passed by outside the window
     held = [u for s, u, _ in result.record if s == State.BUCKLED.value]
     assert max(held) - x_buckled < 2 * p.position_tolerance + rig.tick * p.heart_speed
     retract = next(tr for tr in result.transitions if tr.target is State.RETRACTING)
     ends = [k * PERIOD + end * PERIOD for k in range(int(retract.t / PERIOD) + 1)]
     assert sum(t_buckled < e < retract.t for e in ends) >= p.heart_windows
+
+
+def test_beside_a_heart_a_soft_sample_ends_where_the_beam_buckles() -> None:
+    """Touched 2 mm before buckling (a soft sample): the quiet windows in contact are many
+    before the strains cross the threshold, and the machine takes the first crossing."""
+    rig = BeatingRig(VirtualClock(), holds=hold_from(3.0, 60.0))
+    result = run_trial(rig, rig.clock, plan(gated=True), Guards(), ThresholdDetector())
+    assert result.state is State.DONE, result.reason
+    over = [(s, u) for s, u, e in result.record if e and math.hypot(*e) > 50e-6]
+    assert over[0] == ("buckled", result.marks.x_buckling)  # no indenting tick passed it by
 
 
 def test_without_a_heart_the_post_buckling_travel_is_kept() -> None:
