@@ -11,13 +11,8 @@ import pytest
 
 from palpate.estimation.jointfit import JointFit
 from palpate.estimation.pose.heartbeat import QUIET, in_quiet_phase
-from palpate.estimation.trial.strobe import (
-    OFF_BEAT,
-    held_rows,
-    least_residual,
-    strobe_fit,
-    strobed_rows,
-)
+from palpate.estimation.trial.motion import least_residual
+from palpate.estimation.trial.strobe import OFF_BEAT, held_rows, strobe_fit, strobed_rows
 
 RATE = 250.0  # rows a second
 PERIOD = 0.85
@@ -78,20 +73,25 @@ def parabola(vertex: float, width: float, n: int = 100):  # type: ignore[no-unty
 
 
 def test_the_least_residual_and_its_error_from_the_curvature() -> None:
-    best, sigma, joint = least_residual(parabola(0.3e-3, 0.1e-3), (-1e-3, 1e-3), 0.01e-3)
-    assert best == pytest.approx(0.3e-3, abs=0.01e-3)
-    assert sigma == pytest.approx(0.1e-3 / math.sqrt(100), rel=0.05)  # chi^2 = n rms^2 rises 1
-    assert joint is not None
-    assert joint.modulus == pytest.approx(1e3 + best)
+    least = least_residual(parabola(0.3e-3, 0.1e-3), (-1e-3, 1e-3), 1e-8, 0.01e-3, 0.02e-3)
+    assert least.found
+    assert not least.edge
+    assert least.best == pytest.approx(0.3e-3, abs=0.001e-3)
+    # chi^2 = n rms^2 rises 1 at one standard error
+    assert least.sigma == pytest.approx(0.1e-3 / math.sqrt(100), rel=0.05)
+    assert least.joint is not None
+    assert least.joint.modulus == pytest.approx(1e3 + least.best)
 
 
 def test_a_least_at_the_searchs_edge_is_not_a_value() -> None:
-    _best, sigma, joint = least_residual(parabola(2e-3, 0.1e-3), (-1e-3, 1e-3), 0.01e-3)
-    assert math.isnan(sigma)
-    assert joint is None
-    failed = least_residual(lambda x: None, (-1e-3, 1e-3), 0.01e-3)
-    assert math.isnan(failed[1])
-    assert failed[2] is None
+    edge = least_residual(parabola(2e-3, 0.1e-3), (-1e-3, 1e-3), 1e-8, 0.01e-3, 0.02e-3)
+    assert edge.found
+    assert edge.edge
+    assert math.isnan(edge.sigma)
+    assert edge.joint is None
+    failed = least_residual(lambda x: None, (-1e-3, 1e-3), 1e-8, 0.01e-3, 0.02e-3)
+    assert not failed.found
+    assert failed.joint is None
 
 
 def test_the_drift_where_the_residual_is_least_and_its_interval() -> None:

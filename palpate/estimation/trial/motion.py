@@ -17,6 +17,7 @@ import dataclasses
 import math
 import warnings
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize_scalar  # type: ignore[import-untyped,unused-ignore]
@@ -108,16 +109,27 @@ def record_heart(
     frames carried an ECG's R-wave pulse; None without them, a tip grating or the rows' times."""
     if not pulses or times is None or not tip_forces or len(tip_forces) != len(rows):
         return None
+    found = free_loads(rows, tip_forces)
+    if found is None:
+        return None
+    states, load, sigma = found
+    contact = np.isin(states, HEART_ROWS) & (load > LEVEL_SIGMAS[0] * sigma)
+    advance = [r[1] for r in rows]
+    return heartbeat(advance, load, times, r_waves(times, pulses), contact)
+
+
+def free_loads(
+    rows: Sequence[Row], tip_forces: Sequence[float | None]
+) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The rows' states, their tip loads above the approach's zero (N; NaN where unread) and
+    the load's noise (N); None where the approach has too few rows for the zero."""
     states = np.asarray([r[0] for r in rows])
     load = np.asarray([np.nan if f is None else f for f in tip_forces], dtype=np.float64)
     free = free_load(states, load)
     if free is None:
         return None
     zero, sigma = free
-    load = load - zero
-    contact = np.isin(states, HEART_ROWS) & (load > LEVEL_SIGMAS[0] * sigma)
-    advance = [r[1] for r in rows]
-    return heartbeat(advance, load, times, r_waves(times, pulses), contact)
+    return states, load - zero, sigma
 
 
 def beating_rows(rows: Sequence[Row], times: Sequence[float], heart: Heartbeat) -> list[Row]:
@@ -130,36 +142,72 @@ def beating_rows(rows: Sequence[Row], times: Sequence[float], heart: Heartbeat) 
 def fitted_heart(heart: Heartbeat, fit: Callable[[Heartbeat], JointFit | None]) -> Heartbeat:
     """``heart`` at the amplitude where the residual of ``fit`` (the record's joint fit taken
     against a beat) is least, searched over ``HEART_SCALES`` of the least squares' amplitude; its
-    standard error from the residual's curvature there (the residuals' correlation counted as
-    the fit counts it, by its noise scale), ``HEART_FLOOR`` of it at least. Unchanged where every
-    fit fails; not ``fixed`` where the least lies at the search's edge."""
+    standard error from the residual's curvature there (:func:`least_residual`), ``HEART_FLOOR``
+    of it at least. Unchanged where every fit fails; not ``fixed`` where the least lies at the
+    search's edge."""
+    least = least_residual(
+        lambda k: fit(heart.scaled(k)), HEART_SCALES, 0.01, HEART_STEP, HEART_EDGE
+    )
+    best, floor = least.best, HEART_FLOOR * heart.amplitude * least.best
+    if not least.found:
+        return heart
+    if least.edge:
+        return dataclasses.replace(heart.scaled(best, floor), fixed=False)
+    if math.isnan(least.sigma):
+        return heart.scaled(best, floor)
+    return heart.scaled(best, max(least.sigma, HEART_FLOOR * best) * heart.amplitude)
 
-    fits: dict[float, JointFit | None] = {}  # by scale: the search's, read again at its best
 
-    def score(k: float) -> float:
-        joint = fits[k] = fit(heart.scaled(k))
+@dataclass(frozen=True)
+class Least:
+    """Where a residual is least (:func:`least_residual`): the value, whether any fit
+    succeeded, whether it lies at the search's edge, its standard error (NaN at the edge or
+    where no curvature shows) and the fit there (None where none)."""
+
+    best: float
+    found: bool
+    edge: bool
+    sigma: float
+    joint: JointFit | None
+
+
+def least_residual(
+    fit: Callable[[float], JointFit | None],
+    bounds: tuple[float, float],
+    xatol: float,
+    step: float,
+    edge: float,
+) -> Least:
+    """The value in ``bounds`` (to ``xatol``) where the squared rms residual of ``fit`` is least;
+    its standard error from the residual's curvature ``step`` either side (the residuals'
+    correlation counted as the fit counts it, by its noise scale: chi^2 = n rms^2 rises 1).
+    A least within ``edge`` of the bounds is not a minimum (the residual still falls past it)."""
+    fits: dict[float, JointFit | None] = {}  # the search's, read again at its best
+
+    def score(x: float) -> float:
+        joint = fits[x] = fit(x)
         if joint is None or not joint.success or joint.rms is None:
             return math.inf
         return float(joint.rms) ** 2
 
-    lo, hi = HEART_SCALES
+    lo, hi = bounds
     with warnings.catch_warnings():  # a failed fit scores inf: the search steps around it
         warnings.simplefilter("ignore", RuntimeWarning)
-        found = minimize_scalar(score, bounds=(lo, hi), method="bounded", options={"xatol": 0.01})
+        found = minimize_scalar(score, bounds=bounds, method="bounded", options={"xatol": xatol})
+    best = float(found.x)
     if not math.isfinite(found.fun):
-        return heart
-    best, step = float(found.x), HEART_STEP
-    if min(best - lo, hi - best) < HEART_EDGE:
-        edge = heart.scaled(best, HEART_FLOOR * heart.amplitude * best)
-        return dataclasses.replace(edge, fixed=False)
-    joint = fits[best] if best in fits else fit(heart.scaled(best))
+        return Least(best, False, False, math.nan, None)
+    if min(best - lo, hi - best) < edge:
+        return Least(best, True, True, math.nan, None)
+    joint = fits[best] if best in fits else fit(best)
     around = [score(best - step), float(found.fun), score(best + step)]
     curve = (around[0] - 2.0 * around[1] + around[2]) / step**2
     if not (math.isfinite(curve) and curve > 0) or joint is None:
-        return heart.scaled(best, HEART_FLOOR * heart.amplitude * best)
+        return Least(best, True, False, math.nan, joint)
     widen = joint.noise_scale or 1.0
-    sigma = widen * math.sqrt(2.0 / (max(joint.n_points, 1) * curve))  # chi2 = n rms^2 rises 1
-    return heart.scaled(best, max(sigma, HEART_FLOOR * best) * heart.amplitude)
+    return Least(
+        best, True, False, widen * math.sqrt(2.0 / (max(joint.n_points, 1) * curve)), joint
+    )
 
 
 def heart_envelope(

@@ -26,18 +26,16 @@ Usage::
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar  # type: ignore[import-untyped,unused-ignore]
 
 from ..jointfit import JointFit
 from ..jointfit.noise import MAX_RHO
 from ..pose.heartbeat import in_quiet_phase, r_waves
-from ..pose.motion import LEVEL_SIGMAS, Motion, free_load
-from .motion import DRIFT_SIGMAS, Row, spanning, still_rows
+from ..pose.motion import LEVEL_SIGMAS, Motion
+from .motion import DRIFT_SIGMAS, Row, free_loads, least_residual, spanning, still_rows
 
 OFF_BEAT = "off-beat"  # a row outside the quiet phase: no loading row (estimation.trial.states)
 MIN_WINDOWS = 2  # quiet windows with the tip in contact before buckling: a law, not a point
@@ -76,14 +74,12 @@ def strobed_rows(
     beats = r_waves(times, pulses)
     if len(beats) < 2:
         return None
-    states = np.asarray([r[0] for r in rows])
-    load = np.asarray([np.nan if f is None else f for f in tip_forces], dtype=np.float64)
-    free = free_load(states, load)
-    if free is None:
+    found = free_loads(rows, tip_forces)
+    if found is None:
         return None
-    zero, sigma = free
+    states, load, sigma = found
     quiet = in_quiet_phase(times, beats)
-    touching = quiet & np.isin(states, TOUCHING) & (load - zero > LEVEL_SIGMAS[1] * sigma)
+    touching = quiet & np.isin(states, TOUCHING) & (load > LEVEL_SIGMAS[1] * sigma)
     buckled = quiet & held_rows(rows)
     if _windows(times, beats, touching) < MIN_WINDOWS or _windows(times, beats, buckled) < (
         MIN_BUCKLED
@@ -129,44 +125,14 @@ def strobe_fit(
     def at(v: float) -> JointFit | None:
         return fit(still_rows(quiet, times, v, touch))
 
-    best, sigma, joint = least_residual(at, (-DRIFT_SPAN, DRIFT_SPAN), DRIFT_STEP)
-    span = release - touch
+    least = least_residual(at, (-DRIFT_SPAN, DRIFT_SPAN), DRIFT_STEP, DRIFT_STEP, 2 * DRIFT_STEP)
+    best, sigma, joint, span = least.best, least.sigma, least.joint, release - touch
     motion = Motion(best * span, touch, release, sigma * span)
     if joint is None or math.isnan(sigma):
         why = "the record does not fix the breath hold's drift (its fit is best at the edge)"
         return JointFit(False, f"heartbeat: {why}"), motion
     spread = [at(best + k * sigma) for k in (-DRIFT_SIGMAS, DRIFT_SIGMAS)]
     return _trusted(spanning(joint, spread)), motion
-
-
-def least_residual(
-    fit: Callable[[float], JointFit | None], bounds: tuple[float, float], step: float
-) -> tuple[float, float, JointFit | None]:
-    """The value in ``bounds`` where the residual of ``fit`` is least, its standard error from
-    the residual's curvature ``step`` either side (the residuals' correlation counted by the
-    fit's noise scale; NaN at the bounds' edge or where no curvature shows) and the fit there
-    (None where every fit failed)."""
-
-    def score(x: float) -> float:
-        joint = fit(x)
-        if joint is None or not joint.success or joint.rms is None:
-            return math.inf
-        return float(joint.rms) ** 2
-
-    lo, hi = bounds
-    with warnings.catch_warnings():  # a failed fit scores inf: the search steps around it
-        warnings.simplefilter("ignore", RuntimeWarning)
-        found = minimize_scalar(score, bounds=bounds, method="bounded", options={"xatol": step})
-    best = float(found.x)
-    if not math.isfinite(found.fun) or min(best - lo, hi - best) < 2.0 * step:
-        return best, math.nan, None
-    joint = fit(best)
-    around = [score(best - step), float(found.fun), score(best + step)]
-    curve = (around[0] - 2.0 * around[1] + around[2]) / step**2
-    if joint is None or not (math.isfinite(curve) and curve > 0):
-        return best, math.nan, joint
-    widen = joint.noise_scale or 1.0
-    return best, widen * math.sqrt(2.0 / (max(joint.n_points, 1) * curve)), joint
 
 
 def _trusted(joint: JointFit | None) -> JointFit | None:
