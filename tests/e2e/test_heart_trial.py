@@ -98,7 +98,8 @@ def test_a_gated_trial_that_arrives_in_a_hold_takes_the_beat_out(
 ) -> None:
     assert beating.log_path is not None
     told = replay(arrived_in_a_hold(beating.log_path, tmp_path / "told.jsonl", gated=True))
-    assert told["joint"]["modulus"] == pytest.approx(2e3, rel=0.05)
+    assert told["joint"]["modulus"] == pytest.approx(beating.joint.modulus, rel=0.05)  # type: ignore[union-attr]
+    assert told["joint"]["modulus"] == pytest.approx(2e3, rel=0.1)
     older = replay(arrived_in_a_hold(beating.log_path, tmp_path / "older.jsonl", gated=None))
     assert abs(older["joint"]["modulus"] / 2e3 - 1) > 0.2  # the beat left in: a wrong read
 
