@@ -49,11 +49,11 @@ def resume_outcomes(
     With ``campaign``, a trial that buckled unread is done only where its retries at shorter
     lengths (``campaigns.shorter``) are, as far as they went: the last one stands for it."""
     done: dict[str, TrialOutcome] = {}
+
+    def logged(attempt: TrialSpec) -> TrialOutcome | None:
+        return logged_outcome(log_dir, attempt, stack)
+
     for spec in specs:
-
-        def logged(attempt: TrialSpec) -> TrialOutcome | None:
-            return logged_outcome(log_dir, attempt, stack)
-
         outcome = logged(spec) if campaign is None else chained(spec, campaign, logged)
         if outcome is not None:
             done[spec.trial_id] = outcome

@@ -4,11 +4,12 @@ be read (``campaign.retry_lengths_mm``).
 The beam buckles at P_cr = 20.19 EI / L^2, so the indentation it reaches before buckling grows
 as the exposed length shortens: with Hertz, delta at buckling goes as (P_cr / E)^(2/3), as
 L^(-4/3). Beside the heart, a stiff sample buckles a 45 mm beam within about 0.1 mm of the
-first touch, less than the beat's own excursion: the systole alone buckles it, and the record
-cannot tell the tissue's law from the beat (docs/invivo.md). At 30 mm the same sample is read
-over 1.7 times the indentation. Which length a sample needs is not known before it is touched,
-so a trial that buckled and gave no estimate runs again at each of the campaign's shorter lengths
-in turn, until one gives an estimate::
+first touch, less than the beat's own excursion. The record is then read in the heart's quiet
+phase (``estimation.trial.strobe``), but where the breath hold's drift brings the tissue in as
+fast as the stage, too few quiet windows touch before the beam buckles (docs/invivo.md). At
+30 mm the same sample is read over 1.7 times the indentation. Which length a sample needs is
+not known before it is touched, so a trial that buckled and gave no estimate runs again at each
+of the campaign's shorter lengths in turn, until one gives an estimate::
 
     outcome = chained(spec, scene.campaign, lambda s: run_sim_trial(s, scene, stack))
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from palpate.estimation.jointfit import JointFit
-from palpate.estimation.pose.heartbeat import QUIET, in_quiet_phase
+from palpate.estimation.pose.heartbeat import QUIET, in_quiet_phase, r_waves
 from palpate.estimation.trial.motion import least_residual
 from palpate.estimation.trial.strobe import OFF_BEAT, held_rows, strobe_fit, strobed_rows
 
@@ -44,7 +44,7 @@ def test_the_rows_outside_the_quiet_phase_are_set_aside() -> None:
     rows, times, loads, pulses = record(held_s=2.5)
     strobe = strobed_rows(rows, times, loads, pulses)
     assert strobe is not None
-    quiet = in_quiet_phase(times, strobe.beats)
+    quiet = in_quiet_phase(times, r_waves(times, pulses))
     for (kept, _, _), (state, _, _), q in zip(strobe.rows, rows, quiet, strict=True):
         assert kept == (state if q else OFF_BEAT)
     phase = (strobe.touch % PERIOD) / PERIOD

@@ -50,7 +50,7 @@ from ..verdict import TrialFacts, Verdict, judge, relaxed_verdict
 from .finished import FinishedTrial, tip_load_at_buckling
 from .inputs import EstimatorInputs
 from .lean import lean_of_rows, loading_tip, rows_in
-from .motion import Row, motion_envelope, still_record, unfixed
+from .motion import Row, measured_heart, motion_envelope, steady_rows, unfixed
 from .relaxed import relaxation_of
 from .states import (
     LOADING_STATES,
@@ -214,12 +214,12 @@ def fit_rows(
         return fit(rows).joint
 
     drift = inputs.motion_tolerance is not None  # taken out where the campaign expects it
+    heart = measured_heart(rows, times, tip_forces, beats, drift, joint)
     quiet = strobed_rows(rows, times, tip_forces, beats)
     if quiet is not None and times is not None:
         fitted, (read, motion) = fit(rows), strobe_fit(quiet, times, drift, joint)
-        heart = still_record(rows, times, tip_forces, beats, drift, joint)[2]  # as it beat
     else:
-        rows, motion, heart = still_record(raw := rows, times, tip_forces, beats, drift, joint)
+        rows, motion = steady_rows(raw := rows, times, tip_forces, heart, drift)
         fitted = fit(rows)
         env = motion_envelope(fitted.joint, raw, times, tip_forces, (motion, heart), drift, joint)
         read = unfixed(env, heart, beating=bool(beats))

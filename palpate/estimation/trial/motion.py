@@ -297,22 +297,21 @@ def beat_fit(
     return lambda beat: fit(steady_rows(rows, times, tip_forces, beat, drift)[0])
 
 
-def still_record(
+def measured_heart(
     rows: list[Row],
     times: Sequence[float] | None,
     tip_forces: Sequence[float | None] | None,
     pulses: Sequence[float] | None,
     drift: bool,
     fit: JointOf,
-) -> tuple[list[Row], Motion | None, Heartbeat | None]:
-    """The rows taken against the surface's motion: the heart's beat where the record has an
-    ECG's R waves, then (with ``drift``, where the campaign expects the tissue to move) the
-    drift measured between touch and release; the motion as measured (after the beat) and the
-    beat. ``fit``: the joint fit of rows (the beat's amplitude is set by its residual)."""
+) -> Heartbeat | None:
+    """The heart's beat in the record (:func:`record_heart`), its amplitude where the joint fit
+    ``fit`` of the rows taken against it (:func:`steady_rows`: with ``drift``, the drift measured
+    again after it) is least (:func:`fitted_heart`); None without one."""
     heart = record_heart(rows, tip_forces, times, pulses)
-    if heart is not None:
-        heart = fitted_heart(heart, beat_fit(rows, times, tip_forces, drift, fit))
-    return (*steady_rows(rows, times, tip_forces, heart, drift), heart)
+    if heart is None:
+        return None
+    return fitted_heart(heart, beat_fit(rows, times, tip_forces, drift, fit))
 
 
 def motion_envelope(
@@ -324,10 +323,11 @@ def motion_envelope(
     drift: bool,
     fit: JointOf,
 ) -> JointFit | None:
-    """``joint`` (the fit of :func:`still_record`'s rows of ``raw``) with its interval spanning
+    """``joint`` (the fit of :func:`steady_rows`' rows of ``raw``) with its interval spanning
     the fits at the drift's velocity ``DRIFT_SIGMAS`` standard errors either side (the beat
     taken out as found) and at the beat's amplitude as many either side (the drift measured
-    again at each). ``found``: the motion and the beat :func:`still_record` gave."""
+    again at each). ``found``: the motion :func:`steady_rows` and the beat :func:`measured_heart`
+    gave."""
     motion, heart = found
     if times is None:
         return joint

@@ -49,13 +49,12 @@ DRIFT_STEP = 0.01e-3  # m/s: the residual's curvature is read this far either si
 
 @dataclass(frozen=True)
 class Strobe:
-    """The rows with those outside the quiet phase set aside, the first quiet row in contact
-    and the last buckled one (s): the span the drift is read over, and the R waves."""
+    """The rows with those outside the quiet phase set aside, and the first quiet row in contact
+    and the last held one (s): the span the drift is read over."""
 
     rows: list[Row]
     touch: float
     release: float
-    beats: tuple[float, ...]  # the R waves (s)
 
 
 def strobed_rows(
@@ -87,7 +86,7 @@ def strobed_rows(
         return None
     kept = [(s if q else OFF_BEAT, u, e) for (s, u, e), q in zip(rows, quiet, strict=True)]
     span = (times[int(np.argmax(touching))], times[int(np.flatnonzero(buckled)[-1])])
-    return Strobe(kept, *span, beats)
+    return Strobe(kept, *span)
 
 
 def held_rows(rows: list[Row]) -> np.ndarray:
