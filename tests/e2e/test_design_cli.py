@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 from collections.abc import Callable
 from pathlib import Path
@@ -229,8 +230,14 @@ def test_a_sagging_sensor_with_a_tip_grating_is_pointed_to_the_load_plateau(
 
 @pytest.mark.slow
 def test_a_plain_request_a_tip_grating_serves_names_the_option(
-    capsys: pytest.CaptureFixture[str],
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    """The text, ``--json`` and ``--tip-grating`` answers of one request. Each distinct request
+    is searched and simulated once (the same request gives the same answer: a cache on the
+    service's own evaluation), so the plain request and its tip-grating variant run once each."""
+    from palpate.services import design
+
+    monkeypatch.setattr(design, "_evaluated", functools.cache(design._evaluated))
     argv = ["design", "--modulus-range", "1:10", "--unit", "kPa", "--executor", "serial"]
     assert main(argv) == 1  # as asked, its simulated check fails (issue 60)
     first = capsys.readouterr().out.splitlines()[0]
@@ -242,3 +249,4 @@ def test_a_plain_request_a_tip_grating_serves_names_the_option(
     assert "tip_grating" in out["with_tip_grating"]
     assert main([*argv, "--tip-grating"]) == 0  # the option it names gives the answer
     assert capsys.readouterr().out.startswith("USABLE design")
+    assert design._evaluated.cache_info().misses == 2  # type: ignore[attr-defined]

@@ -273,13 +273,22 @@ class _Model:
         rows = np.arange(j.shape[1])[None, :]
         lo = loads[rows, np.maximum(j - 1, 0)]
         hi = loads[rows, np.minimum(j + 1, cols - 1)]
-        both = np.concatenate([cs, cs])
-        for _ in range(_GOLDEN):
-            a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-            ss = self._row_ss(both, np.concatenate([a, b]))
-            ss_a, ss_b = ss[: cs.size], ss[cs.size :]
+        a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
+        ss = self._row_ss(np.concatenate([cs, cs]), np.concatenate([a, b]))
+        ss_a, ss_b = ss[: cs.size], ss[cs.size :]
+        for _ in range(_GOLDEN - 1):  # golden section: one new point a step, the other kept
             left = ss_a < ss_b
             lo, hi = np.where(left, lo, a), np.where(left, b, hi)
+            new = np.where(left, hi - _PHI * (hi - lo), lo + _PHI * (hi - lo))
+            ss_new = self._row_ss(cs, new)
+            a, b, ss_a, ss_b = (
+                np.where(left, new, b),
+                np.where(left, a, new),
+                np.where(left, ss_new, ss_b),
+                np.where(left, ss_a, ss_new),
+            )
+        left = ss_a < ss_b
+        lo, hi = np.where(left, lo, a), np.where(left, b, hi)
         P = 0.5 * (lo + hi)
         return np.sum(self._row_ss(cs, P), axis=-1), P
 
@@ -347,10 +356,18 @@ def _profile(model: _Model) -> Lean:
     rss = model.rss_many(grid)[0]
     k = int(np.argmin(rss))
     lo, hi = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
-    for _ in range(_GOLDEN_C):  # the profile between the grid's neighbours of its minimum
-        a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-        at_a, at_b = model.rss_many(np.array([a, b]))[0]
-        lo, hi = (lo, b) if at_a < at_b else (a, hi)
+    a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
+    at_a, at_b = model.rss_many(np.array([a, b]))[0]
+    for _ in range(_GOLDEN_C - 1):  # the profile between the grid's neighbours of its minimum
+        if at_a < at_b:
+            hi, b, at_b = b, a, at_a
+            a = hi - _PHI * (hi - lo)
+            at_a = float(model.rss_many(np.array([a]))[0][0])
+        else:
+            lo, a, at_a = a, b, at_b
+            b = lo + _PHI * (hi - lo)
+            at_b = float(model.rss_many(np.array([b]))[0][0])
+    lo, hi = (lo, b) if at_a < at_b else (a, hi)
     c = 0.5 * (lo + hi)
     rss_free, P = model.rss(c)
     rss_pinned, P_pinned = model.rss(0.0, pinned=True)
