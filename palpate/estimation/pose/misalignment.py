@@ -47,6 +47,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,8 +69,7 @@ LENGTH_STEP = 1e-4  # m: rows are grouped by exposed length to this step for the
 _BELOW = 120  # candidate loads per row below LOAD_SHARE of the capacity
 _ABOVE = 120  # and above it, up to _ABOVE_MAX capacities (a pinned tip's loads, to 1.2 P_cr)
 _ABOVE_MAX = 10.0
-_GOLDEN_C = 16  # golden-section steps on c
-_GOLDEN = 14  # golden-section steps on each row's load
+_GOLDEN_C, _GOLDEN = 16, 14  # golden-section steps on c, and on each row's load
 _PHI = (math.sqrt(5.0) - 1.0) / 2.0
 GRID_DEG = 40.0  # the lean searched over +-this
 GRID_POINTS = 21
@@ -262,9 +262,8 @@ class _Model:
         return float(rss[0]), P[0]
 
     def rss_many(self, cs: FloatArray, pinned: bool = False) -> tuple[FloatArray, FloatArray]:
-        """:meth:`rss` at every ``c`` of ``cs`` (C,) at once: (C,) sums and (C, N) loads. The
-        arithmetic of each c is :meth:`rss`'s element for element (one numpy call for all of
-        them instead of one per c: the rows are few, the calls' overhead was the cost)."""
+        """:meth:`rss` at every ``c`` of ``cs`` (C,) at once (one numpy call for all: the rows are
+        few, the calls' overhead was the cost): (C,) sums and (C, N) loads."""
         cols = self.loads.shape[1] if pinned else _BELOW
         loads = self.loads[:, :cols]
         bb, bh, hh = (q[None, :, :cols] for q in self.quadratic)
@@ -273,22 +272,7 @@ class _Model:
         rows = np.arange(j.shape[1])[None, :]
         lo = loads[rows, np.maximum(j - 1, 0)]
         hi = loads[rows, np.minimum(j + 1, cols - 1)]
-        a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-        ss = self._row_ss(np.concatenate([cs, cs]), np.concatenate([a, b]))
-        ss_a, ss_b = ss[: cs.size], ss[cs.size :]
-        for _ in range(_GOLDEN - 1):  # golden section: one new point a step, the other kept
-            left = ss_a < ss_b
-            lo, hi = np.where(left, lo, a), np.where(left, b, hi)
-            new = np.where(left, hi - _PHI * (hi - lo), lo + _PHI * (hi - lo))
-            ss_new = self._row_ss(cs, new)
-            a, b, ss_a, ss_b = (
-                np.where(left, new, b),
-                np.where(left, a, new),
-                np.where(left, ss_new, ss_b),
-                np.where(left, ss_a, ss_new),
-            )
-        left = ss_a < ss_b
-        lo, hi = np.where(left, lo, a), np.where(left, b, hi)
+        lo, hi = _golden(lambda x: self._row_ss(cs, x), lo, hi, _GOLDEN)
         P = 0.5 * (lo + hi)
         return np.sum(self._row_ss(cs, P), axis=-1), P
 
@@ -331,6 +315,23 @@ class _Model:
         return (d0 + d1)[:, None, :], (d1 - d0)[:, None, :], span
 
 
+def _golden(
+    f: Callable[[FloatArray], FloatArray], lo: FloatArray, hi: FloatArray, steps: int
+) -> tuple[FloatArray, FloatArray]:
+    """The brackets [lo, hi] of the minima of ``f`` (elementwise) after ``steps`` steps."""
+    a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
+    fa, fb = f(a), f(b)
+    for _ in range(steps - 1):  # golden section: the interior point kept, one new evaluation
+        left = fa < fb
+        lo, hi = np.where(left, lo, a), np.where(left, b, hi)
+        new = np.where(left, hi - _PHI * (hi - lo), lo + _PHI * (hi - lo))
+        f_new = f(new)
+        a, b = np.where(left, new, b), np.where(left, a, new)
+        fa, fb = np.where(left, f_new, fb), np.where(left, fa, f_new)
+    left = fa < fb
+    return np.where(left, lo, a), np.where(left, b, hi)
+
+
 def _without_mode(v: FloatArray, u: FloatArray) -> FloatArray:
     """v (gratings first) with its component along the unit onset mode u taken out, the
     gratings' products summed in order."""
@@ -355,20 +356,9 @@ def _profile(model: _Model) -> Lean:
     grid = np.tan(np.radians(np.linspace(-GRID_DEG, GRID_DEG, GRID_POINTS)))
     rss = model.rss_many(grid)[0]
     k = int(np.argmin(rss))
-    lo, hi = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
-    a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-    at_a, at_b = model.rss_many(np.array([a, b]))[0]
-    for _ in range(_GOLDEN_C - 1):  # the profile between the grid's neighbours of its minimum
-        if at_a < at_b:
-            hi, b, at_b = b, a, at_a
-            a = hi - _PHI * (hi - lo)
-            at_a = float(model.rss_many(np.array([a]))[0][0])
-        else:
-            lo, a, at_a = a, b, at_b
-            b = lo + _PHI * (hi - lo)
-            at_b = float(model.rss_many(np.array([b]))[0][0])
-    lo, hi = (lo, b) if at_a < at_b else (a, hi)
-    c = 0.5 * (lo + hi)
+    lo, hi = grid[[max(k - 1, 0)]], grid[[min(k + 1, grid.size - 1)]]  # of the minimum: refined
+    lo, hi = _golden(lambda x: model.rss_many(x)[0], lo, hi, _GOLDEN_C)
+    c = float(0.5 * (lo + hi)[0])
     rss_free, P = model.rss(c)
     rss_pinned, P_pinned = model.rss(0.0, pinned=True)
     rows = model.rows
