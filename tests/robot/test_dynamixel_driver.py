@@ -100,6 +100,19 @@ def test_goal_step_is_clamped_per_tick(driver: DynamixelBus) -> None:
     assert sent["outer_roll"] == pytest.approx(2 * step, abs=1e-3)
 
 
+def test_goals_the_servos_hold_already_are_not_sent(silent: EmulatedBus) -> None:
+    """A tick whose goals round to the ticks last sent (a rest, a hold) sends no packet; the
+    next new goal goes out as before."""
+    with in_process(silent) as driver:
+        driver.set_torque(True)
+        first = driver.write_goals({"translation": 0.1})
+        packets = silent.packets_handled
+        assert driver.write_goals({"translation": 0.1 + 1e-4}) == first  # within one tick
+        assert silent.packets_handled == packets
+        driver.write_goals({"translation": 0.2})
+        assert silent.packets_handled == packets + 1
+
+
 def test_write_goals_needs_torque(driver: DynamixelBus) -> None:
     with pytest.raises(RuntimeError, match="torque"):
         driver.write_goals({"outer_roll": 0.1})

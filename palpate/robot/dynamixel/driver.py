@@ -6,10 +6,10 @@ already constructed ``dynamixel_sdk.PortHandler`` (and, optionally, an object wi
 packet handler's calls: the simulator's register-level path). Nothing is patched and nothing is
 built behind the caller's back, so a test hands it the emulator's port.
 
-Per control tick it makes one sync write of the goals (:meth:`DynamixelBus.write_goals`) and one
-sync read of Moving .. Present_Position (:meth:`DynamixelBus.read_state`). The sync read is made
-from the SDK's ``syncReadTx`` / ``readRx`` rather than ``GroupSyncRead``, because the latter drops
-each status packet's error byte, and the Alert bit in it is how a servo reports a hardware fault.
+Per control tick it makes one sync write of the goals (:meth:`DynamixelBus.write_goals`; none
+where the servos hold them already) and one sync read of Moving .. Present_Position
+(:meth:`DynamixelBus.read_state`), from the SDK's ``syncReadTx`` / ``readRx``: ``GroupSyncRead``
+drops each status packet's error byte, whose Alert bit is how a servo reports a hardware fault.
 
 Safety lives here: every transaction is retried a bounded number of times and then raises
 :class:`~robot.motors.ServoTransportError`; a port that fails under the driver (a USB adapter
@@ -17,9 +17,8 @@ unplugged: pyserial's EIO or "readiness to read but returned no data") is counte
 (``port_errors``) and opened again with a back-off (``reopens``; :mod:`robot.dynamixel.port`),
 its transactions failing as transport errors meanwhile; a status error or the Alert bit raises
 :class:`~robot.motors.ServoFaultError` with the decoded Hardware Error Status (never retried);
-goals move at most ``max_goal_step`` per call; :meth:`close` (also on leaving the ``with`` block)
-turns torque off on every servo before releasing the port, whatever happened before.
-"""
+goals move at most ``max_goal_step`` per call; :meth:`close` (also leaving the ``with`` block)
+turns torque off on every servo before releasing the port, whatever happened before."""
 
 from __future__ import annotations
 
@@ -322,7 +321,7 @@ class DynamixelBus:
 
     def write_goals(self, goals: Mapping[str, float]) -> dict[str, float]:
         """One sync write of shaft-angle goals (rad), each clamped to ``max_goal_step`` from the
-        last goal sent; returns the goals actually sent. Torque must be on."""
+        last goal sent; returns them. Torque must be on."""
         if not self._last_goals:
             raise RuntimeError("write_goals needs torque on (call set_torque(True) first)")
         sent: dict[str, float] = {}
@@ -336,6 +335,9 @@ class DynamixelBus:
             ticks = units.ticks_from_rad(last + step)
             sent[name] = units.rad_from_ticks(ticks)
             param += goal_param(m.id, ticks)  # ticks_from_rad keeps it in range
+
+        if all(self._last_goals[n] == g for n, g in sent.items()):
+            return sent  # a rest, a hold: 40 % of a campaign's ticks send nothing
 
         def call() -> tuple[None, int, int]:
             result = self._ph.syncWriteTxOnly(self._port, GOAL_ADDR, GOAL_LEN, param, len(param))
