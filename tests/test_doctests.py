@@ -19,6 +19,7 @@ LAYER_FRONTS = (
     "palpate.sensor_design",
     "palpate.estimation.reach",
     "palpate.estimation.pose.heartbeat",
+    "palpate.estimation.pose.golden",
     "palpate.sim.heart",
     "palpate.estimation.trial.finished",
     "palpate.reports.mapresults",

@@ -1,2 +1,3 @@
 """Pose and geometry: the surface and its normal (``surface``, ``surface_belief``), the sensor's
-lean on it (``misalignment``, ``slip_path``) and the surface's motion (``motion``)."""
+lean on it (``misalignment``, ``slip_path``, both searching with ``golden``) and the surface's
+motion (``motion``)."""

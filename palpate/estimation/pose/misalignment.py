@@ -47,7 +47,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,6 +54,7 @@ from numpy.typing import NDArray
 
 from ..beam.column import capacity, lateral_shape, lateral_shape_by_grating
 from ..beam.states import onset_mode
+from .golden import golden_brackets
 
 FloatArray = NDArray[np.float64]
 
@@ -70,7 +70,6 @@ _BELOW = 120  # candidate loads per row below LOAD_SHARE of the capacity
 _ABOVE = 120  # and above it, up to _ABOVE_MAX capacities (a pinned tip's loads, to 1.2 P_cr)
 _ABOVE_MAX = 10.0
 _GOLDEN_C, _GOLDEN = 16, 14  # golden-section steps on c, and on each row's load
-_PHI = (math.sqrt(5.0) - 1.0) / 2.0
 GRID_DEG = 40.0  # the lean searched over +-this
 GRID_POINTS = 21
 
@@ -272,7 +271,7 @@ class _Model:
         rows = np.arange(j.shape[1])[None, :]
         lo = loads[rows, np.maximum(j - 1, 0)]
         hi = loads[rows, np.minimum(j + 1, cols - 1)]
-        lo, hi = _golden(lambda x: self._row_ss(cs, x), lo, hi, _GOLDEN)
+        lo, hi = golden_brackets(lambda x: self._row_ss(cs, x), lo, hi, _GOLDEN)
         P = 0.5 * (lo + hi)
         return np.sum(self._row_ss(cs, P), axis=-1), P
 
@@ -315,23 +314,6 @@ class _Model:
         return (d0 + d1)[:, None, :], (d1 - d0)[:, None, :], span
 
 
-def _golden(
-    f: Callable[[FloatArray], FloatArray], lo: FloatArray, hi: FloatArray, steps: int
-) -> tuple[FloatArray, FloatArray]:
-    """The brackets [lo, hi] of the minima of ``f`` (elementwise) after ``steps`` steps."""
-    a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-    fa, fb = f(a), f(b)
-    for _ in range(steps - 1):  # golden section: the interior point kept, one new evaluation
-        left = fa < fb
-        lo, hi = np.where(left, lo, a), np.where(left, b, hi)
-        new = np.where(left, hi - _PHI * (hi - lo), lo + _PHI * (hi - lo))
-        f_new = f(new)
-        a, b = np.where(left, new, b), np.where(left, a, new)
-        fa, fb = np.where(left, f_new, fb), np.where(left, fa, f_new)
-    left = fa < fb
-    return np.where(left, lo, a), np.where(left, b, hi)
-
-
 def _without_mode(v: FloatArray, u: FloatArray) -> FloatArray:
     """v (gratings first) with its component along the unit onset mode u taken out, the
     gratings' products summed in order."""
@@ -357,7 +339,7 @@ def _profile(model: _Model) -> Lean:
     rss = model.rss_many(grid)[0]
     k = int(np.argmin(rss))
     lo, hi = grid[[max(k - 1, 0)]], grid[[min(k + 1, grid.size - 1)]]  # of the minimum: refined
-    lo, hi = _golden(lambda x: model.rss_many(x)[0], lo, hi, _GOLDEN_C)
+    lo, hi = golden_brackets(lambda x: model.rss_many(x)[0], lo, hi, _GOLDEN_C)
     c = float(0.5 * (lo + hi)[0])
     rss_free, P = model.rss(c)
     rss_pinned, P_pinned = model.rss(0.0, pinned=True)

@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..beam.column import capacity, lateral_shape
+from .golden import golden_brackets
 from .misalignment import LOAD_SHARE
 
 FloatArray = NDArray[np.float64]
@@ -55,7 +56,6 @@ MODEL_FLOOR = math.radians(0.5)  # rad: the normal depth's law (Hertz's 2/3 powe
 LEAN_GRID = np.radians(np.concatenate([-np.geomspace(40.0, 0.25, 40), np.geomspace(0.25, 40, 40)]))
 _CANDIDATES = 160  # loads per row below LOAD_SHARE of the capacity
 _GOLDEN = 24
-_PHI = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 @dataclass(frozen=True)
@@ -145,10 +145,7 @@ class _Rows:
         best = np.argmin(np.sum(r * r, axis=-1), axis=1)
         lo = grid[np.arange(n), np.maximum(best - 1, 0)]
         hi = grid[np.arange(n), np.minimum(best + 1, j - 1)]
-        for _ in range(_GOLDEN):
-            a, b = hi - _PHI * (hi - lo), lo + _PHI * (hi - lo)
-            left = self._ss(c, a) < self._ss(c, b)
-            lo, hi = np.where(left, lo, a), np.where(left, b, hi)
+        lo, hi = golden_brackets(lambda x: self._ss(c, x), lo, hi, _GOLDEN)
         P = 0.5 * (lo + hi)
         return P, float(np.sum(self._ss(c, P)))
 
