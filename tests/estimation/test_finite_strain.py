@@ -125,3 +125,25 @@ def test_deep_the_neo_hookean_law_widens_and_past_its_rows_is_flagged() -> None:
     linear = dataclasses.replace(neo, material="linear")
     assert model_form(neo, shallow).finite_strain >= model_form(linear, shallow).finite_strain
     assert model_form(neo, deep).finite_strain >= FINITE_STRAIN * 0.5
+
+
+def test_a_sticking_tip_on_a_sliding_layer_carries_its_whole_effect_in_the_bound() -> None:
+    """On a sliding base the world's FE leaves the sticking approximation's two limits (under
+    the lung's 10 mm tip, h/R 0.16-0.25), so the bound carries the stick's whole departure from
+    the frictionless law there; on a bonded base, where the limits hold the FE, half their
+    spread."""
+    from palpate.estimation.jointfit.modelform import model_form
+
+    radius, thickness = 10e-3, 1.6e-3
+    depth = 0.2 * thickness
+    x = np.linspace(0.0, depth / radius, 33)
+    for bonded in (False, True):
+        law = ContactLaw(radius, 0.45, thickness, bonded, material="neo-hookean", tip="sticking")
+        whole = np.max(
+            np.abs(
+                departure_curve(0.45, bonded, radius / thickness, "sticking").at(x)[0]
+                - departure_curve(0.45, bonded, radius / thickness, "frictionless").at(x)[0]
+            )
+        )
+        bound = model_form(law, depth).finite_strain
+        assert bool(bound >= whole) is (not bonded)

@@ -26,8 +26,9 @@ exact for none of the tissues the sensor meets. What the literature says about i
   second order is within 0.2 % of the world's finite elements to delta/h = 0.2 with a
   frictionless tip, 0.44 % at 0.3: docs/layer-law.md), plus ``FINITE_STRAIN (delta/R - 0.3)``
   past delta/R = 0.3, where it is checked (1-3 % off at 0.6); a sticking tip's departure
-  bridges two limits (``estimation.contact.finite_strain.departure``): half their spread in
-  quadrature.
+  bridges two limits (``estimation.contact.finite_strain.departure``): on a bonded layer half
+  their spread in quadrature; on a sliding one, whose FE leaves the limits, the stick's whole
+  departure from the frictionless law (``_stick``).
 
 The two are independent and combine in quadrature, at the deepest indentation of the record
 (where the load, hence the leverage on E, is largest): ``eps``. It is a bound on a bias of
@@ -44,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..contact.finite_strain.table import stick_spread_curve
+from ..contact.finite_strain.table import departure_curve, stick_spread_curve
 from ..contact.law import ContactLaw
 
 LAYER_SERIES = 0.25
@@ -94,9 +95,22 @@ def _finite_strain(law: ContactLaw, max_depth: float) -> float:
     out = float(np.max(np.abs(curve.at(depths)[0]))) * strain
     out += FINITE_STRAIN * max(0.0, ratio - SECOND_ORDER_DEPTH)
     if law.tip == "sticking":
-        spread = stick_spread_curve(law.poisson, law.bonded, law.inverse_thickness)
-        out = math.hypot(out, float(np.max(spread.at(depths)[0])))
+        out = math.hypot(out, _stick(law, depths))
     return out
+
+
+def _stick(law: ContactLaw, depths: np.ndarray) -> float:
+    """What the sticking tip's approximation may miss over ``depths`` (delta/R): on a bonded
+    layer half the spread of its two limits, which hold the world's FE in every table checked;
+    on a sliding one the stick's whole effect (its departure against the frictionless one),
+    since there the FE leaves the limits (under the lung's 10 mm tip, h/R 0.16-0.25, by up to
+    2-6 % of the force at delta/h 0.2-0.25: docs/layer-law.md)."""
+    if law.bonded:
+        spread = stick_spread_curve(law.poisson, law.bonded, law.inverse_thickness)
+        return float(np.max(spread.at(depths)[0]))
+    stick = departure_curve(law.poisson, law.bonded, law.inverse_thickness, "sticking")
+    free = departure_curve(law.poisson, law.bonded, law.inverse_thickness, "frictionless")
+    return float(np.max(np.abs(stick.at(depths)[0] - free.at(depths)[0])))
 
 
 def widened(modulus: float, ci_low: float, ci_high: float, eps: float) -> tuple[float, float]:

@@ -23,7 +23,9 @@ The force is ``F = dPi/ddelta``, so the relative departure from the linear law i
   stick's own shear field is left out, and :func:`_sticking` bridges the two limits where that
   is right (a thin layer, a half-space). An approximation: within 0.7 % of the world's FE to
   delta/h = 0.2 on the thin layers, 0.5 % on the lung and paper layers to delta/R = 0.2
-  (docs/layer-law.md); half the spread of its limits is carried in the interval
+  (docs/layer-law.md), but on a sliding layer under the lung's 10 mm tip (h/R 0.16-0.25) the
+  FE leaves the limits by up to 2-6 % at delta/h 0.2-0.25: the interval carries half the
+  limits' spread on a bonded layer and the stick's whole effect on a sliding one
   (``estimation.jointfit.modelform``).
 
 ``u1`` comes from the exact linear layer law's contact density (``estimation.contact.layer_exact``)
