@@ -202,6 +202,15 @@ def _print_report(done: CampaignDone, args: argparse.Namespace) -> None:
     levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
     print(f"world tissue: {', '.join(levels)}{note}")
+    for s in samples:
+        stops = tissue_description(scene, c.stack, s.name).get("table_stops")
+        if stops is not None:
+            print(
+                f"  {s.name}: the world's finite elements stop at delta/R "
+                f"{stops['delta_over_r']:.3g} of the {stops['asked_delta_over_r']:.3g} asked "
+                f"({stops['message']}): deeper, its force is the table's extrapolation, not the "
+                "FE, and its trials measure the estimator against that extrapolation"
+            )
     held = [s.name for s in samples if s.inclusions]
     if held:
         print(

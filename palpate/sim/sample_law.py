@@ -42,6 +42,7 @@ from .equilibrium import TissueLaw
 from .equilibrium.law import FloatArray
 from .fem import FeTissueLaw, LayerProblem, table_key
 from .fem.problem import significant
+from .fem.table import solved_table
 from .fem3d import Inclusion, InclusionProblem, InclusionWorld
 from .fem3d.offsets import MapWorld, on_axis
 from .fem3d.patch import PatchProblem, PatchWorld
@@ -205,6 +206,9 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
             poisson=problem.poisson,
             table=table_key(problem),
         )
+        stops = table_stops(problem)
+        if stops is not None:
+            out["table_stops"] = stops
         if not isinstance(world, LayerProblem):
             out["inclusions"] = [
                 {
@@ -220,6 +224,32 @@ def describe(sample: SampleConfig, fidelity: FidelityConfig, tip_radius: float) 
         out["law"] = "Sneddon x Dimitriadis (sim.tissue: the estimator's own family)"
     out["viscoelastic"] = None if sls is None else {**sls.describe(), "modulus": "relaxed"}
     return out
+
+
+SHORT_TABLE = 0.5
+"""A table whose solve stopped before this share of the depth it was asked for is reported."""
+
+
+def table_stops(problem: LayerProblem) -> dict[str, Any] | None:
+    """Where the finite elements of ``problem`` stopped, when they stopped short (their solve
+    did not converge, before ``SHORT_TABLE`` of the depth asked): past ``delta_over_r`` the
+    world's force is an extrapolation of the table, not the FE (``sim.fem.law``). None for a
+    table that reached its depth, and for one not solved yet (this never solves). Usage::
+
+        table_stops(problem)  # a 1.6 mm sliding layer under a 10 mm tip, frictionless:
+        # {'delta_over_r': 0.0018, 'asked_delta_over_r': 0.08, 'message': 'stopped at ...'}
+    """
+    table = solved_table(problem)
+    if table is None:
+        return None
+    reach = float(table.depths[-1])
+    if table.success or reach >= SHORT_TABLE * problem.depth_max:
+        return None
+    return {
+        "delta_over_r": reach,
+        "asked_delta_over_r": problem.depth_max,
+        "message": table.message,
+    }
 
 
 @dataclass(frozen=True)

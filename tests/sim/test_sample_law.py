@@ -141,6 +141,33 @@ def test_description_names_the_table() -> None:
     assert d["table"] == table_key(SHIPPED["paper-linear-stick"])
     assert d["viscoelastic"] is None
     assert describe(SAMPLE, FidelityConfig(tissue_model="closed-form"), R)["level"] == "closed-form"
+    assert "table_stops" not in d  # the shipped table reached its depth
+
+
+def test_a_table_whose_solve_stopped_short_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A finite-element solve that stopped early (an element inverted) leaves the world's force
+    past it an extrapolation: the description says where, so a campaign can say so."""
+    import palpate.sim.sample_law as law
+
+    problem = fe_problem(SAMPLE, FE, R)
+    shipped = read_table(problem, SHIPPED_DIR)
+    assert shipped is not None
+    reach = 0.2 * problem.depth_max
+    short = dataclasses.replace(
+        shipped,
+        depths=shipped.depths[shipped.depths <= reach],
+        success=False,
+        message="stopped at delta/R = 0.08 after 6 bisections: element inverted (det F <= 0)",
+    )
+    monkeypatch.setattr(law, "solved_table", lambda p: short)
+    stops = describe(SAMPLE, FE, R)["table_stops"]
+    assert stops["delta_over_r"] == pytest.approx(float(short.depths[-1]))
+    assert stops["asked_delta_over_r"] == problem.depth_max
+    assert "element inverted" in stops["message"]
+    monkeypatch.setattr(law, "solved_table", lambda p: dataclasses.replace(short, success=True))
+    assert "table_stops" not in describe(SAMPLE, FE, R)
+    monkeypatch.setattr(law, "solved_table", lambda p: None)  # not solved yet: none is solved
+    assert "table_stops" not in describe(SAMPLE, FE, R)
 
 
 SCENES = [

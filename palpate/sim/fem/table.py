@@ -127,13 +127,22 @@ def solve_table(problem: LayerProblem) -> ForceTable:
     )
 
 
-@functools.lru_cache(maxsize=64)
-def load_table(problem: LayerProblem) -> ForceTable:
-    """The table of ``problem``: shipped, else cached, else solved and cached (kept in memory)."""
+def solved_table(problem: LayerProblem) -> ForceTable | None:
+    """The table of ``problem`` if it is shipped or cached already (None: not solved yet; this
+    never solves)."""
     for directory in (SHIPPED_DIR, cache_dir()):
         table = read_table(problem, directory)
         if table is not None:
             return table
+    return None
+
+
+@functools.lru_cache(maxsize=64)
+def load_table(problem: LayerProblem) -> ForceTable:
+    """The table of ``problem``: shipped, else cached, else solved and cached (kept in memory)."""
+    table = solved_table(problem)
+    if table is not None:
+        return table
     table = solve_table(problem)
     save_table(table, cache_dir())
     return table
