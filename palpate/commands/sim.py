@@ -199,14 +199,15 @@ def _print_report(done: CampaignDone, args: argparse.Namespace) -> None:
     failed = [o for o in outcomes if o.state != "done"]
     print_table(c.scene.name, records)
     samples = c.scene.campaign_samples()
-    levels = sorted({tissue_description(scene, c.stack, s.name)["level"] for s in samples})
+    tissues = {s.name: tissue_description(scene, c.stack, s.name) for s in samples}
+    levels = sorted({t["level"] for t in tissues.values()})
     note = " (the estimator's own model: this judges self-consistency)" * ("closed-form" in levels)
     print(f"world tissue: {', '.join(levels)}{note}")
-    for s in samples:
-        stops = tissue_description(scene, c.stack, s.name).get("table_stops")
+    for name, tissue in tissues.items():
+        stops = tissue.get("table_stops")
         if stops is not None:
             print(
-                f"  {s.name}: the world's finite elements stop at delta/R "
+                f"  {name}: the world's finite elements stop at delta/R "
                 f"{stops['delta_over_r']:.3g} of the {stops['asked_delta_over_r']:.3g} asked "
                 f"({stops['message']}): deeper, its force is the table's extrapolation, not the "
                 "FE, and its trials measure the estimator against that extrapolation"
